@@ -1,0 +1,67 @@
+"""ght_cad: GHT-Bézier curves and developable surfaces for CAD.
+
+The core (this package) depends on numpy and scipy only; CAD kernels (build123d/OCP, cadquery,
+FreeCAD) are reached through thin adapters in :mod:`ght_cad.cad` and ``freecad_workbench``, which
+are never imported here.
+
+Stable names (spec section 9): :func:`basis`, :class:`GHTCurve`, :func:`developable_from_planes`,
+:func:`unroll`.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from .basis import basis, bernstein
+from .curve import GHTCurve
+from .errors import (
+    ConversionError,
+    DegenerateGeometryError,
+    EdgeOfRegressionError,
+    GHTError,
+    NotDevelopableError,
+    ShapeParameterError,
+    SingularJoinError,
+)
+from .seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "basis",
+    "bernstein",
+    "GHTCurve",
+    "Seed",
+    "GHTSeed",
+    "GBTSeed",
+    "BernsteinSeed",
+    "make_seed",
+    "register_seed",
+    "seed_names",
+    "GHTError",
+    "ShapeParameterError",
+    "DegenerateGeometryError",
+    "EdgeOfRegressionError",
+    "NotDevelopableError",
+    "SingularJoinError",
+    "ConversionError",
+    "developable_from_planes",
+    "unroll",
+]
+
+# Names provided by modules that import scipy or are heavier: loaded on first use so that
+# ``import ght_cad`` stays fast (< 0.3 s) and never touches a CAD kernel.
+_LAZY: dict[str, str] = {
+    "developable_from_planes": "ght_cad.developable",
+    "unroll": "ght_cad.unroll",
+}
+
+
+def __getattr__(name: str) -> Any:
+    mod = _LAZY.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'ght_cad' has no attribute {name!r}")
+    value = getattr(importlib.import_module(mod), name)
+    globals()[name] = value
+    return value

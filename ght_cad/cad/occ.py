@@ -1,0 +1,154 @@
+"""OCP (OpenCASCADE) conversions of ght_cad's plain B-spline data, STEP I/O and validity checks.
+
+Shared by every build123d/cadquery adapter. OCCT arrays are 1-based; static methods end in ``_s``.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable
+
+import numpy as np
+from OCP.BRep import BRep_Builder
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
+from OCP.gp import gp_Pnt
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
+from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
+from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
+
+from ..bspline import BSplineCurveData, BSplineSurfaceData
+from ..errors import GHTError
+from ..io import atomic_path
+
+__all__ = [
+    "geom_bspline_curve",
+    "geom_bspline_surface",
+    "make_edge",
+    "make_face",
+    "is_valid",
+    "write_step",
+    "read_step",
+    "unwrap",
+]
+
+
+def unwrap(shape: Any) -> TopoDS_Shape:
+    """The OCP ``TopoDS_Shape`` behind a build123d or cadquery shape (or the shape itself)."""
+    return shape.wrapped if hasattr(shape, "wrapped") else shape
+
+
+def _real_array(values: Iterable[float]) -> TColStd_Array1OfReal:
+    vals = list(values)
+    arr = TColStd_Array1OfReal(1, len(vals))
+    for i, v in enumerate(vals, 1):
+        arr.SetValue(i, float(v))
+    return arr
+
+
+def _int_array(values: Iterable[int]) -> TColStd_Array1OfInteger:
+    vals = list(values)
+    arr = TColStd_Array1OfInteger(1, len(vals))
+    for i, v in enumerate(vals, 1):
+        arr.SetValue(i, int(v))
+    return arr
+
+
+def _pnt(p: np.ndarray) -> gp_Pnt:
+    q = np.zeros(3)
+    q[: min(3, p.size)] = p[:3]
+    return gp_Pnt(float(q[0]), float(q[1]), float(q[2]))
+
+
+def geom_bspline_curve(data: BSplineCurveData) -> Geom_BSplineCurve:
+    """``Geom_BSplineCurve`` from plain data (2-D poles get z = 0)."""
+    if data.dim not in (2, 3):
+        raise GHTError(f"a CAD edge needs 2-D or 3-D poles; got dimension {data.dim}")
+    poles = TColgp_Array1OfPnt(1, data.poles.shape[0])
+    for i, p in enumerate(data.poles, 1):
+        poles.SetValue(i, _pnt(p))
+    knots, mults = data.distinct_knots()
+    if data.weights is None:
+        return Geom_BSplineCurve(poles, _real_array(knots), _int_array(mults), int(data.degree), False)
+    return Geom_BSplineCurve(
+        poles, _real_array(data.weights), _real_array(knots), _int_array(mults), int(data.degree), False
+    )
+
+
+def geom_bspline_surface(data: BSplineSurfaceData) -> Geom_BSplineSurface:
+    """``Geom_BSplineSurface`` from plain data."""
+    nu, nv, _ = data.poles.shape
+    poles = TColgp_Array2OfPnt(1, nu, 1, nv)
+    for i in range(nu):
+        for j in range(nv):
+            poles.SetValue(i + 1, j + 1, _pnt(data.poles[i, j]))
+    ku, mu = BSplineCurveData(np.zeros((nu, 1)), data.knots_u, data.degree_u).distinct_knots()
+    kv, mv = BSplineCurveData(np.zeros((nv, 1)), data.knots_v, data.degree_v).distinct_knots()
+    return Geom_BSplineSurface(
+        poles, _real_array(ku), _real_array(kv), _int_array(mu), _int_array(mv), int(data.degree_u), int(data.degree_v)
+    )
+
+
+def make_edge(data: BSplineCurveData) -> Any:
+    """A build123d ``Edge`` holding the exact B-spline of ``data``."""
+    from build123d import Edge
+
+    return Edge(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge())
+
+
+def make_face(data: BSplineSurfaceData, tolerance: float = 1e-7) -> Any:
+    """A build123d ``Face`` on the B-spline surface of ``data`` (natural bounds)."""
+    from build123d import Face
+
+    builder = BRepBuilderAPI_MakeFace(geom_bspline_surface(data), float(tolerance))
+    if not builder.IsDone():
+        raise GHTError("OCCT could not build a face on the B-spline surface")
+    return Face(builder.Face())
+
+
+def is_valid(shape: Any) -> bool:
+    """``BRepCheck_Analyzer(shape).IsValid()``."""
+    return bool(BRepCheck_Analyzer(unwrap(shape)).IsValid())
+
+
+def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True) -> str:
+    """Write one shape or several (as a compound) to a STEP file, atomically.
+
+    Raises:
+        GHTError: an invalid shape (when ``check``) or a failed write; the target is untouched.
+    """
+    items = list(shapes) if isinstance(shapes, (list, tuple)) else [shapes]
+    if not items:
+        raise GHTError("nothing to export: the list of shapes is empty")
+    raw = [unwrap(s) for s in items]
+    if check:
+        for i, s in enumerate(raw):
+            if not BRepCheck_Analyzer(s).IsValid():
+                raise GHTError(f"shape #{i} is not a valid B-rep (BRepCheck_Analyzer); not exported to {path}")
+    if len(raw) == 1:
+        shape = raw[0]
+    else:
+        comp = TopoDS_Compound()
+        bb = BRep_Builder()
+        bb.MakeCompound(comp)
+        for s in raw:
+            bb.Add(comp, s)
+        shape = comp
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    with atomic_path(path) as tmp:
+        if writer.Write(str(tmp)) != IFSelect_RetDone:
+            raise GHTError(f"OCCT failed to write STEP file {path}")
+    return str(path)
+
+
+def read_step(path: str | os.PathLike) -> TopoDS_Shape:
+    """Read a STEP file into one OCP shape."""
+    reader = STEPControl_Reader()
+    if reader.ReadFile(str(path)) != IFSelect_RetDone:
+        raise GHTError(f"could not read STEP file {path}")
+    reader.TransferRoots()
+    return reader.OneShape()

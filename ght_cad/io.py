@@ -1,0 +1,66 @@
+"""Atomic file output: a failed export leaves no partial file and never damages an existing one."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable, Iterator, IO
+
+__all__ = ["atomic_path", "atomic_write", "write_text_atomic", "write_bytes_atomic"]
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
+
+    For writers that want a file name (OCCT's STEP writer, matplotlib, ezdxf). If the block raises,
+    or leaves no file behind, the temporary file is removed and ``path`` is untouched.
+
+    Example:
+        >>> with atomic_path("part.step") as tmp:        # doctest: +SKIP
+        ...     writer.Write(str(tmp))
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    sfx = target.suffix if suffix is None else suffix
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=sfx + ".part", dir=target.parent)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    # Some writers refuse an existing file or append to it: hand them a path that does not exist.
+    tmp.unlink()
+    try:
+        yield tmp
+        if not tmp.exists() or tmp.stat().st_size == 0:
+            raise OSError(f"writing {target} produced no data")
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str | None = "utf-8") -> Iterator[IO]:
+    """Open a temporary file beside ``path`` for writing; rename it over ``path`` on success."""
+    binary = "b" in mode
+    with atomic_path(path) as tmp:
+        with open(tmp, mode, encoding=None if binary else encoding) as fh:
+            yield fh
+            fh.flush()
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically and return the path."""
+    with atomic_write(path, "w") as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically and return the path."""
+    with atomic_write(path, "wb") as fh:
+        fh.write(data)
+    return Path(path)

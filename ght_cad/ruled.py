@@ -1,0 +1,230 @@
+r"""Ruled surfaces and their developability degree (spec section 5).
+
+A ruled surface is ``X(u, v) = a(u) + v (b(u) - a(u))``, u, v ∈ [0, 1], with directrix ``a`` and
+ruling ``g = b - a``. It is developable iff ``det(a'(u), g(u), g'(u)) = 0`` for all u; then the
+tangent plane is constant along each ruling and it unrolls with no stretch.
+
+Every surface class of the package (enveloping, spine, geodesic, curve-pair strips) derives from
+:class:`RuledSurface` and only implements :meth:`RuledSurface.a` and :meth:`RuledSurface.b` with
+analytic derivatives; measures, sampling and conversion are shared.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import asdict, dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from ._validate import as_parameter_array
+from .curve import GHTCurve, gauss_legendre
+from .errors import GHTError
+
+__all__ = [
+    "Developability",
+    "RuledSurface",
+    "CurvePairRuledSurface",
+    "FunctionRuledSurface",
+    "developability_from_jets",
+]
+
+
+@dataclass(frozen=True)
+class Developability:
+    r"""Developability degree of a ruled surface (spec section 5).
+
+    Attributes:
+        theta_max: max over u of ``θ(u) = angle(n_a, n_b)`` in degrees.
+        theta_rms: ``sqrt(∫ θ(u)^2 du)`` in degrees.
+        dd: degree of developability ``∫ cos θ(u) du`` (1 is exactly developable).
+        R: smooth objective ``∫_0^1 (1 - n_a · n_b) du`` (Gauss–Legendre).
+        residual_max: ``max |det(a', g, g')| / (|a'| |g| |g'|)`` (scale-free residual).
+    """
+
+    theta_max: float
+    theta_rms: float
+    dd: float
+    R: float
+    residual_max: float
+
+    def as_dict(self) -> dict[str, float]:
+        return {k: float(v) for k, v in asdict(self).items()}
+
+    def __str__(self) -> str:
+        return (
+            f"theta_max={self.theta_max:.3e} deg, theta_rms={self.theta_rms:.3e} deg, "
+            f"DD={self.dd:.12f}, R={self.R:.3e}"
+        )
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return v / n
+
+
+def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(θ in degrees, n_a·n_b) with ``n_a = a'×g/|a'×g|`` and ``n_b = b'×g/|b'×g|``."""
+    na = _unit(np.cross(a1, g))
+    nb = _unit(np.cross(b1, g))
+    dot = np.clip(np.sum(na * nb, axis=-1), -1.0, 1.0)
+    # atan2 of |na × nb| and na·nb is accurate near 0 where arccos is not
+    cr = np.linalg.norm(np.cross(na, nb), axis=-1)
+    return np.degrees(np.arctan2(cr, dot)), dot
+
+
+def developability_from_jets(
+    a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray, weights: np.ndarray
+) -> tuple[float, float, float, float]:
+    """θ_rms, DD, R and θ_max from directrix values/derivatives at quadrature nodes."""
+    g = b0 - a0
+    th, dot = _theta(a1, b1, g)
+    theta_rms = float(np.sqrt(np.sum(weights * th**2) / np.sum(weights)))
+    dd = float(np.sum(weights * np.cos(np.radians(th))) / np.sum(weights))
+    R = float(np.sum(weights * (1.0 - dot)) / np.sum(weights))
+    return float(th.max()), theta_rms, dd, R
+
+
+class RuledSurface(ABC):
+    r"""Abstract ruled surface ``X(u, v) = a(u) + v (b(u) - a(u))`` on [0, 1]².
+
+    Subclasses implement :meth:`a` and :meth:`b` (values and analytic derivatives, orders 0..2
+    at least). ``v`` may leave [0, 1] to extend the rulings.
+    """
+
+    @abstractmethod
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Directrix ``a^(r)(u)``, shape (len(u), 3)."""
+
+    @abstractmethod
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Second boundary ``b^(r)(u)``, shape (len(u), 3)."""
+
+    # -- geometry ------------------------------------------------------------------------
+    def ruling(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Ruling vector ``g^(r)(u) = b^(r)(u) - a^(r)(u)`` (not normalized)."""
+        return self.b(u, derivative) - self.a(u, derivative)
+
+    def evaluate(self, u: Any, v: Any) -> np.ndarray:
+        """Points ``X(u, v) = (1-v) a(u) + v b(u)``; u and v broadcast to a common 1-D shape."""
+        uu, us = as_parameter_array(u, "u")
+        vv, vs = as_parameter_array(v, "v")
+        uu, vv = np.broadcast_arrays(uu, vv)
+        A = self.a(uu)
+        B = self.b(uu)
+        out = A + vv[:, None] * (B - A)
+        return out[0] if (us and vs) else out
+
+    def grid(self, nu: int = 33, nv: int = 9) -> np.ndarray:
+        """Points on a regular (nu, nv) grid, shape (nu, nv, 3)."""
+        u = np.linspace(0.0, 1.0, nu)
+        A = self.a(u)
+        G = self.b(u) - A
+        v = np.linspace(0.0, 1.0, nv)
+        return A[:, None, :] + v[None, :, None] * G[:, None, :]
+
+    def partials(self, u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``(X_u, X_v) = (a' + v g', g)``."""
+        uu, _ = as_parameter_array(u, "u")
+        vv, _ = as_parameter_array(v, "v")
+        uu, vv = np.broadcast_arrays(uu, vv)
+        a1 = self.a(uu, 1)
+        g = self.ruling(uu)
+        g1 = self.ruling(uu, 1)
+        return a1 + vv[:, None] * g1, g
+
+    def normal(self, u: Any, v: Any) -> np.ndarray:
+        """Unit normal ``X_u × X_v / |X_u × X_v|``."""
+        xu, xv = self.partials(u, v)
+        return _unit(np.cross(xu, xv))
+
+    def gaussian_curvature(self, u: Any, v: Any) -> np.ndarray:
+        r"""Gaussian curvature of the ruled surface, ``K = -det(a', g, g')^2 / |X_u × g|^4``."""
+        uu, _ = as_parameter_array(u, "u")
+        vv, _ = as_parameter_array(v, "v")
+        uu, vv = np.broadcast_arrays(uu, vv)
+        a1 = self.a(uu, 1)
+        g = self.ruling(uu)
+        g1 = self.ruling(uu, 1)
+        det = np.einsum("ij,ij->i", a1, np.cross(g, g1))
+        w2 = np.sum(np.cross(a1 + vv[:, None] * g1, g) ** 2, axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return -(det**2) / w2**2
+
+    def developability_residual(self, u: Any) -> np.ndarray:
+        r"""Scale-free residual ``det(a', g, g') / (|a'| |g| |g'|)`` (0 on a developable)."""
+        uu, _ = as_parameter_array(u, "u")
+        a1 = self.a(uu, 1)
+        g = self.ruling(uu)
+        g1 = self.ruling(uu, 1)
+        det = np.einsum("ij,ij->i", a1, np.cross(g, g1))
+        scale = np.linalg.norm(a1, axis=1) * np.linalg.norm(g, axis=1) * np.linalg.norm(g1, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(scale > 0, det / np.where(scale > 0, scale, 1.0), 0.0)
+
+    def theta(self, u: Any) -> np.ndarray:
+        """Angle θ(u) in degrees between the normals at the two ends of the ruling at u."""
+        uu, _ = as_parameter_array(u, "u")
+        th, _ = _theta(self.a(uu, 1), self.b(uu, 1), self.ruling(uu))
+        return th
+
+    def developability(self, nodes: int = 64, samples: int = 257) -> Developability:
+        r"""Developability degree (spec section 5).
+
+        ``θ(u) = angle(n_a, n_b)``, ``n_a = a'×g/|a'×g|``, ``n_b = b'×g/|b'×g|``;
+        ``θ_rms = sqrt(∫θ²)``, ``DD = ∫ cos θ``, ``R = ∫(1 - n_a·n_b)`` by ``nodes``-point
+        Gauss–Legendre quadrature (>= 64); ``θ_max`` over the quadrature nodes and ``samples``
+        uniform parameters (ends included).
+        """
+        if nodes < 64:
+            raise GHTError(f"nodes={nodes} is too few; the developability integrals use >= 64 Gauss–Legendre nodes")
+        t, w = gauss_legendre(nodes)
+        _, theta_rms, dd, R = developability_from_jets(self.a(t), self.a(t, 1), self.b(t), self.b(t, 1), w)
+        uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
+        theta_max = float(np.max(self.theta(uu)))
+        res = float(np.max(np.abs(self.developability_residual(uu))))
+        return Developability(theta_max, theta_rms, dd, R, res)
+
+    def ruling_lengths(self, u: Any) -> np.ndarray:
+        """``|b(u) - a(u)|``."""
+        return np.linalg.norm(self.ruling(u), axis=-1)
+
+
+class CurvePairRuledSurface(RuledSurface):
+    """Ruled surface between two GHT curves paired by their common parameter.
+
+    ``X(u, v) = (1-v) A(u) + v B(u)`` with ``A``, ``B`` 3-D :class:`GHTCurve` objects.
+    Used for quasi-developable strips whose shape parameters are optimized (spec sections 5, 8).
+    """
+
+    def __init__(self, curve_a: GHTCurve, curve_b: GHTCurve) -> None:
+        for name, c in (("curve_a", curve_a), ("curve_b", curve_b)):
+            if not isinstance(c, GHTCurve):
+                raise GHTError(f"{name} must be a GHTCurve, got {type(c).__name__}")
+            if c.dim != 3:
+                raise GHTError(f"{name} has dimension {c.dim}; a ruled surface needs 3-D curves")
+        self.curve_a = curve_a
+        self.curve_b = curve_b
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self.curve_a.derivative(u, derivative)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self.curve_b.derivative(u, derivative)
+
+
+class FunctionRuledSurface(RuledSurface):
+    """Ruled surface from two callables ``a(u, derivative)`` and ``b(u, derivative)``."""
+
+    def __init__(self, a: Callable[[np.ndarray, int], np.ndarray], b: Callable[[np.ndarray, int], np.ndarray]) -> None:
+        self._a = a
+        self._b = b
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        uu, _ = as_parameter_array(u, "u")
+        return np.asarray(self._a(uu, derivative), dtype=float).reshape(uu.size, 3)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        uu, _ = as_parameter_array(u, "u")
+        return np.asarray(self._b(uu, derivative), dtype=float).reshape(uu.size, 3)
