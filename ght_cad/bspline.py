@@ -10,13 +10,23 @@ end knots, length ``len(poles) + degree + 1``), non-rational unless ``weights`` 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
-from .errors import GHTError
+from .errors import ConversionError, GHTError
 
-__all__ = ["BSplineCurveData", "BSplineSurfaceData", "knots_and_multiplicities"]
+if TYPE_CHECKING:  # pragma: no cover
+    from .curve import GHTCurve
+
+__all__ = [
+    "BSplineCurveData",
+    "BSplineSurfaceData",
+    "knots_and_multiplicities",
+    "fit_function",
+    "curve_to_bspline",
+    "clamped_knots",
+]
 
 
 def knots_and_multiplicities(knots: np.ndarray, tol: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -131,3 +141,274 @@ class BSplineSurfaceData:
         Bu = BSpline.design_matrix(np.clip(uu, self.knots_u[0], self.knots_u[-1]), self.knots_u, self.degree_u).toarray()
         Bv = BSpline.design_matrix(np.clip(vv, self.knots_v[0], self.knots_v[-1]), self.knots_v, self.degree_v).toarray()
         return np.einsum("ki,kj,ijd->kd", Bu, Bv, self.poles)
+
+
+# ---------------------------------------------------------------------------------------------
+# Conversion: certified B-spline approximation that keeps the parametrization
+# ---------------------------------------------------------------------------------------------
+
+
+def clamped_knots(breaks: Sequence[float], degree: int) -> np.ndarray:
+    """Full clamped knot vector on the span boundaries ``breaks`` (first/last repeated p+1 times)."""
+    b = np.asarray(breaks, dtype=float)
+    p = int(degree)
+    return np.concatenate([np.full(p, b[0]), b, np.full(p, b[-1])])
+
+
+def _end_basis(knots: np.ndarray, degree: int, n_poles: int, end: int, orders: int) -> np.ndarray:
+    """Matrix ``D[k, j] = N_j^(k)(end)`` for k = 0..orders-1 over the ``orders`` poles at that end.
+
+    At a clamped end the first k+1 poles alone determine the k-th derivative, so ``D`` is
+    triangular with a nonzero diagonal.
+    """
+    from scipy.interpolate import BSpline
+
+    idx = np.arange(orders) if end == 0 else np.arange(n_poles - orders, n_poles)
+    coef = np.zeros((n_poles, orders))
+    coef[idx, np.arange(orders)] = 1.0
+    sp = BSpline(knots, coef, degree, extrapolate=False)
+    x = float(knots[0] if end == 0 else knots[-1])
+    return np.array([sp(x, nu=k) for k in range(orders)])  # (orders, orders): row k, column pole
+
+
+def _call(func: Callable[[np.ndarray], np.ndarray], t: np.ndarray, dim: int | None) -> np.ndarray:
+    vals = np.asarray(func(t), dtype=float)
+    if vals.ndim == 1:
+        vals = vals[:, None]
+    if vals.ndim != 2 or vals.shape[0] != t.size:
+        raise GHTError(
+            f"func must map an array of {t.size} parameters to an array of shape ({t.size}, d); "
+            f"it returned shape {vals.shape}"
+        )
+    if dim is not None and vals.shape[1] != dim:
+        raise GHTError(f"func returned dimension {vals.shape[1]}, earlier calls returned {dim}")
+    if not np.all(np.isfinite(vals)):
+        raise GHTError("func returned NaN or inf values on [0, 1]")
+    return vals
+
+
+def _chebyshev_lobatto(count: int) -> np.ndarray:
+    """``count`` Chebyshev–Lobatto points on [0, 1] (ends included), increasing."""
+    k = np.arange(count)
+    return 0.5 * (1.0 - np.cos(np.pi * k / (count - 1)))
+
+
+def fit_function(
+    func: Callable[[np.ndarray], np.ndarray],
+    *,
+    tol: float,
+    degree: int = 5,
+    end_derivatives: tuple[Sequence[np.ndarray], Sequence[np.ndarray]] | None = None,
+    max_spans: int = 1024,
+) -> BSplineCurveData:
+    r"""Certified B-spline approximation ``C(t) ≈ f(t)`` on [0, 1] that keeps the parametrization.
+
+    ``C(t) = Σ_i N_{i,p}(t) P_i`` on a clamped knot vector. The deviation is measured at matched
+    parameters, ``max_t |f(t) - C(t)|`` (Euclidean norm in R^d), never by projection, so that two
+    functions fitted together (stack them into one d-vector) share one knot vector and pole ``i``
+    of each belongs to the same parameter neighbourhood (e.g. the two ends of a ruling).
+
+    Algorithm: least squares ``min Σ_s |f(t_s) - C(t_s)|²`` over ``p + 2`` Gauss–Legendre nodes per
+    span with the end poles fixed by ``end_derivatives`` (a clamped B-spline's first ``r+1``
+    poles fix ``C(0), ..., C^(r)(0)``: ``D P_{0..r} = [f(0), ..., f^(r)(0)]`` with the triangular
+    matrix ``D[k, j] = N_j^(k)(0)``; likewise at t = 1). The error is then sampled at
+    ``max(16, 4(p+1))`` Chebyshev–Lobatto points per span plus 257 uniform points, each span's
+    worst sample is refined by golden-section search (30 steps), and every span whose error
+    exceeds ``tol`` is split into ``max(2, ceil((e/tol)^{1/(p+1)}))`` equal pieces (the error of a
+    degree-p fit scales as ``h^{p+1}``), until the maximum is ``<= tol``.
+
+    Args:
+        func: vectorized map from a 1-D array of parameters (N,) to values (N, d) (or (N,)).
+        tol: required maximum deviation (> 0), in the units of ``func``'s values.
+        degree: B-spline degree p, 1..25.
+        end_derivatives: ``([f(0), f'(0), ...], [f(1), f'(1), ...])``; the listed derivatives
+            (each list may be empty, at most p entries) are reproduced exactly by the B-spline.
+        max_spans: refinement limit.
+
+    Returns:
+        :class:`BSplineCurveData` with ``max_deviation`` (the achieved, sampled maximum) and
+        ``info`` = ``{"spans", "samples_checked", "iterations", "end_orders", "tol"}``.
+
+    Raises:
+        GHTError: bad tol/degree/end_derivatives or a func that returns NaN/inf or bad shapes.
+        ConversionError: ``max_spans`` reached before the deviation fell below ``tol``.
+    """
+    from scipy.interpolate import BSpline
+
+    try:
+        tol = float(tol)
+    except (TypeError, ValueError):
+        raise GHTError(f"tol={tol!r} is not a number; it must be a positive float") from None
+    if not np.isfinite(tol) or tol <= 0.0:
+        raise GHTError(f"tol={tol!r} is not allowed; it must be a positive finite number")
+    if int(degree) != degree or not 1 <= int(degree) <= 25:
+        raise GHTError(f"degree={degree!r} is not allowed; B-spline degrees are integers 1..25")
+    p = int(degree)
+    if int(max_spans) < 1:
+        raise GHTError(f"max_spans={max_spans!r} is not allowed; it must be >= 1")
+
+    dim = _call(func, np.array([0.0, 0.5, 1.0]), None).shape[1]
+    ends: list[np.ndarray] = [np.zeros((0, dim)), np.zeros((0, dim))]
+    if end_derivatives is not None:
+        if len(end_derivatives) != 2:
+            raise GHTError("end_derivatives must be a pair (derivatives at t=0, derivatives at t=1)")
+        for e, seq in enumerate(end_derivatives):
+            arr = np.asarray([np.asarray(v, dtype=float).reshape(-1) for v in seq], dtype=float).reshape(-1, dim) if len(seq) else np.zeros((0, dim))
+            if arr.shape[0] > p:
+                raise GHTError(
+                    f"end_derivatives at t={e} lists {arr.shape[0]} values (orders 0..{arr.shape[0]-1}); "
+                    f"a degree-{p} B-spline can impose orders 0..{p - 1} only"
+                )
+            if not np.all(np.isfinite(arr)):
+                raise GHTError(f"end_derivatives at t={e} contain NaN or inf")
+            ends[e] = arr
+    r0, r1 = ends[0].shape[0], ends[1].shape[0]
+
+    # start with the fewest spans that leave the two sets of fixed end poles disjoint
+    spans = max(1, r0 + r1 - p)
+    breaks = np.linspace(0.0, 1.0, spans + 1)
+    xg, _ = np.polynomial.legendre.leggauss(p + 2)
+    xg = 0.5 * (xg + 1.0)
+    cheb = _chebyshev_lobatto(max(16, 4 * (p + 1)))
+    uniform = np.linspace(0.0, 1.0, 257)
+    golden = 0.5 * (np.sqrt(5.0) - 1.0)
+    samples_checked = 0
+    iterations = 0
+    worst = np.inf
+    while True:
+        iterations += 1
+        knots = clamped_knots(breaks, p)
+        n = knots.size - p - 1
+        h = np.diff(breaks)
+        # fixed end poles from the end derivatives
+        fixed = np.zeros((n, dim))
+        is_fixed = np.zeros(n, dtype=bool)
+        if r0:
+            D = _end_basis(knots, p, n, 0, r0)
+            fixed[:r0] = np.linalg.solve(D, ends[0])
+            is_fixed[:r0] = True
+        if r1:
+            D = _end_basis(knots, p, n, 1, r1)
+            fixed[n - r1 :] = np.linalg.solve(D, ends[1])
+            is_fixed[n - r1 :] = True
+        # least squares for the free poles
+        ts = (breaks[:-1, None] + h[:, None] * xg[None, :]).ravel()
+        F = _call(func, ts, dim)
+        A = BSpline.design_matrix(ts, knots, p).tocsc()
+        poles = fixed.copy()
+        free = ~is_fixed
+        if free.any():
+            rhs = F - A[:, is_fixed] @ fixed[is_fixed] if is_fixed.any() else F
+            Af = A[:, free]
+            if Af.shape[1] <= 400:
+                sol, *_ = np.linalg.lstsq(Af.toarray(), rhs, rcond=None)
+            else:
+                from scipy.sparse.linalg import splu
+
+                M = (Af.T @ Af).tocsc()
+                sol = splu(M).solve(np.asarray(Af.T @ rhs))
+            poles[free] = sol
+        sp = BSpline(knots, poles, p, extrapolate=False)
+
+        def err(t: np.ndarray) -> np.ndarray:
+            return np.linalg.norm(_call(func, t, dim) - sp(t), axis=1)
+
+        # dense check: Chebyshev-Lobatto points per span + a uniform grid
+        tc = (breaks[:-1, None] + h[:, None] * cheb[None, :])
+        ec = err(tc.ravel()).reshape(tc.shape)
+        eu = err(uniform)
+        samples_checked += tc.size + uniform.size
+        span_err = ec.max(axis=1)
+        su = np.clip(np.searchsorted(breaks, uniform, side="right") - 1, 0, spans - 1)
+        np.maximum.at(span_err, su, eu)
+        if span_err.max() <= tol:
+            # refine each span's worst sample by golden-section search on its neighbouring bracket
+            k = ec.argmax(axis=1)
+            lo = tc[np.arange(spans), np.maximum(k - 1, 0)]
+            hi = tc[np.arange(spans), np.minimum(k + 1, cheb.size - 1)]
+            x1 = hi - golden * (hi - lo)
+            x2 = lo + golden * (hi - lo)
+            e1, e2 = err(x1), err(x2)
+            best = np.maximum(e1, e2)
+            for _ in range(30):
+                left = e1 >= e2  # maximum lies in [lo, x2]
+                hi = np.where(left, x2, hi)
+                lo = np.where(left, lo, x1)
+                x2n = np.where(left, x1, lo + golden * (hi - lo))
+                x1n = np.where(left, hi - golden * (hi - lo), x2)
+                xnew = np.where(left, x1n, x2n)
+                enew = err(xnew)
+                e1, e2 = np.where(left, enew, e2), np.where(left, e1, enew)
+                x1, x2 = x1n, x2n
+                best = np.maximum(best, enew)
+            samples_checked += 32 * spans
+            span_err = np.maximum(span_err, best)
+        worst = float(span_err.max())
+        if worst <= tol:
+            break
+        bad = span_err > tol
+        pieces = np.where(bad, np.maximum(2, np.ceil((span_err / tol) ** (1.0 / (p + 1)))), 1).astype(int)
+        pieces = np.minimum(pieces, 8)
+        if pieces.sum() > max_spans:
+            if spans >= max_spans:
+                raise ConversionError(
+                    f"B-spline fit did not reach tol={tol:g}: deviation {worst:.3g} with {spans} spans "
+                    f"(max_spans={max_spans}); raise tol or max_spans"
+                )
+            pieces = np.where(bad, 2, 1)
+            if pieces.sum() > max_spans:
+                raise ConversionError(
+                    f"B-spline fit did not reach tol={tol:g}: deviation {worst:.3g} with {spans} spans "
+                    f"(max_spans={max_spans}); raise tol or max_spans"
+                )
+        new = [breaks[:1]]
+        for i in range(spans):
+            new.append(np.linspace(breaks[i], breaks[i + 1], pieces[i] + 1)[1:])
+        breaks = np.concatenate(new)
+        spans = breaks.size - 1
+
+    return BSplineCurveData(
+        poles,
+        knots,
+        p,
+        max_deviation=worst,
+        info={
+            "spans": spans,
+            "samples_checked": samples_checked,
+            "iterations": iterations,
+            "end_orders": (r0 - 1, r1 - 1),
+            "tol": tol,
+        },
+    )
+
+
+def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 5) -> BSplineCurveData:
+    r"""Certified B-spline ``C(t)`` of a GHT-Bézier curve ``P(t)`` with the same parametrization.
+
+    Calls :func:`fit_function` on ``t ↦ P(t)`` with the exact end jets
+    ``P^(r)(0), P^(r)(1)`` for ``r = 0..min(3, p-1)`` (analytic derivatives) imposed, so that
+    ``C^(r) = P^(r)`` at both ends and a C^r/G^r joint of GHT segments stays C^r/G^r between their
+    B-spline edges. ``max_t |P(t) - C(t)| <= tol``.
+
+    Args:
+        curve: the :class:`~ght_cad.curve.GHTCurve` (any dimension).
+        tol: maximum deviation; default ``1e-7 ×`` the diagonal of the curve's bounding box.
+        degree: B-spline degree p (>= 1).
+
+    Returns:
+        :class:`BSplineCurveData` with ``max_deviation`` and ``info`` (see :func:`fit_function`).
+
+    Raises:
+        GHTError: bad ``tol``/``degree``. ConversionError: the tolerance is not reachable.
+    """
+    if int(degree) != degree or not 1 <= int(degree) <= 25:
+        raise GHTError(f"degree={degree!r} is not allowed; B-spline degrees are integers 1..25")
+    if tol is None:
+        lo, hi = curve.bounding_box()
+        diag = float(np.linalg.norm(hi - lo))
+        tol = 1e-7 * diag if diag > 0 else 1e-12
+    r = min(3, int(degree) - 1)
+    ends = ([curve.derivative(0.0, k) for k in range(r + 1)], [curve.derivative(1.0, k) for k in range(r + 1)])
+    out = fit_function(curve.evaluate, tol=tol, degree=int(degree), end_derivatives=ends)
+    out.info["source"] = repr(curve)
+    return out

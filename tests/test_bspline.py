@@ -1,0 +1,127 @@
+"""Certified B-spline conversion (ght_cad.bspline.fit_function / curve_to_bspline)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ght_cad import GHTCurve
+from ght_cad.bspline import BSplineCurveData, curve_to_bspline, fit_function
+from ght_cad.errors import ConversionError, GHTError
+
+shape = st.floats(-1.0, 1.0, allow_nan=False)
+
+
+def _independent_deviation(curve: GHTCurve, bs: BSplineCurveData, seed: int = 7) -> float:
+    """Deviation at matched parameters on points the fitter never saw (random + uniform)."""
+    rng = np.random.default_rng(seed)
+    t = np.concatenate([rng.uniform(0.0, 1.0, 20000), np.linspace(0.0, 1.0, 4001)])
+    return float(np.linalg.norm(curve.evaluate(t) - bs.evaluate(t), axis=1).max())
+
+
+@settings(max_examples=30)
+@given(
+    degree=st.integers(2, 10),
+    mu=shape,
+    nu=shape,
+    gamma=shape,
+    dim=st.sampled_from([2, 3]),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_curve_deviation_below_default_tolerance(degree, mu, nu, gamma, dim, seed):
+    rng = np.random.default_rng(seed)
+    curve = GHTCurve(rng.normal(size=(degree + 1, dim)) * 10.0, mu, nu, gamma)
+    bs = curve_to_bspline(curve)
+    lo, hi = curve.bounding_box()
+    tol = 1e-7 * float(np.linalg.norm(hi - lo))
+    assert bs.info["tol"] == pytest.approx(tol)
+    assert bs.max_deviation <= tol
+    # independent check on 24001 fresh parameters: the reported figure is the true maximum
+    dev = _independent_deviation(curve, bs)
+    assert dev <= tol * (1 + 1e-6)
+    assert dev <= bs.max_deviation * (1 + 1e-3) + 1e-15
+
+
+@settings(max_examples=20)
+@given(degree=st.integers(2, 10), mu=shape, nu=shape, gamma=shape, seed=st.integers(0, 2**31 - 1),
+       p=st.integers(4, 8))
+def test_end_derivatives_are_exact(degree, mu, nu, gamma, seed, p):
+    """C^(r)(0) = P^(r)(0), C^(r)(1) = P^(r)(1), r = 0..3, to 1e-9 relative to |P^(r)|."""
+    rng = np.random.default_rng(seed)
+    curve = GHTCurve(rng.normal(size=(degree + 1, 3)), mu, nu, gamma)
+    bs = curve_to_bspline(curve, degree=p)
+    ends = np.array([0.0, 1.0])
+    for r in range(4):
+        exact = curve.derivative(ends, r)
+        got = bs.evaluate(ends, r)
+        scale = max(1.0, float(np.abs(exact).max()))
+        assert np.abs(got - exact).max() <= 1e-9 * scale, r
+
+
+def test_explicit_tolerance_and_pole_count():
+    curve = GHTCurve([(0, 0), (1, 2), (3, 3), (4, 0), (6, 1)], 0.3, -0.5, 0.2)
+    coarse = curve_to_bspline(curve, tol=1e-4)
+    fine = curve_to_bspline(curve, tol=1e-10)
+    assert coarse.max_deviation <= 1e-4 and fine.max_deviation <= 1e-10
+    assert coarse.poles.shape[0] < fine.poles.shape[0] < 200
+    assert _independent_deviation(curve, fine) <= 1e-10
+
+
+def test_stacked_function_shares_knots_and_pairs_poles():
+    """Two boundary curves stacked into d = 6 get one knot vector; each half is within tol."""
+    a = GHTCurve([(0, 0, 0), (1, 0.5, 0), (2, 0, 0.3), (3, 1, 0)], 0.2, 0.4, -0.3)
+    b = GHTCurve([(0, 0, 1), (1, 0.2, 1.2), (2.5, 0, 1), (3, 0.5, 1)], -0.6, 0.1, 0.5)
+    bs = fit_function(lambda t: np.hstack([a.evaluate(t), b.evaluate(t)]), tol=1e-8)
+    assert bs.dim == 6
+    t = np.linspace(0, 1, 5001)
+    vals = bs.evaluate(t)
+    assert np.linalg.norm(vals[:, :3] - a.evaluate(t), axis=1).max() <= 1e-8
+    assert np.linalg.norm(vals[:, 3:] - b.evaluate(t), axis=1).max() <= 1e-8
+
+
+def test_scalar_function_and_polynomial_exactness():
+    # a quintic is reproduced to round-off by one degree-5 span
+    f = lambda t: 1 + t - 3 * t**2 + t**5  # noqa: E731
+    bs = fit_function(f, tol=1e-12, degree=5)
+    assert bs.info["spans"] == 1 and bs.poles.shape == (6, 1)
+    assert bs.max_deviation <= 1e-12
+
+
+def test_fixed_end_derivatives_for_a_function():
+    f = lambda t: np.column_stack([np.cos(3 * t), np.sin(3 * t)])  # noqa: E731
+    ends = ([[1, 0], [0, 3], [-9, 0]], [[np.cos(3), np.sin(3)], [-3 * np.sin(3), 3 * np.cos(3)], [-9 * np.cos(3), -9 * np.sin(3)]])
+    bs = fit_function(f, tol=1e-9, degree=5, end_derivatives=ends)
+    for r in range(3):
+        assert np.allclose(bs.evaluate([0.0], r)[0], ends[0][r], atol=1e-9)
+        assert np.allclose(bs.evaluate([1.0], r)[0], ends[1][r], atol=1e-9)
+
+
+def test_unreachable_tolerance_raises_conversion_error():
+    f = lambda t: np.abs(t - 1 / 3) ** 0.5  # noqa: E731  (not smooth: needs endless refinement)
+    with pytest.raises(ConversionError, match="max_spans"):
+        fit_function(f, tol=1e-12, max_spans=64)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"tol": 0.0}, "tol"),
+        ({"tol": float("nan")}, "tol"),
+        ({"tol": 1e-6, "degree": 0}, "degree"),
+        ({"tol": 1e-6, "degree": 2.5}, "degree"),
+        ({"tol": 1e-6, "degree": 2, "end_derivatives": ([0, 1, 2], [])}, "orders"),
+        ({"tol": 1e-6, "max_spans": 0}, "max_spans"),
+    ],
+)
+def test_bad_arguments(kwargs, match):
+    with pytest.raises(GHTError, match=match):
+        fit_function(lambda t: t, **kwargs)
+
+
+def test_bad_function_output():
+    with pytest.raises(GHTError, match="shape"):
+        fit_function(lambda t: np.ones((3, 3, 3)), tol=1e-6)
+    with pytest.raises(GHTError, match="NaN"):
+        fit_function(lambda t: np.full(t.shape, np.nan), tol=1e-6)
