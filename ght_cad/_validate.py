@@ -64,7 +64,7 @@ def check_finite_array(name: str, arr: np.ndarray) -> np.ndarray:
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
         raise GHTError(
-            f"{name} contains a non-finite value {arr[idx]!r} at index {idx}; all values must be finite"
+            f"{name} contains a non-finite value {float(arr[idx])!r} at index {idx}; all values must be finite"
         )
     return arr
 

@@ -148,6 +148,9 @@ class GHTCurve:
     def _eval(self, t: Any, order: int) -> np.ndarray:
         tt, scalar = as_parameter_array(t)
         check_unit_interval("t", tt, slack=1e-9)
+        if order == 0:
+            out = self._evaluate_points(tt)
+            return out[0] if scalar else out
         P = self._points
         if tt.size <= _CHUNK:
             out = seed_basis(tt, self.degree, self._seed, order) @ P
@@ -157,6 +160,46 @@ class GHTCurve:
                 sl = slice(lo, lo + _CHUNK)
                 out[sl] = seed_basis(tt[sl], self.degree, self._seed, order) @ P
         return out[0] if scalar else out
+
+    @cached_property
+    def _compact_weights(self) -> np.ndarray:
+        """Stacked, binomial-scaled control points of the compact form (3(n+1), dim)."""
+        n = self.degree - 2
+        binom = np.array([comb(n, j) for j in range(n + 1)], dtype=float)[:, None]
+        return np.vstack([self._points[k : k + n + 1] * binom for k in range(3)])
+
+    def _evaluate_points(self, t: np.ndarray, chunk: int = 8192) -> np.ndarray:
+        r"""Fast evaluation by the compact form ``P = f0 Q0 + f1 Q1 + f2 Q2``.
+
+        Per chunk: one seed evaluation (one sin/cos pass), the degree-n Bernstein powers
+        ``C(n,j) t^j (1-t)^{n-j}``, and one matrix product of the (K, 3(n+1)) products
+        ``f_k B_{j,n}`` with the stacked control points.
+        """
+        n = self.degree - 2
+        W = self._compact_weights
+        out = np.empty((t.size, self.dim))
+        K = min(chunk, max(t.size, 1))
+        T = np.empty((K, n + 1))
+        U = np.empty((K, n + 1))
+        F = np.empty((K, 3, n + 1))
+        for lo in range(0, t.size, K):
+            tt = t[lo : lo + K]
+            k = tt.size
+            if k < K:
+                T, U, F = T[:k], U[:k], F[:k]
+            f = self._seed.jet(tt, 0)
+            T[:, 0] = 1.0
+            U[:, n] = 1.0
+            if n:
+                u = 1.0 - tt
+                for j in range(1, n + 1):
+                    np.multiply(T[:, j - 1], tt, out=T[:, j])
+                    np.multiply(U[:, n - j + 1], u, out=U[:, n - j])
+                T *= U
+            for j in range(3):
+                np.multiply(f[:, j : j + 1], T, out=F[:, j])
+            np.matmul(F.reshape(k, -1), W, out=out[lo : lo + k])
+        return out
 
     def evaluate(self, t: Any) -> np.ndarray:
         """Points ``P(t) = Σ b_{i,m}(t) P_i``; shape (len(t), dim), or (dim,) for scalar t."""
@@ -261,6 +304,8 @@ class GHTCurve:
         ``c_3 = n(n-1)(n-2) + 3n(n-1) a_1^1 + 3n a_2^2`` (spec section 3).
         """
         r = _check_order(order)
+        if r > self.degree:
+            return 0.0  # no point P_r exists: the order cannot be imposed by moving a point
         if end == 0:
             return float(seed_basis(np.array([0.0]), self.degree, self._seed, r)[0, r])
         return float(seed_basis(np.array([1.0]), self.degree, self._seed, r)[0, self.degree - r])

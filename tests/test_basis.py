@@ -1,0 +1,187 @@
+"""Property tests of the GHT seeds and the degree-m basis (spec sections 1-3).
+
+Tolerances: identities that hold exactly in real arithmetic are checked to 1e-13 (absolute, the
+basis values are O(1)); derivatives against finite differences to a relative 1e-6 of the
+derivative's scale (4th-order central stencil, h = 1e-3).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from ght_cad import GBTSeed, GHTCurve, GHTSeed, basis, bernstein
+from ght_cad.basis import bernstein_recursive_basis, seed_basis
+
+params = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False)
+degrees = st.integers(min_value=2, max_value=10)
+T = np.linspace(0.0, 1.0, 101)
+
+
+@given(degrees, params, params, params)
+def test_partition_of_unity_and_nonnegativity(m: int, mu: float, nu: float, gamma: float) -> None:
+    b = basis(T, m, mu, nu, gamma)
+    assert b.shape == (T.size, m + 1)
+    np.testing.assert_allclose(b.sum(axis=1), 1.0, rtol=0, atol=1e-13)
+    assert b.min() >= -1e-14
+    # derivatives of a partition of unity sum to zero
+    for r in (1, 2, 3):
+        d = basis(T, m, mu, nu, gamma, derivative=r)
+        assert np.abs(d.sum(axis=1)).max() <= 1e-11 * max(1.0, np.abs(d).max())
+
+
+@given(degrees, params, params, params)
+def test_end_values(m: int, mu: float, nu: float, gamma: float) -> None:
+    b = basis(np.array([0.0, 1.0]), m, mu, nu, gamma)
+    expected = np.zeros((2, m + 1))
+    expected[0, 0] = expected[1, m] = 1.0
+    np.testing.assert_allclose(b, expected, atol=1e-15)
+
+
+@given(degrees, params, params, params)
+def test_symmetry(m: int, mu: float, nu: float, gamma: float) -> None:
+    """b_{i,m}(t; μ,ν,γ) = b_{m-i,m}(1-t; ν,μ,γ)."""
+    b = basis(T, m, mu, nu, gamma)
+    br = basis(1.0 - T, m, nu, mu, gamma)[:, ::-1]
+    np.testing.assert_allclose(b, br, atol=1e-14)
+
+
+@given(degrees, params, params)
+def test_gamma_one_is_bernstein(m: int, mu: float, nu: float) -> None:
+    for r in range(4):
+        np.testing.assert_allclose(basis(T, m, mu, nu, 1.0, derivative=r), bernstein(T, m, r), atol=1e-10 * 10**r)
+
+
+@given(degrees, params, params)
+def test_gamma_minus_one_is_gbt(m: int, mu: float, nu: float) -> None:
+    gbt = GBTSeed(mu, nu)
+    for r in range(4):
+        np.testing.assert_allclose(
+            basis(T, m, mu, nu, -1.0, derivative=r), seed_basis(T, m, gbt, r), atol=1e-13 * 10**r
+        )
+    # and the GBT seed is exactly the spec's formula
+    s, c = np.sin(np.pi * T / 2), np.cos(np.pi * T / 2)
+    np.testing.assert_allclose(gbt.jet(T)[:, 0], (1 - s) * (1 - mu * s), atol=1e-15)
+    np.testing.assert_allclose(gbt.jet(T)[:, 2], (1 - c) * (1 - nu * c), atol=1e-15)
+
+
+@given(degrees, params, params, params)
+def test_closed_form_equals_recursion(m: int, mu: float, nu: float, gamma: float) -> None:
+    seed = GHTSeed(mu, nu, gamma)
+    np.testing.assert_allclose(basis(T, m, mu, nu, gamma), bernstein_recursive_basis(T, m, seed), atol=1e-14)
+
+
+@given(degrees, params, params, params)
+def test_linear_independence(m: int, mu: float, nu: float, gamma: float) -> None:
+    tt = (np.arange(m + 1) + 0.5) / (m + 1)
+    sv = np.linalg.svd(basis(tt, m, mu, nu, gamma), compute_uv=False)
+    assert sv.min() > 1e-8 * sv.max()
+
+
+def _fd4(f, t: np.ndarray, h: float) -> np.ndarray:
+    """4th-order central difference."""
+    return (-f(t + 2 * h) + 8 * f(t + h) - 8 * f(t - h) + f(t - 2 * h)) / (12 * h)
+
+
+@given(degrees, params, params, params)
+def test_derivatives_match_finite_differences(m: int, mu: float, nu: float, gamma: float) -> None:
+    tt = np.linspace(0.05, 0.95, 19)
+    h = 1e-3
+    for r in (1, 2, 3):
+        analytic = basis(tt, m, mu, nu, gamma, derivative=r)
+        fd = _fd4(lambda x: basis(x, m, mu, nu, gamma, derivative=r - 1), tt, h)
+        scale = max(1.0, np.abs(analytic).max())
+        assert np.abs(analytic - fd).max() <= 1e-6 * scale, (r, np.abs(analytic - fd).max(), scale)
+
+
+@given(params, params, params)
+def test_seed_jets_table(mu: float, nu: float, gamma: float) -> None:
+    """The jets table of spec section 1 from the seed's analytic derivatives."""
+    seed = GHTSeed(mu, nu, gamma)
+    a, e = seed.end_jets()
+    w = (1 + gamma) / 2
+    pi = math.pi
+    assert a[1, 0] == pytest.approx(-(1 - w) * (1 + mu) * pi / 2 - 2 * w, abs=1e-13)
+    assert a[2, 0] == pytest.approx((1 - w) * mu * pi**2 / 2 + 2 * w, abs=1e-13)
+    assert a[3, 0] == pytest.approx((1 - w) * (1 + mu) * pi**3 / 8, abs=1e-12)
+    assert a[2, 2] == pytest.approx((1 - w) * (1 - nu) * pi**2 / 4 + 2 * w, abs=1e-13)
+    assert a[1, 2] == pytest.approx(0.0, abs=1e-14)
+    assert a[3, 2] == pytest.approx(0.0, abs=1e-12)
+    for r in (1, 2, 3):
+        assert a[r, 1] == pytest.approx(-(a[r, 0] + a[r, 2]), abs=1e-12)
+    # at t = 1 by symmetry: e_r^2(μ,ν) = (-1)^r a_r^0(ν,μ), e_r^0(μ,ν) = (-1)^r a_r^2(ν,μ)
+    a_sw, _ = GHTSeed(nu, mu, gamma).end_jets()
+    for r in range(4):
+        assert e[r, 2] == pytest.approx((-1) ** r * a_sw[r, 0], abs=1e-12)
+        assert e[r, 0] == pytest.approx((-1) ** r * a_sw[r, 2], abs=1e-12)
+    # seed admissibility: f2'(0) = f0'(1) = 0 and values at the ends
+    np.testing.assert_allclose(a[0], [1, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(e[0], [0, 0, 1], atol=1e-15)
+    assert abs(e[1, 0]) <= 1e-14
+
+
+@given(degrees, params, params, params, st.integers(0, 2**31 - 1))
+def test_end_derivative_formulas(m: int, mu: float, nu: float, gamma: float, seed: int) -> None:
+    """P^(r)(0), P^(r)(1) by the spec's end-jet formula equal the analytic derivative."""
+    pts = np.random.default_rng(seed).normal(size=(m + 1, 3))
+    c = GHTCurve(pts, mu, nu, gamma)
+    for r in range(4):
+        for end in (0, 1):
+            d = c.derivative(float(end), r)
+            assert np.abs(c.end_derivative(end, r) - d).max() <= 1e-11 * max(1.0, np.abs(d).max())
+
+
+@given(degrees, params, params, params)
+def test_newest_point_coefficients(m: int, mu: float, nu: float, gamma: float) -> None:
+    """c_1 = n + a_1^1, c_2 = n(n-1) + 2n a_1^1 + a_2^2, c_3 = n(n-1)(n-2) + 3n(n-1) a_1^1 + 3n a_2^2."""
+    c = GHTCurve(np.zeros((m + 1, 2)) + np.arange(m + 1)[:, None], mu, nu, gamma)
+    a, _ = c.seed.end_jets()
+    n = m - 2
+    c1 = n + a[1, 1]
+    c2 = n * (n - 1) + 2 * n * a[1, 1] + a[2, 2]
+    c3 = n * (n - 1) * (n - 2) + 3 * n * (n - 1) * a[1, 1] + 3 * n * a[2, 2]
+    for r, cr in ((1, c1), (2, c2), (3, c3)):
+        assert c.newest_point_coefficient(r) == pytest.approx(cr, abs=1e-11)
+    assert c.newest_point_coefficient(1) > 0  # first order can always be imposed
+
+
+def test_first_end_derivative_closed_form() -> None:
+    """P'(0) = [n - a_1^0](P1 - P0), P'(1) = [n + e_1^2](P_m - P_{m-1})."""
+    pts = np.array([[0, 0], [1, 2], [3, 3], [4, 1], [6, 0]], float)
+    c = GHTCurve(pts, 0.4, -0.3, 0.2)
+    a, e = c.seed.end_jets()
+    n = c.degree - 2
+    np.testing.assert_allclose(c.derivative(0.0), (n - a[1, 0]) * (pts[1] - pts[0]), atol=1e-13)
+    np.testing.assert_allclose(c.derivative(1.0), (n + e[1, 2]) * (pts[-1] - pts[-2]), atol=1e-13)
+
+
+def test_custom_seed_registration() -> None:
+    """A user-registered seed plugs into the basis and curves."""
+    from ght_cad import Seed, make_seed, register_seed, seed_names
+
+    class CubicSeed(Seed):
+        """f0 = (1-t)^3, f2 = t^3 (admissible: f2'(0) = f0'(1) = 0)."""
+
+        name = "cubic-test"
+
+        def f0_f2(self, t, order=0):
+            if order == 0:
+                return (1 - t) ** 3, t**3
+            if order == 1:
+                return -3 * (1 - t) ** 2, 3 * t**2
+            if order == 2:
+                return 6 * (1 - t), 6 * t
+            return np.full_like(t, -6.0), np.full_like(t, 6.0)
+
+    register_seed("cubic-test", CubicSeed)
+    assert "cubic-test" in seed_names()
+    b = basis(T, 5, seed="cubic-test")
+    np.testing.assert_allclose(b.sum(axis=1), 1.0, atol=1e-14)
+    c = GHTCurve([[0, 0], [1, 1], [2, 0], [3, 1]], seed=make_seed("cubic-test"))
+    np.testing.assert_allclose(c.evaluate(1.0), [3, 1], atol=1e-15)
+    # its reversal goes through the generic ReversedSeed
+    np.testing.assert_allclose(c.reversed().evaluate(T), c.evaluate(1 - T), atol=1e-14)

@@ -1,0 +1,67 @@
+"""Bad input raises clear errors naming the value and the allowed range."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ght_cad import GHTCurve, GHTError, ShapeParameterError, basis
+
+
+@pytest.mark.parametrize(
+    "kwargs, pattern",
+    [
+        ({"mu": 1.2}, r"mu=1\.2 is outside the allowed range \[-1, 1\]"),
+        ({"nu": -1.0001}, r"nu=-1\.0001 is outside the allowed range \[-1, 1\]"),
+        ({"gamma": float("nan")}, r"gamma=nan is not finite; allowed range is \[-1, 1\]"),
+        ({"gamma": "abc"}, r"gamma='abc' is not a number"),
+    ],
+)
+def test_shape_parameter_out_of_range(kwargs, pattern) -> None:
+    with pytest.raises(ShapeParameterError, match=pattern):
+        basis([0.5], 3, **kwargs)
+    with pytest.raises(ValueError, match=pattern):
+        GHTCurve([[0, 0], [1, 1], [2, 0]], **kwargs)
+
+
+def test_degree_too_low() -> None:
+    with pytest.raises(GHTError, match=r"degree=1 is not allowed; degree must be an integer >= 2"):
+        basis([0.5], 1)
+    with pytest.raises(GHTError, match=r"degree=2\.5 is not an integer"):
+        basis([0.5], 2.5)
+    with pytest.raises(GHTError, match=r"control_points has 2 points; at least 3 are required"):
+        GHTCurve([[0, 0], [1, 1]])
+
+
+def test_nan_control_points() -> None:
+    with pytest.raises(GHTError, match=r"control_points contains a non-finite value nan at index \(1, 0\)"):
+        GHTCurve([[0, 0], [np.nan, 1], [2, 0]])
+    with pytest.raises(GHTError, match=r"non-finite value inf"):
+        GHTCurve([[0, 0, 0], [1, 1, 1], [2, 0, np.inf]])
+
+
+@pytest.mark.parametrize(
+    "points, pattern",
+    [
+        ([0.0, 1.0, 2.0], r"control_points must be a 2-D array of shape \(count, dim\); got shape \(3,\)"),
+        (np.zeros((3, 2, 2)), r"got shape \(3, 2, 2\)"),
+        ([[0, 0], [1], [2, 0]], r"control_points could not be read as an array"),
+    ],
+)
+def test_wrong_array_shapes(points, pattern) -> None:
+    with pytest.raises(GHTError, match=pattern):
+        GHTCurve(points)
+
+
+def test_bad_parameters_and_orders() -> None:
+    c = GHTCurve([[0, 0], [1, 1], [2, 0]])
+    with pytest.raises(GHTError, match=r"t=1\.5 is outside the parameter domain \[0, 1\]"):
+        c.evaluate([0.2, 1.5])
+    with pytest.raises(GHTError, match=r"t contains a non-finite value nan"):
+        c.evaluate([np.nan])
+    with pytest.raises(GHTError, match=r"derivative=4 is not allowed; analytic derivatives exist for orders 0\.\.3"):
+        c.derivative(0.5, 4)
+    with pytest.raises(GHTError, match=r"torsion needs a 3-D curve; this curve has dim=2"):
+        c.torsion(0.5)
+    with pytest.raises(GHTError, match=r"seed='nope' is not registered; known seeds: bernstein, gbt, ght"):
+        GHTCurve([[0, 0], [1, 1], [2, 0]], seed="nope")

@@ -1,0 +1,129 @@
+"""GHT-Bézier curve properties (spec section 3): classical Bézier properties and exact circles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from ght_cad import GHTCurve
+
+params = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False)
+degrees = st.integers(min_value=2, max_value=10)
+dims = st.sampled_from([2, 3, 4])
+seeds = st.integers(0, 2**31 - 1)
+T = np.linspace(0.0, 1.0, 57)
+
+
+def _curve(m: int, dim: int, mu: float, nu: float, gamma: float, seed: int) -> GHTCurve:
+    return GHTCurve(np.random.default_rng(seed).normal(size=(m + 1, dim)), mu, nu, gamma)
+
+
+@given(degrees, dims, params, params, params, seeds)
+def test_endpoint_interpolation_and_tangents(m, dim, mu, nu, gamma, seed) -> None:
+    c = _curve(m, dim, mu, nu, gamma, seed)
+    P = c.control_points
+    np.testing.assert_allclose(c.evaluate(0.0), P[0], atol=1e-14)
+    np.testing.assert_allclose(c.evaluate(1.0), P[-1], atol=1e-13)
+    # end tangents are along the first / last leg of the control polygon, pointing inward
+    d0, d1 = c.derivative(0.0), c.derivative(1.0)
+    leg0, leg1 = P[1] - P[0], P[-1] - P[-2]
+    assert np.linalg.norm(d0 - (d0 @ leg0) / (leg0 @ leg0) * leg0) <= 1e-10 * np.linalg.norm(d0)
+    assert d0 @ leg0 > 0 and d1 @ leg1 > 0
+
+
+@given(degrees, params, params, params, seeds)
+def test_convex_hull(m, mu, nu, gamma, seed) -> None:
+    """Points are convex combinations of the control points (non-negative weights summing to 1)."""
+    c = _curve(m, 2, mu, nu, gamma, seed)
+    b = c.basis(T)
+    assert b.min() >= -1e-14
+    # bounding box containment follows from the convex combination
+    lo, hi = c.control_points.min(0), c.control_points.max(0)
+    pts = c.evaluate(T)
+    assert np.all(pts >= lo - 1e-12) and np.all(pts <= hi + 1e-12)
+
+
+@given(degrees, dims, params, params, params, seeds)
+def test_affine_invariance(m, dim, mu, nu, gamma, seed) -> None:
+    c = _curve(m, dim, mu, nu, gamma, seed)
+    rng = np.random.default_rng(seed + 1)
+    A = rng.normal(size=(dim, dim))
+    b = rng.normal(size=dim)
+    moved = c.transformed(A, b)
+    np.testing.assert_allclose(moved.evaluate(T), c.evaluate(T) @ A.T + b, atol=1e-11)
+    H = np.eye(dim + 1)
+    H[:dim, :dim], H[:dim, dim] = A, b
+    np.testing.assert_allclose(c.transformed(H).evaluate(T), moved.evaluate(T), atol=1e-12)
+
+
+@given(degrees, dims, params, params, params, seeds)
+def test_reversal_symmetry(m, dim, mu, nu, gamma, seed) -> None:
+    c = _curve(m, dim, mu, nu, gamma, seed)
+    r = c.reversed()
+    assert (r.mu, r.nu, r.gamma) == (nu, mu, gamma)
+    np.testing.assert_allclose(r.evaluate(T), c.evaluate(1.0 - T), atol=1e-13)
+    np.testing.assert_allclose(r.derivative(T, 1), -c.derivative(1.0 - T, 1), atol=1e-10)
+
+
+@given(degrees, dims, params, params, params, seeds)
+def test_fast_evaluation_equals_basis_product(m, dim, mu, nu, gamma, seed) -> None:
+    c = _curve(m, dim, mu, nu, gamma, seed)
+    tt = np.random.default_rng(seed).random(20000)
+    np.testing.assert_allclose(c.evaluate(tt), c.basis(tt) @ c.control_points, atol=1e-12)
+
+
+def test_gamma_one_is_classical_bezier() -> None:
+    from scipy.interpolate import BPoly
+
+    pts = np.random.default_rng(3).normal(size=(7, 3))
+    c = GHTCurve(pts, 0.7, -0.4, 1.0)
+    ref = BPoly(pts[:, None, :], [0.0, 1.0])(T)
+    np.testing.assert_allclose(c.evaluate(T), ref, atol=1e-13)
+
+
+def test_exact_quarter_circle() -> None:
+    """γ = -1, μ = ν = 0 and (1,0), (1,1), (0,1): the quarter unit circle, uniform in angle."""
+    c = GHTCurve([(1, 0), (1, 1), (0, 1)], 0.0, 0.0, -1.0)
+    np.testing.assert_allclose(c.evaluate(T), np.column_stack([np.cos(np.pi * T / 2), np.sin(np.pi * T / 2)]), atol=2e-16)
+    np.testing.assert_allclose(c.curvature(T), 1.0, atol=1e-13)
+    np.testing.assert_allclose(c.signed_curvature(T), 1.0, atol=1e-13)
+    np.testing.assert_allclose(c.speed(T), math.pi / 2, atol=1e-14)
+    assert c.arc_length() == pytest.approx(math.pi / 2, rel=1e-14)
+
+
+def test_curvature_and_torsion_of_a_planar_and_a_twisted_curve() -> None:
+    planar = GHTCurve([(0, 0, 0), (1, 2, 0), (3, 1, 0), (4, 3, 0)], 0.2, 0.1, 0.0)
+    np.testing.assert_allclose(planar.torsion(T[1:-1]), 0.0, atol=1e-12)
+    # curvature equals the planar formula
+    flat = GHTCurve(planar.control_points[:, :2], 0.2, 0.1, 0.0)
+    np.testing.assert_allclose(planar.curvature(T), np.abs(flat.signed_curvature(T)), rtol=1e-12)
+    # a twisted curve: torsion from the definition det(P',P'',P''')/|P'×P''|²
+    tw = GHTCurve([(0, 0, 0), (1, 0, 0.3), (1, 1, 0.9), (0, 1, 1.6), (-1, 1, 2.0)], -0.3, 0.5, 0.4)
+    d1, d2, d3 = (tw.derivative(T, r) for r in (1, 2, 3))
+    cr = np.cross(d1, d2)
+    np.testing.assert_allclose(tw.torsion(T), np.einsum("ij,ij->i", cr, d3) / np.einsum("ij,ij->i", cr, cr), rtol=1e-12)
+    Tn, Nn, Bn = tw.frenet(T)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", Tn, Nn), 0.0, atol=1e-13)
+    np.testing.assert_allclose(np.linalg.norm(Bn, axis=1), 1.0, atol=1e-13)
+
+
+def test_arc_length_against_dense_polyline() -> None:
+    c = GHTCurve(np.random.default_rng(7).normal(size=(6, 3)), 0.5, -0.5, 0.3)
+    tt = np.linspace(0, 1, 200001)
+    poly = np.linalg.norm(np.diff(c.evaluate(tt), axis=0), axis=1).sum()
+    assert c.arc_length() == pytest.approx(poly, rel=1e-9)
+    assert c.arc_length(0.0, 0.4) + c.arc_length(0.4, 1.0) == pytest.approx(c.arc_length(), rel=1e-13)
+
+
+def test_dict_round_trip_and_with_shape() -> None:
+    c = GHTCurve([(0, 0), (1, 1), (2, 0), (3, 2)], 0.1, 0.2, 0.3)
+    d = GHTCurve.from_dict(c.to_dict())
+    np.testing.assert_array_equal(d.evaluate(T), c.evaluate(T))
+    e = c.with_shape(mu=-0.5)
+    assert e.shape_parameters == (-0.5, 0.2, 0.3)
+    assert e.degree == c.degree == 3
+    assert not c.control_points.flags.writeable
