@@ -1,0 +1,301 @@
+"""Shared machinery of the workbench's features: proxy base, view provider, task panel, command.
+
+Every feature module (``ght_curve``, ``composite_curve``, ...) holds its Proxy, ViewProvider and
+Command, CurvesWB style, built on these bases. Proxies persist through ``__getstate__`` /
+``__setstate__`` (FreeCAD 0.20) and ``dumps`` / ``loads`` (newer FreeCAD). View providers and task
+panels are only created when ``FreeCAD.GuiUp``.
+"""
+
+from __future__ import annotations
+
+import traceback
+from typing import Any, Callable, Iterable, Sequence
+
+import FreeCAD as App
+
+from . import icon
+
+__all__ = [
+    "SHAPE_PARAMETERS",
+    "FeatureProxy",
+    "ViewProviderBase",
+    "ShapeParameterPanel",
+    "BaseCommand",
+    "add_shape_parameters",
+    "restore_constraints",
+    "set_read_only",
+    "new_feature",
+    "register_command",
+    "COMMANDS",
+]
+
+# (name, tooltip) of the spec's shape parameters: App::PropertyFloatConstraint in [-1, 1].
+SHAPE_PARAMETERS = (
+    ("Mu", "Shape parameter μ ∈ [-1, 1] (start side of the GHT seed)"),
+    ("Nu", "Shape parameter ν ∈ [-1, 1] (end side of the GHT seed)"),
+    ("Gamma", "Shape parameter γ ∈ [-1, 1]: -1 trigonometric (GBT, exact circles), 1 classical Bézier"),
+)
+_STEP = 0.05
+
+
+def add_shape_parameters(obj: Any, group: str = "Shape", values: Sequence[float] = (0.0, 0.0, 0.0), prefix: str = "") -> None:
+    """Add Mu, Nu, Gamma (optionally prefixed) as float-constraint properties in [-1, 1]."""
+    for (name, tip), value in zip(SHAPE_PARAMETERS, values):
+        pname = prefix + name
+        if pname not in obj.PropertiesList:
+            obj.addProperty("App::PropertyFloatConstraint", pname, group, tip)
+        setattr(obj, pname, (float(value), -1.0, 1.0, _STEP))
+
+
+def restore_constraints(obj: Any) -> None:
+    """Re-apply the [-1, 1] range to every Mu/Nu/Gamma-like property (lost on file reload in 0.20)."""
+    for pname in obj.PropertiesList:
+        if any(pname.endswith(n) for n, _ in SHAPE_PARAMETERS) and obj.getTypeIdOfProperty(pname) == "App::PropertyFloatConstraint":
+            setattr(obj, pname, (float(getattr(obj, pname)), -1.0, 1.0, _STEP))
+
+
+def set_read_only(obj: Any, names: Iterable[str]) -> None:
+    """Editor mode 1 (read-only in the property editor) for output properties."""
+    for n in names:
+        obj.setEditorMode(n, 1)
+
+
+class FeatureProxy:
+    """Base proxy: type tag, persistence hooks and error reporting around ``compute``."""
+
+    Type = "GHT::Feature"
+
+    def __init__(self, obj: Any) -> None:
+        obj.Proxy = self
+        self.Type = type(self).Type
+        self.setup(obj)
+
+    # -- to override ------------------------------------------------------------------
+    def setup(self, obj: Any) -> None:
+        """Add properties (called once at creation)."""
+
+    def compute(self, obj: Any) -> None:
+        """Build ``obj.Shape`` (and output properties) from the input properties."""
+
+    # -- FreeCAD hooks --------------------------------------------------------------------
+    def execute(self, obj: Any) -> None:
+        try:
+            self.compute(obj)
+        except Exception as exc:  # report on the console, keep the old shape, mark the object
+            App.Console.PrintError(f"{obj.Label}: {type(exc).__name__}: {exc}\n")
+            App.Console.PrintLog(traceback.format_exc() + "\n")
+            raise
+
+    def onDocumentRestored(self, obj: Any) -> None:
+        restore_constraints(obj)
+        self.restored(obj)
+
+    def restored(self, obj: Any) -> None:
+        """Re-apply editor modes etc. after a file is opened."""
+
+    def __getstate__(self) -> dict:
+        return {"Type": type(self).Type}
+
+    def __setstate__(self, state: Any) -> None:
+        if isinstance(state, dict):
+            self.Type = state.get("Type", type(self).Type)
+        return None
+
+    def dumps(self) -> dict:
+        return self.__getstate__()
+
+    def loads(self, state: Any) -> None:
+        return self.__setstate__(state)
+
+
+class ViewProviderBase:
+    """View provider: icon, double-click opens the feature's task panel."""
+
+    icon_name = "GHT_Workbench"
+    panel_factory: Callable[[Any], Any] | None = None
+
+    def __init__(self, vobj: Any) -> None:
+        vobj.Proxy = self
+
+    def attach(self, vobj: Any) -> None:
+        self.Object = vobj.Object
+
+    def getIcon(self) -> str:
+        return icon(self.icon_name)
+
+    def claimChildren(self) -> list:
+        return []
+
+    def setEdit(self, vobj: Any, mode: int = 0) -> bool:
+        if mode != 0 or type(self).panel_factory is None:
+            return False
+        import FreeCADGui as Gui
+
+        Gui.Control.showDialog(type(self).panel_factory(vobj.Object))
+        return True
+
+    def unsetEdit(self, vobj: Any, mode: int = 0) -> bool:
+        import FreeCADGui as Gui
+
+        Gui.Control.closeDialog()
+        return True
+
+    def doubleClicked(self, vobj: Any) -> bool:
+        import FreeCADGui as Gui
+
+        Gui.ActiveDocument.setEdit(vobj.Object.Name, 0)
+        return True
+
+    def __getstate__(self) -> None:
+        return None
+
+    def __setstate__(self, state: Any) -> None:
+        return None
+
+    def dumps(self) -> None:
+        return None
+
+    def loads(self, state: Any) -> None:
+        return None
+
+
+def _qt() -> tuple[Any, Any]:
+    try:
+        from PySide2 import QtCore, QtWidgets
+    except ImportError:  # pragma: no cover - other FreeCAD builds
+        from PySide import QtCore  # type: ignore
+        from PySide import QtGui as QtWidgets  # type: ignore
+    return QtCore, QtWidgets
+
+
+class ShapeParameterPanel:
+    """Task panel with one slider + spin box per float property; every change recomputes (live preview).
+
+    OK keeps the values, Cancel restores the values the feature had when the panel opened.
+    """
+
+    def __init__(self, obj: Any, names: Sequence[str] | None = None, title: str = "Shape parameters") -> None:
+        QtCore, QtWidgets = _qt()
+        self.obj = obj
+        self.names = list(names) if names is not None else [n for n, _ in SHAPE_PARAMETERS if n in obj.PropertiesList]
+        self.saved = {n: float(getattr(obj, n)) for n in self.names}
+        self.form = QtWidgets.QWidget()
+        self.form.setWindowTitle(f"{obj.Label}: {title}")
+        layout = QtWidgets.QFormLayout(self.form)
+        self.spins: dict[str, Any] = {}
+        self.sliders: dict[str, Any] = {}
+        for n in self.names:
+            row = QtWidgets.QHBoxLayout()
+            spin = QtWidgets.QDoubleSpinBox()
+            spin.setRange(-1.0, 1.0)
+            spin.setDecimals(3)
+            spin.setSingleStep(_STEP)
+            spin.setValue(self.saved[n])
+            spin.setToolTip(obj.getDocumentationOfProperty(n))
+            slider = QtWidgets.QSlider(QtCore.Qt.Horizontal)
+            slider.setRange(-1000, 1000)
+            slider.setValue(int(round(self.saved[n] * 1000)))
+            spin.valueChanged.connect(lambda v, n=n: self._changed(n, v, "spin"))
+            slider.valueChanged.connect(lambda v, n=n: self._changed(n, v / 1000.0, "slider"))
+            row.addWidget(slider)
+            row.addWidget(spin)
+            layout.addRow(n, row)
+            self.spins[n] = spin
+            self.sliders[n] = slider
+        self.status = QtWidgets.QLabel("")
+        layout.addRow(self.status)
+
+    def _changed(self, name: str, value: float, source: str) -> None:
+        if source == "slider":
+            self.spins[name].blockSignals(True)
+            self.spins[name].setValue(value)
+            self.spins[name].blockSignals(False)
+        else:
+            self.sliders[name].blockSignals(True)
+            self.sliders[name].setValue(int(round(value * 1000)))
+            self.sliders[name].blockSignals(False)
+        self.preview(name, value)
+
+    def preview(self, name: str, value: float) -> None:
+        """Write the value and recompute the feature (and what depends on it)."""
+        setattr(self.obj, name, float(value))
+        try:
+            self.obj.Document.recompute()
+            self.status.setText("")
+        except Exception as exc:  # keep the panel open on a bad combination
+            self.status.setText(str(exc))
+
+    def accept(self) -> bool:
+        import FreeCADGui as Gui
+
+        self.obj.Document.recompute()
+        Gui.Control.closeDialog()
+        if Gui.ActiveDocument is not None:
+            Gui.ActiveDocument.resetEdit()
+        return True
+
+    def reject(self) -> bool:
+        import FreeCADGui as Gui
+
+        for n, v in self.saved.items():
+            setattr(self.obj, n, v)
+        self.obj.Document.recompute()
+        Gui.Control.closeDialog()
+        if Gui.ActiveDocument is not None:
+            Gui.ActiveDocument.resetEdit()
+        return True
+
+    def getStandardButtons(self) -> int:
+        _, QtWidgets = _qt()
+        return int(QtWidgets.QDialogButtonBox.Ok | QtWidgets.QDialogButtonBox.Cancel)
+
+
+def new_feature(
+    doc: Any, name: str, proxy_cls: type, vp_cls: type | None, type_id: str = "Part::FeaturePython"
+) -> Any:
+    """Create a feature with its proxy and (GUI only) view provider."""
+    if doc is None:
+        doc = App.ActiveDocument or App.newDocument()
+    obj = doc.addObject(type_id, name)
+    proxy_cls(obj)
+    if App.GuiUp and vp_cls is not None:
+        vp_cls(obj.ViewObject)
+    return obj
+
+
+# name -> command instance; filled by each feature module's ``register`` and used by init_gui.
+COMMANDS: dict[str, Any] = {}
+
+
+class BaseCommand:
+    """Command base: resources from class attributes, active with an open document."""
+
+    name = "GHT_Base"
+    icon_name = "GHT_Workbench"
+    menu_text = ""
+    tooltip = ""
+
+    def GetResources(self) -> dict:
+        return {"Pixmap": icon(self.icon_name), "MenuText": self.menu_text, "ToolTip": self.tooltip}
+
+    def IsActive(self) -> bool:
+        return App.ActiveDocument is not None
+
+    def Activated(self) -> None:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def open_panel(self, obj: Any) -> None:
+        """Open the feature's task panel (live preview of its shape parameters) in the GUI."""
+        if App.GuiUp:
+            import FreeCADGui as Gui
+
+            Gui.ActiveDocument.setEdit(obj.Name, 0)
+
+
+def register_command(cmd: BaseCommand) -> None:
+    """Register with FreeCADGui (GUI only) and remember it for the workbench toolbar/menu."""
+    COMMANDS[cmd.name] = cmd
+    if App.GuiUp:
+        import FreeCADGui as Gui
+
+        Gui.addCommand(cmd.name, cmd)

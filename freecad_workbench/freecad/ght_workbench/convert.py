@@ -1,0 +1,140 @@
+"""Plain B-spline data from the ght_cad core -> FreeCAD ``Part`` geometry (and back to arrays).
+
+The core hands over poles/knots/degrees (:class:`ght_cad.bspline.BSplineCurveData`,
+:class:`ght_cad.bspline.BSplineSurfaceData`); here they become ``Part.BSplineCurve`` /
+``Part.BSplineSurface`` through ``buildFromPolesMultsKnots`` (distinct knots + multiplicities,
+OCCT's form). No build123d/OCP: this runs in FreeCAD's own Python.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
+
+import FreeCAD as App
+import Part
+
+from . import _ensure_core  # noqa: F401  (makes ght_cad importable)
+from ght_cad.bspline import BSplineCurveData, BSplineSurfaceData, knots_and_multiplicities
+from ght_cad.errors import ConversionError, GHTError
+
+__all__ = [
+    "vec",
+    "points_array",
+    "fit_curve_function",
+    "curve_data",
+    "part_curve",
+    "part_surface",
+    "edge_from_data",
+    "face_from_data",
+]
+
+# Default fitting tolerance (model units) when a feature does not set one.
+DEFAULT_TOL = 1e-6
+
+
+def vec(p: Sequence[float]) -> "App.Vector":
+    """``App.Vector`` from a 2-D or 3-D point (2-D gets z = 0)."""
+    q = [float(x) for x in p][:3]
+    q += [0.0] * (3 - len(q))
+    return App.Vector(*q)
+
+
+def points_array(points: Iterable[Any]) -> np.ndarray:
+    """(n, 3) float array from FreeCAD vectors (or any 3-sequences)."""
+    return np.array([[float(p[0]), float(p[1]), float(p[2])] for p in points], dtype=float).reshape(-1, 3)
+
+
+def _fallback_fit(f: Callable[[np.ndarray], np.ndarray], tol: float, max_points: int = 4097) -> BSplineCurveData:
+    """Cubic interpolation of ``f`` at 2^k+1 uniform parameters, k growing until the midpoint error <= tol.
+
+    Only used while the core has no ``ght_cad.bspline.fit_function``; the ends are interpolated
+    exactly (clamped knot vector, not-a-knot conditions).
+    """
+    from scipy.interpolate import make_interp_spline
+
+    n = 17
+    while True:
+        t = np.linspace(0.0, 1.0, n)
+        sp = make_interp_spline(t, f(t), k=3)
+        mid = 0.5 * (t[:-1] + t[1:])
+        err = float(np.max(np.linalg.norm(sp(mid) - f(mid), axis=-1)))
+        if err <= tol or n >= max_points:
+            if err > tol:
+                raise ConversionError(f"cubic fit reached {err:.3g} > tol={tol:g} with {n} points")
+            return BSplineCurveData(np.asarray(sp.c), np.asarray(sp.t), 3, max_deviation=err)
+        n = 2 * n - 1
+
+
+def fit_curve_function(f: Callable[[np.ndarray], np.ndarray], tol: float = DEFAULT_TOL) -> BSplineCurveData:
+    """B-spline data of a vector function ``f(t)`` on [0, 1] (shape (len(t), d)), deviation <= tol.
+
+    Uses ``ght_cad.bspline.fit_function`` when the core provides it (one common knot vector for
+    every coordinate, so a 6-D stack of two boundary curves keeps its pairing).
+    """
+    try:
+        from ght_cad.bspline import fit_function  # type: ignore[attr-defined]
+    except ImportError:
+        return _fallback_fit(f, tol)
+    return fit_function(f, tol=tol)
+
+
+def curve_data(curve: Any, tol: float = DEFAULT_TOL) -> BSplineCurveData:
+    """B-spline data of a :class:`ght_cad.GHTCurve` via ``ght_cad.bspline.curve_to_bspline``."""
+    try:
+        from ght_cad.bspline import curve_to_bspline  # type: ignore[attr-defined]
+    except ImportError:
+        return _fallback_fit(curve.evaluate, tol)
+    return curve_to_bspline(curve, tol=tol)
+
+
+def part_curve(data: BSplineCurveData) -> "Part.BSplineCurve":
+    """``Part.BSplineCurve`` with exactly the poles, knots and degree of ``data``."""
+    if data.dim not in (2, 3):
+        raise GHTError(f"a CAD edge needs 2-D or 3-D poles; got dimension {data.dim}")
+    knots, mults = data.distinct_knots()
+    c = Part.BSplineCurve()
+    poles = [vec(p) for p in data.poles]
+    if data.weights is None:
+        c.buildFromPolesMultsKnots(poles, [int(m) for m in mults], [float(k) for k in knots], False, int(data.degree))
+    else:
+        c.buildFromPolesMultsKnots(
+            poles,
+            [int(m) for m in mults],
+            [float(k) for k in knots],
+            False,
+            int(data.degree),
+            [float(w) for w in data.weights],
+        )
+    return c
+
+
+def part_surface(data: BSplineSurfaceData) -> "Part.BSplineSurface":
+    """``Part.BSplineSurface`` with exactly the net, knots and degrees of ``data``."""
+    ku, mu = knots_and_multiplicities(data.knots_u)
+    kv, mv = knots_and_multiplicities(data.knots_v)
+    s = Part.BSplineSurface()
+    poles = [[vec(p) for p in row] for row in data.poles]
+    s.buildFromPolesMultsKnots(
+        poles,
+        [int(m) for m in mu],
+        [int(m) for m in mv],
+        [float(k) for k in ku],
+        [float(k) for k in kv],
+        False,
+        False,
+        int(data.degree_u),
+        int(data.degree_v),
+    )
+    return s
+
+
+def edge_from_data(data: BSplineCurveData) -> "Part.Edge":
+    """An edge on :func:`part_curve`."""
+    return part_curve(data).toShape()
+
+
+def face_from_data(data: BSplineSurfaceData) -> "Part.Face":
+    """A face on :func:`part_surface` with its natural bounds."""
+    return Part.Face(part_surface(data))

@@ -1,0 +1,172 @@
+r"""GHT-Bézier curve feature: ``P(t) = Σ_{i=0..m} b_{i,m}(t; μ, ν, γ) P_i`` as a B-spline edge.
+
+Control points come from a list (``ControlPoints``) or from linked geometry (``Source``: selected
+vertices, a sketch's points or any shape's vertices, in order). The core evaluates the curve and
+``ght_cad.bspline.curve_to_bspline`` turns it into B-spline data within ``Tolerance``; that data
+becomes a ``Part.BSplineCurve``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+import FreeCAD as App
+import Part
+
+from ._base import (
+    BaseCommand,
+    FeatureProxy,
+    ShapeParameterPanel,
+    ViewProviderBase,
+    add_shape_parameters,
+    new_feature,
+    register_command,
+    set_read_only,
+)
+from .convert import DEFAULT_TOL, curve_data, edge_from_data, points_array
+
+__all__ = ["GHTCurveFeature", "make_ght_curve", "points_from_links", "core_curve"]
+
+
+def points_from_links(links: Sequence[tuple[Any, Sequence[str]]]) -> list["App.Vector"]:
+    """Points of linked geometry, in order: named vertices, else a sketch's Part.Point geometries,
+    else a points cloud, else every vertex of the shape."""
+    pts: list[App.Vector] = []
+    for obj, subs in links:
+        subs = [s for s in (subs or []) if s]
+        if subs:
+            for s in subs:
+                el = obj.Shape.getElement(s)
+                if not isinstance(el, Part.Vertex):
+                    raise ValueError(f"{obj.Label}.{s} is a {type(el).__name__}; select vertices or a sketch")
+                pts.append(App.Vector(el.Point))
+            continue
+        if obj.isDerivedFrom("Sketcher::SketchObject"):
+            geo = [g for g in obj.Geometry if isinstance(g, Part.Point)]
+            if geo:
+                pts += [obj.getGlobalPlacement().multVec(App.Vector(g.X, g.Y, g.Z)) for g in geo]
+                continue
+        if hasattr(obj, "Points") and hasattr(obj.Points, "Points"):
+            pts += [App.Vector(p) for p in obj.Points.Points]
+            continue
+        pts += [App.Vector(v.Point) for v in obj.Shape.Vertexes]
+    return pts
+
+
+def core_curve(obj: Any) -> Any:
+    """The :class:`ght_cad.GHTCurve` a GHT curve feature describes (3-D control points)."""
+    from ght_cad import GHTCurve
+
+    return GHTCurve(points_array(obj.ControlPoints), float(obj.Mu), float(obj.Nu), float(obj.Gamma))
+
+
+class GHTCurveFeature(FeatureProxy):
+    """Proxy of a GHT curve (``Part::FeaturePython``)."""
+
+    Type = "GHT::Curve"
+
+    def setup(self, obj: Any) -> None:
+        obj.addProperty("App::PropertyLinkSubList", "Source", "Input", "Vertices, a sketch or a shape whose points become the control points (overrides ControlPoints)")
+        obj.addProperty("App::PropertyVectorList", "ControlPoints", "Input", "Control points P_0..P_m (m >= 2)")
+        add_shape_parameters(obj)
+        obj.addProperty("App::PropertyFloat", "Tolerance", "Conversion", "Maximum deviation of the B-spline edge from the exact GHT curve")
+        obj.Tolerance = DEFAULT_TOL
+        obj.addProperty("App::PropertyInteger", "Degree", "Output", "Degree m = number of control points - 1")
+        obj.addProperty("App::PropertyFloat", "CurveLength", "Output", "Arc length ∫|P'(t)|dt of the exact curve")
+        obj.addProperty("App::PropertyFloat", "MaxDeviation", "Output", "Deviation of the B-spline from the exact curve")
+        self.restored(obj)
+
+    def restored(self, obj: Any) -> None:
+        set_read_only(obj, ("Degree", "CurveLength", "MaxDeviation"))
+
+    def compute(self, obj: Any) -> None:
+        if obj.Source:
+            pts = points_from_links(obj.Source)
+            if [tuple(p) for p in pts] != [tuple(p) for p in obj.ControlPoints]:
+                obj.ControlPoints = pts
+        curve = core_curve(obj)
+        data = curve_data(curve, tol=max(float(obj.Tolerance), 1e-12))
+        obj.Shape = edge_from_data(data)
+        obj.Degree = curve.degree
+        obj.CurveLength = float(curve.arc_length())
+        obj.MaxDeviation = float(data.max_deviation) if data.max_deviation is not None else 0.0
+
+
+class ViewProviderGHTCurve(ViewProviderBase):
+    icon_name = "GHT_Curve"
+
+    def claimChildren(self) -> list:
+        return []
+
+
+def _panel(obj: Any) -> ShapeParameterPanel:
+    return ShapeParameterPanel(obj, title="GHT curve")
+
+
+ViewProviderGHTCurve.panel_factory = staticmethod(_panel)
+
+
+def make_ght_curve(
+    control_points: Any = None,
+    mu: float = 0.0,
+    nu: float = 0.0,
+    gamma: float = 0.0,
+    *,
+    source: Any = None,
+    doc: Any = None,
+    name: str = "GHTCurve",
+) -> Any:
+    """Create a GHT curve feature.
+
+    Args:
+        control_points: (m+1, 2|3) points (m >= 2), unless ``source`` is given.
+        mu, nu, gamma: shape parameters in [-1, 1].
+        source: ``[(obj, ["Vertex1", ...]), (sketch, [])]`` links that supply the points.
+        doc: target document (default: the active one).
+
+    Returns:
+        The recomputed ``Part::FeaturePython`` object.
+    """
+    from ght_cad._validate import check_shape_parameter
+
+    for n, v in (("mu", mu), ("nu", nu), ("gamma", gamma)):
+        check_shape_parameter(n, v)
+    obj = new_feature(doc, name, GHTCurveFeature, ViewProviderGHTCurve)
+    if control_points is not None:
+        pts = np.asarray(control_points, dtype=float)
+        obj.ControlPoints = [App.Vector(*(list(p) + [0.0] * (3 - len(p)))[:3]) for p in pts]
+    if source is not None:
+        obj.Source = source
+    obj.Mu, obj.Nu, obj.Gamma = float(mu), float(nu), float(gamma)
+    obj.Document.recompute()
+    return obj
+
+
+class CommandGHTCurve(BaseCommand):
+    name = "GHT_Curve"
+    icon_name = "GHT_Curve"
+    menu_text = "GHT curve"
+    tooltip = (
+        "GHT-Bézier curve from the selected vertices (in selection order) or sketch points; "
+        "with nothing selected, a default degree-3 curve. Shape parameters μ, ν, γ ∈ [-1, 1]."
+    )
+
+    def Activated(self) -> None:
+        import FreeCADGui as Gui
+
+        links = []
+        for sel in Gui.Selection.getSelectionEx():
+            links.append((sel.Object, list(sel.SubElementNames)))
+        doc = App.ActiveDocument
+        doc.openTransaction("GHT curve")
+        if links and len(points_from_links(links)) >= 3:
+            obj = make_ght_curve(source=links, doc=doc)
+        else:
+            obj = make_ght_curve([(0, 0, 0), (10, 20, 0), (30, 20, 0), (40, 0, 0)], doc=doc)
+        doc.commitTransaction()
+        self.open_panel(obj)
+
+
+register_command(CommandGHTCurve())
