@@ -1,0 +1,573 @@
+"""The ``ght-cad`` command line.
+
+Subcommands::
+
+    ght-cad demo --out DIR              the whole pipeline on the embedded default design
+    ght-cad run DESIGN.toml --out DIR   the same from a design file (docs/design-files.md)
+    ght-cad curve ...                   one GHT-Bézier curve: properties, STEP edge, plots
+    ght-cad surface DESIGN.toml ...     developable surface of a design: measures, STEP face, view
+    ght-cad optimize DESIGN.toml ...    shape-parameter optimization of a design's surface
+    ght-cad unroll DESIGN.toml ...      flat pattern of a design's surface: DXF, SVG, PNG, errors
+    ght-cad export DESIGN.toml FILE...  write a design's result to STEP/DXF/SVG/JSON/PNG by suffix
+    ght-cad plot-basis ...              PNG of the GHT-Bernstein basis for chosen shape parameters
+
+Exit codes (stable, scripts may rely on them):
+
+    0  success
+    1  internal failure (a bug or a failing CAD kernel); the message says what failed
+    2  bad input or usage: unknown option, unreadable or invalid design file, a value out of
+       range (one line on stderr naming the file, the key and the allowed values)
+    130 interrupted (Ctrl-C)
+
+With ``--json`` the result (or ``{"ok": false, "error": ..., "exit_code": ...}``) is printed to
+stdout as one JSON object; human-readable text goes to stdout otherwise. A progress bar is drawn
+on stderr only when stderr is a terminal. Heavy modules (numpy, scipy, matplotlib, OCP) are
+imported inside the commands so that ``ght-cad --help`` is fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAILURE", "EXIT_USAGE", "EXIT_INTERRUPTED"]
+
+EXIT_OK = 0
+EXIT_FAILURE = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
+
+PROG = "ght-cad"
+
+
+class UsageError(Exception):
+    """Bad command-line input detected by a command (exit code 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line on stderr and exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+# ---------------------------------------------------------------------------------------------
+def _json_default(o: Any) -> Any:
+    try:
+        import numpy as np
+
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if isinstance(o, np.generic):
+            return o.item()
+    except ImportError:  # pragma: no cover
+        pass
+    if isinstance(o, Path):
+        return str(o)
+    if hasattr(o, "as_dict"):
+        return o.as_dict()
+    return str(o)
+
+
+def _clean(o: Any) -> Any:
+    """Replace NaN/inf by None so the output is strict JSON."""
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {str(k): _clean(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    return o
+
+
+def dumps(obj: Any) -> str:
+    """Strict JSON text (numpy values converted, NaN/inf as null)."""
+    return json.dumps(_clean(json.loads(json.dumps(obj, default=_json_default))), indent=2, allow_nan=False)
+
+
+def _parse_floats(text: str, what: str) -> list[float]:
+    try:
+        vals = [float(x) for x in text.replace(",", " ").split()]
+    except ValueError:
+        raise UsageError(f"{what}={text!r} is not a list of numbers; write e.g. '0,0.5,-1'") from None
+    return vals
+
+
+def _parse_points(text: str, what: str = "--points") -> list[list[float]]:
+    """Points from JSON (``[[0,0],[1,2]]``) or ``'x,y[,z] x,y[,z] ...'`` (space or ';' separated)."""
+    s = text.strip()
+    if s.startswith("["):
+        try:
+            pts = json.loads(s)
+        except json.JSONDecodeError as exc:
+            raise UsageError(f"{what} is not valid JSON: {exc}") from None
+        if not isinstance(pts, list) or not all(isinstance(p, list) for p in pts):
+            raise UsageError(f"{what} must be a JSON list of coordinate lists, e.g. [[0,0],[1,2],[3,0]]")
+        return pts
+    groups = [g for g in s.replace(";", " ").split() if g]
+    pts = []
+    for g in groups:
+        try:
+            pts.append([float(x) for x in g.split(",")])
+        except ValueError:
+            raise UsageError(f"{what}: {g!r} is not a point; write points as 'x,y[,z]' separated by spaces") from None
+    return pts
+
+
+def _progress(total: int | None, label: str) -> Any:
+    from .progress import Progress
+
+    return Progress(total, label)
+
+
+def _emit(args: argparse.Namespace, result: dict[str, Any], text: Callable[[dict[str, Any]], str]) -> None:
+    if getattr(args, "json", False):
+        print(dumps({"ok": True, **result}))
+    else:
+        print(text(result))
+
+
+def _outputs_text(result: dict[str, Any]) -> str:
+    lines = []
+    for k, v in (result.get("outputs") or {}).items():
+        lines.append(f"  {k}: {v}")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------------------
+# commands
+# ---------------------------------------------------------------------------------------------
+def cmd_plot_basis(args: argparse.Namespace) -> int:
+    from .plotting import SIZES, plot_basis
+
+    params = []
+    for p in args.params or ["0,0,-1", "0,0,0", "0,0,1", "-0.8,0.8,0"]:
+        vals = _parse_floats(p, "--params")
+        if len(vals) != 3:
+            raise UsageError(f"--params {p!r} must be three numbers mu,nu,gamma each in [-1, 1]")
+        params.append(tuple(vals))
+    path = plot_basis(args.out, args.degree, params, derivative=args.derivative)
+    result = {
+        "command": "plot-basis",
+        "degree": args.degree,
+        "derivative": args.derivative,
+        "params": [list(p) for p in params],
+        "outputs": {"png": str(path)},
+        "pixels": list(SIZES["basis"]),
+    }
+    _emit(args, result, lambda r: f"wrote {path}")
+    return EXIT_OK
+
+
+def cmd_curve(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .curve import GHTCurve
+
+    if args.points is None:
+        raise UsageError("--points is required, e.g. --points '0,0 1,2 3,2 4,0'")
+    curve = GHTCurve(_parse_points(args.points), args.mu, args.nu, args.gamma)
+    t = np.linspace(0.0, 1.0, 513)
+    kappa = curve.curvature(t)
+    result: dict[str, Any] = {
+        "command": "curve",
+        "degree": curve.degree,
+        "dim": curve.dim,
+        "mu": curve.mu,
+        "nu": curve.nu,
+        "gamma": curve.gamma,
+        "arc_length": curve.arc_length(),
+        "curvature_max": float(np.nanmax(kappa)),
+        "start_tangent": curve.derivative(0.0, 1).tolist(),
+        "end_tangent": curve.derivative(1.0, 1).tolist(),
+        "outputs": {},
+    }
+    if args.step:
+        from .bspline import curve_to_bspline
+        from .cad.occ import make_edge, write_step
+
+        if curve.dim not in (2, 3):
+            raise UsageError(f"--step needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
+        data = curve_to_bspline(curve)
+        write_step(make_edge(data), args.step)
+        result["outputs"]["step"] = str(args.step)
+        result["bspline"] = {"degree": data.degree, "poles": int(data.poles.shape[0]), "max_deviation": data.max_deviation}
+    if args.plot:
+        from .plotting import plot_curve
+
+        result["outputs"]["curve_png"] = str(plot_curve(curve, args.plot))
+    if args.curvature_plot:
+        from .plotting import plot_curvature
+
+        result["outputs"]["curvature_png"] = str(plot_curvature(curve, args.curvature_plot))
+
+    def text(r: dict[str, Any]) -> str:
+        s = (
+            f"GHT-Bézier curve: degree {r['degree']}, dim {r['dim']}, mu={r['mu']:g}, nu={r['nu']:g}, "
+            f"gamma={r['gamma']:g}\n  arc length {r['arc_length']:.10g}, max curvature {r['curvature_max']:.6g}"
+        )
+        out = _outputs_text(r)
+        return s + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def _load(args: argparse.Namespace) -> Any:
+    from .design import load_design
+
+    return load_design(args.design)
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    from .demo import run_demo
+
+    report = run_demo(args.out, progress=not args.no_progress, quick=args.quick)
+    _emit(args, {"command": "demo", **report}, _report_text)
+    return EXIT_OK
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .design import load_design, run_design
+
+    design = load_design(args.design)
+    out = args.out if args.out is not None else Path(args.design).with_suffix("").name + "-out"
+    report = run_design(design, out, progress=not args.no_progress)
+    _emit(args, {"command": "run", **report}, _report_text)
+    return EXIT_OK
+
+
+def _report_text(r: dict[str, Any]) -> str:
+    lines = [f"{r.get('name', 'design')}: results in {r.get('out_dir')}"]
+    dev = r.get("developability")
+    if dev:
+        lines.append(
+            f"  developability: DD={dev['dd']:.12f}  theta_max={dev['theta_max']:.3e} deg  R={dev['R']:.3e}"
+        )
+    pat = r.get("flat_pattern")
+    if pat and pat.get("errors"):
+        errs = ", ".join(f"{k}={v:.2e}" for k, v in pat["errors"].items() if isinstance(v, (int, float)))
+        lines.append(f"  flat pattern errors: {errs}")
+    opt = r.get("optimization")
+    if opt:
+        lines.append(
+            f"  optimization ({opt.get('method')}, {opt.get('objective')}): best {opt.get('best_value'):.6g} "
+            f"at {opt.get('best_parameters')}"
+        )
+    if r.get("elapsed_s") is not None:
+        lines.append(f"  elapsed {r['elapsed_s']:.1f} s")
+    files = r.get("files") or []
+    if files:
+        lines.append("  files: " + ", ".join(files))
+    return "\n".join(lines)
+
+
+def cmd_surface(args: argparse.Namespace) -> int:
+    from .design import build_surface, surface_summary
+
+    design = _load(args)
+    built = build_surface(design)
+    result = {"command": "surface", "name": design.name, **surface_summary(built), "outputs": {}}
+    if args.step:
+        from .design import export_step
+
+        result["outputs"]["step"] = str(export_step(built, args.step))
+    if args.plot:
+        from .plotting import plot_surface
+
+        result["outputs"]["surface_png"] = str(plot_surface(built.surface, args.plot, title=design.name))
+
+    def text(r: dict[str, Any]) -> str:
+        d = r["developability"]
+        s = f"{r['name']}: DD={d['dd']:.12f}, theta_max={d['theta_max']:.3e} deg, theta_rms={d['theta_rms']:.3e} deg, R={d['R']:.3e}"
+        out = _outputs_text(r)
+        return s + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def cmd_optimize(args: argparse.Namespace) -> int:
+    from .design import optimize_design
+
+    design = _load(args)
+    overrides = {k: getattr(args, k) for k in ("method", "objective", "iterations", "population", "seed")}
+    result_opt = optimize_design(design, overrides={k: v for k, v in overrides.items() if v is not None},
+                                 progress=not args.no_progress)
+    result = {"command": "optimize", "name": design.name, **result_opt.summary(), "outputs": {}}
+    if args.plot:
+        from .plotting import plot_convergence
+
+        result["outputs"]["convergence_png"] = str(
+            plot_convergence({result["method"]: result_opt.history}, args.plot, title=f"{design.name}: {result['objective']}")
+        )
+
+    def text(r: dict[str, Any]) -> str:
+        s = (
+            f"{r['name']}: {r['method']} on {r['objective']}: best {r['best_value']:.8g} at "
+            + ", ".join(f"{k}={v:.6g}" for k, v in r["best_parameters"].items())
+        )
+        out = _outputs_text(r)
+        return s + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def cmd_unroll(args: argparse.Namespace) -> int:
+    from .design import build_surface, unroll_surface
+
+    design = _load(args)
+    built = build_surface(design)
+    pattern = unroll_surface(built)
+    result: dict[str, Any] = {"command": "unroll", "name": design.name, "errors": _errors_dict(pattern), "outputs": {}}
+    if args.dxf:
+        pattern.export_dxf(args.dxf)
+        result["outputs"]["dxf"] = str(args.dxf)
+    if args.svg:
+        pattern.export_svg(args.svg)
+        result["outputs"]["svg"] = str(args.svg)
+    if args.png:
+        from .design import plot_pattern
+
+        result["outputs"]["png"] = str(plot_pattern(pattern, args.png, title=design.name))
+
+    def text(r: dict[str, Any]) -> str:
+        s = f"{r['name']}: flat pattern errors " + ", ".join(
+            f"{k}={v:.2e}" for k, v in r["errors"].items() if isinstance(v, (int, float))
+        )
+        out = _outputs_text(r)
+        return s + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def _errors_dict(pattern: Any) -> dict[str, Any]:
+    from .design import pattern_errors
+
+    return pattern_errors(pattern)
+
+
+_EXPORT_SUFFIXES = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from .design import export_files
+
+    for f in args.files:
+        if Path(f).suffix.lower() not in _EXPORT_SUFFIXES:
+            raise UsageError(
+                f"cannot export to {f!r}: unknown suffix {Path(f).suffix!r}; allowed: {', '.join(_EXPORT_SUFFIXES)}"
+            )
+    design = _load(args)
+    written = export_files(design, args.files)
+    result = {"command": "export", "name": design.name, "outputs": written}
+    _emit(args, result, lambda r: "\n".join(f"wrote {v}" for v in r["outputs"].values()))
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------------------------
+# parser
+# ---------------------------------------------------------------------------------------------
+_EPILOG = (
+    "exit codes: 0 success, 1 internal failure, 2 bad input or usage (one line on stderr), "
+    "130 interrupted. Design files: see docs/design-files.md."
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argparse parser of ``ght-cad`` (one sub-parser per command)."""
+    p = _Parser(
+        prog=PROG,
+        description="GHT-Bézier curves and developable surfaces: from control points or planes to "
+        "B-rep (STEP) and flat patterns (DXF/SVG).",
+        epilog=_EPILOG,
+    )
+    p.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    def common(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--json", action="store_true", help="print the result as one JSON object on stdout")
+
+    def design_arg(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("design", metavar="DESIGN.toml", help="design file (schema: docs/design-files.md)")
+
+    sp = sub.add_parser(
+        "demo",
+        help="run the whole pipeline on the embedded default design",
+        description="Run the whole pipeline on the embedded default design (a developable hull plate "
+        "from control planes): GHT curves and planes -> developable surface -> shape-parameter "
+        "optimization -> B-rep -> STEP, DXF and SVG flat patterns, PNG figures, JSON and Markdown report.",
+        epilog=_EPILOG,
+    )
+    sp.add_argument("--out", required=True, metavar="DIR", help="output folder (created; files are replaced atomically)")
+    sp.add_argument("--quick", action="store_true", help="fewer optimizer iterations (for smoke tests)")
+    sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    common(sp)
+    sp.set_defaults(func=cmd_demo)
+
+    sp = sub.add_parser(
+        "run",
+        help="run the whole pipeline on a design file",
+        description="Run the whole pipeline on DESIGN.toml. The file is validated first; an invalid "
+        "file gives one line on stderr naming the file, the key and the allowed values (exit 2). "
+        "Results are computed into a temporary folder beside --out and moved in only when "
+        "everything succeeded, so a failure leaves --out untouched.",
+        epilog=_EPILOG,
+    )
+    design_arg(sp)
+    sp.add_argument("--out", metavar="DIR", help="output folder (default: <design name>-out)")
+    sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    common(sp)
+    sp.set_defaults(func=cmd_run)
+
+    sp = sub.add_parser(
+        "curve",
+        help="one GHT-Bézier curve: properties, STEP edge, plots",
+        description="Evaluate a GHT-Bézier curve P(t) = sum b_i,m(t; mu,nu,gamma) P_i: degree, arc "
+        "length, curvature, end tangents; optionally a STEP edge (certified B-spline) and PNG plots.",
+        epilog=_EPILOG,
+    )
+    sp.add_argument("--points", metavar="PTS", help="control points: 'x,y[,z] x,y[,z] ...' or JSON [[x,y],...] (>= 3 points)")
+    sp.add_argument("--mu", type=float, default=0.0, help="shape parameter mu in [-1, 1] (default 0)")
+    sp.add_argument("--nu", type=float, default=0.0, help="shape parameter nu in [-1, 1] (default 0)")
+    sp.add_argument("--gamma", type=float, default=0.0, help="shape parameter gamma in [-1, 1] (default 0)")
+    sp.add_argument("--step", metavar="FILE", help="write the curve as a STEP edge")
+    sp.add_argument("--plot", metavar="PNG", help="plot of the curve with its control polygon (800x700 px)")
+    sp.add_argument("--curvature-plot", metavar="PNG", help="plot of the curvature along the curve (900x500 px)")
+    common(sp)
+    sp.set_defaults(func=cmd_curve)
+
+    sp = sub.add_parser(
+        "surface",
+        help="developable surface of a design: developability degree, STEP face, view",
+        description="Build the surface of DESIGN.toml with its given shape parameters and report its "
+        "developability degree (theta_max, theta_rms, DD, R; spec section 5).",
+        epilog=_EPILOG,
+    )
+    design_arg(sp)
+    sp.add_argument("--step", metavar="FILE", help="write the surface as a STEP face")
+    sp.add_argument("--plot", metavar="PNG", help="rendered view of the surface (900x700 px)")
+    common(sp)
+    sp.set_defaults(func=cmd_surface)
+
+    sp = sub.add_parser(
+        "optimize",
+        help="optimize the shape parameters of a design's surface",
+        description="Minimize the design's objective (AL, En, CVEn of the dual curve, or R, the "
+        "developability objective of a curve-pair strip) over the shape parameters with PSO, GWO or "
+        "I-GWO. Options override the design's [optimize] block.",
+        epilog=_EPILOG,
+    )
+    design_arg(sp)
+    sp.add_argument("--method", choices=("pso", "gwo", "igwo"), help="optimizer")
+    sp.add_argument("--objective", metavar="NAME", help="AL, En, CVEn or R")
+    sp.add_argument("--iterations", type=int, metavar="N", help="iterations (>= 1)")
+    sp.add_argument("--population", type=int, metavar="N", help="population size (>= 4)")
+    sp.add_argument("--seed", type=int, metavar="S", help="random seed")
+    sp.add_argument("--plot", metavar="PNG", help="convergence plot (800x500 px)")
+    sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    common(sp)
+    sp.set_defaults(func=cmd_optimize)
+
+    sp = sub.add_parser(
+        "unroll",
+        help="flat pattern of a design's surface (DXF, SVG, PNG) with its errors",
+        description="Unroll the design's developable surface into the plane (spec section 6) and "
+        "report the relative length and area errors of the pattern.",
+        epilog=_EPILOG,
+    )
+    design_arg(sp)
+    sp.add_argument("--dxf", metavar="FILE", help="write the pattern as DXF")
+    sp.add_argument("--svg", metavar="FILE", help="write the pattern as SVG")
+    sp.add_argument("--png", metavar="FILE", help="plot of the pattern (900x700 px)")
+    common(sp)
+    sp.set_defaults(func=cmd_unroll)
+
+    sp = sub.add_parser(
+        "export",
+        help="write a design's result to files chosen by suffix",
+        description="Build the design (with its given shape parameters) and write each FILE by its "
+        "suffix: .step/.stp (surface face and curves), .dxf/.svg (flat pattern), .json (report), "
+        ".png (rendered surface).",
+        epilog=_EPILOG,
+    )
+    design_arg(sp)
+    sp.add_argument("files", nargs="+", metavar="FILE", help="output files (.step .stp .dxf .svg .json .png)")
+    common(sp)
+    sp.set_defaults(func=cmd_export)
+
+    sp = sub.add_parser(
+        "plot-basis",
+        help="PNG of the GHT-Bernstein basis for chosen shape parameters",
+        description="Plot b_i,m(t; mu,nu,gamma) (or a derivative), one panel per --params triple, "
+        "with the classical Bernstein basis dashed for comparison. 1200x800 px.",
+        epilog=_EPILOG,
+    )
+    sp.add_argument("--degree", type=int, default=3, help="degree m >= 2 (default 3)")
+    sp.add_argument(
+        "--params", action="append", metavar="MU,NU,GAMMA",
+        help="shape parameters of one panel, each in [-1, 1] (repeatable; default four panels)",
+    )
+    sp.add_argument("--derivative", type=int, default=0, choices=(0, 1, 2, 3), help="derivative order")
+    sp.add_argument("--out", required=True, metavar="PNG", help="PNG file to write")
+    common(sp)
+    sp.set_defaults(func=cmd_plot_basis)
+    return p
+
+
+def _version() -> str:
+    try:
+        from . import __version__
+
+        return __version__
+    except Exception:  # pragma: no cover
+        return "unknown"
+
+
+def _fail(args: argparse.Namespace | None, code: int, message: str) -> int:
+    msg = " ".join(str(message).split())  # one line
+    sys.stderr.write(f"{PROG}: error: {msg}\n")
+    if args is not None and getattr(args, "json", False):
+        print(dumps({"ok": False, "error": msg, "exit_code": code}))
+    return code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``ght-cad``; returns the exit code (0 ok, 1 failure, 2 bad input, 130 Ctrl-C)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
+    try:
+        from .errors import GHTError
+    except Exception:  # pragma: no cover
+        GHTError = ValueError  # type: ignore[assignment,misc]
+    try:
+        return int(args.func(args) or 0)
+    except KeyboardInterrupt:
+        return _fail(args, EXIT_INTERRUPTED, "interrupted")
+    except UsageError as exc:
+        return _fail(args, EXIT_USAGE, str(exc))
+    except GHTError as exc:
+        return _fail(args, EXIT_USAGE, str(exc))
+    except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+        return _fail(args, EXIT_USAGE, f"{exc.strerror or exc}: {exc.filename}")
+    except Exception as exc:  # noqa: BLE001 - exit code 1 for every internal failure
+        if os.environ.get("GHT_CAD_DEBUG"):
+            traceback.print_exc()
+        return _fail(args, EXIT_FAILURE, f"internal failure: {type(exc).__name__}: {exc} (set GHT_CAD_DEBUG=1 for a traceback)")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
