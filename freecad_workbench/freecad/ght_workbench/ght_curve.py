@@ -138,7 +138,8 @@ def make_ght_curve(
         pts = np.asarray(control_points, dtype=float)
         obj.ControlPoints = [App.Vector(*(list(p) + [0.0] * (3 - len(p)))[:3]) for p in pts]
     if source is not None:
-        obj.Source = source
+        # an empty sub-list would drop the link: FreeCAD wants "" for "the whole object"
+        obj.Source = [(o, list(subs) if subs else "") for o, subs in source]
     obj.Mu, obj.Nu, obj.Gamma = float(mu), float(nu), float(gamma)
     obj.Document.recompute()
     return obj
@@ -158,7 +159,7 @@ class CommandGHTCurve(BaseCommand):
 
         links = []
         for sel in Gui.Selection.getSelectionEx():
-            links.append((sel.Object, list(sel.SubElementNames)))
+            links.append((sel.Object, [s for s in sel.SubElementNames if s.startswith("Vertex")]))
         doc = App.ActiveDocument
         doc.openTransaction("GHT curve")
         if links and len(points_from_links(links)) >= 3:

@@ -1,0 +1,256 @@
+"""Export commands: STEP of selected features, DXF/SVG of flat patterns (atomic writes).
+
+FreeCAD's Python has no ezdxf, so DXF is written by :func:`write_dxf_r12`, a minimal AutoCAD R12
+ASCII writer (LINE and POLYLINE entities on layers OUTLINE and BEND), which every CAM/laser
+program reads. SVG is plain ``<path>`` markup in millimetres. Curved edges are discretized with
+chordal deviation ``deflection``.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable, Sequence
+
+import FreeCAD as App
+import Part
+
+from . import _ensure_core  # noqa: F401
+from ._base import BaseCommand, register_command
+from ght_cad.errors import GHTError
+from ght_cad.io import atomic_path, write_text_atomic
+
+__all__ = [
+    "export_step",
+    "read_step",
+    "flat_pattern_polylines",
+    "write_dxf_r12",
+    "write_svg",
+    "export_flat_pattern_dxf",
+    "export_flat_pattern_svg",
+]
+
+
+def _shapes(objects: Iterable[Any]) -> list:
+    out = []
+    for o in objects:
+        shp = getattr(o, "Shape", None)
+        if shp is None or shp.isNull():
+            raise GHTError(f"{getattr(o, 'Label', o)} has no shape to export")
+        out.append(shp)
+    return out
+
+
+def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool = True) -> str:
+    """Write the shapes of ``objects`` (one, or a compound of several) to a STEP file atomically.
+
+    Raises:
+        GHTError: nothing to export, an invalid shape (when ``check``), or a failed write (the
+            target file is then untouched).
+    """
+    shapes = _shapes(objects)
+    if not shapes:
+        raise GHTError("nothing to export: no objects given")
+    if check:
+        for o, s in zip(objects, shapes):
+            if not s.isValid():
+                raise GHTError(f"{o.Label} is not a valid shape (shape.isValid() is False); not exported to {path}")
+    shape = shapes[0] if len(shapes) == 1 else Part.makeCompound(shapes)
+    with atomic_path(path) as tmp:
+        shape.exportStep(str(tmp))
+    return str(path)
+
+
+def read_step(path: str | os.PathLike) -> "Part.Shape":
+    """Read a STEP file back into one ``Part.Shape``."""
+    shape = Part.Shape()
+    shape.read(str(path))
+    return shape
+
+
+def _edge_points(edge: "Part.Edge", deflection: float) -> list[tuple[float, float]]:
+    if isinstance(edge.Curve, Part.Line) or edge.Curve.TypeId == "Part::GeomLine":
+        pts = [edge.Vertexes[0].Point, edge.Vertexes[-1].Point]
+        if edge.Orientation == "Reversed":
+            pts = pts[::-1]
+    else:
+        pts = edge.discretize(Deflection=deflection)
+    return [(float(p.x), float(p.y)) for p in pts]
+
+
+def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[list[tuple[float, float]]], list[list[tuple[float, float]]]]:
+    """(outline polylines, bend-line polylines) of a flat pattern feature in its XY plane.
+
+    The outline is every edge of the planar face(s) of ``obj.Shape``; bend lines are the loose
+    edges of the compound (not bounding a face).
+    """
+    shape = obj.Shape
+    outline = [_edge_points(e, deflection) for f in shape.Faces for w in f.Wires for e in w.OrderedEdges]
+    face_edges = [e for f in shape.Faces for e in f.Edges]
+    bends = [_edge_points(e, deflection) for e in shape.Edges if not any(e.isSame(fe) for fe in face_edges)]
+    return outline, bends
+
+
+def _dxf_pairs(pairs: list[tuple[int, Any]]) -> str:
+    out = []
+    for code, value in pairs:
+        if isinstance(value, float):
+            value = f"{value:.12g}"
+        out.append(f"{code:>3}\n{value}\n")
+    return "".join(out)
+
+
+def write_dxf_r12(
+    path: str | os.PathLike, layers: dict[str, list[list[tuple[float, float]]]], colors: dict[str, int] | None = None
+) -> str:
+    """Minimal AutoCAD R12 ASCII DXF: 2-point polylines become LINE, longer ones POLYLINE/VERTEX.
+
+    Args:
+        path: target file (written atomically).
+        layers: layer name -> list of polylines [(x, y), ...] in model units (mm).
+        colors: ACI colour per layer (default 7; BEND 1 = red).
+    """
+    colors = {"OUTLINE": 7, "BEND": 1, **(colors or {})}
+    pairs: list[tuple[int, Any]] = [(0, "SECTION"), (2, "HEADER"), (9, "$ACADVER"), (1, "AC1009"), (9, "$INSUNITS"), (70, 4), (0, "ENDSEC")]
+    pairs += [(0, "SECTION"), (2, "TABLES"), (0, "TABLE"), (2, "LAYER"), (70, len(layers))]
+    for name in layers:
+        pairs += [(0, "LAYER"), (2, name), (70, 0), (62, colors.get(name, 7)), (6, "CONTINUOUS")]
+    pairs += [(0, "ENDTAB"), (0, "ENDSEC"), (0, "SECTION"), (2, "ENTITIES")]
+    for name, polys in layers.items():
+        for pl in polys:
+            if len(pl) < 2:
+                continue
+            if len(pl) == 2:
+                (x0, y0), (x1, y1) = pl
+                pairs += [(0, "LINE"), (8, name), (10, x0), (20, y0), (30, 0.0), (11, x1), (21, y1), (31, 0.0)]
+            else:
+                pairs += [(0, "POLYLINE"), (8, name), (66, 1), (10, 0.0), (20, 0.0), (30, 0.0), (70, 0)]
+                for x, y in pl:
+                    pairs += [(0, "VERTEX"), (8, name), (10, x), (20, y), (30, 0.0)]
+                pairs += [(0, "SEQEND"), (8, name)]
+    pairs += [(0, "ENDSEC"), (0, "EOF")]
+    write_text_atomic(path, _dxf_pairs(pairs))
+    return str(path)
+
+
+def write_svg(path: str | os.PathLike, layers: dict[str, list[list[tuple[float, float]]]], margin: float = 5.0) -> str:
+    """SVG in millimetres (y up in the model, flipped for SVG); one ``<g id=layer>`` per layer."""
+    pts = [p for polys in layers.values() for pl in polys for p in pl]
+    if not pts:
+        raise GHTError("nothing to export: the flat pattern has no edges")
+    xs = [p[0] for p in pts]
+    ys = [p[1] for p in pts]
+    x0, x1, y0, y1 = min(xs) - margin, max(xs) + margin, min(ys) - margin, max(ys) + margin
+    w, h = x1 - x0, y1 - y0
+    style = {"OUTLINE": 'stroke="black" stroke-width="0.25"', "BEND": 'stroke="red" stroke-width="0.2" stroke-dasharray="2,1"'}
+    body = []
+    for name, polys in layers.items():
+        body.append(f'<g id="{name}" fill="none" {style.get(name, style["OUTLINE"])}>')
+        for pl in polys:
+            d = " ".join(("M" if i == 0 else "L") + f"{x - x0:.6f},{y1 - y:.6f}" for i, (x, y) in enumerate(pl))
+            body.append(f'<path d="{d}"/>')
+        body.append("</g>")
+    text = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.6f}mm" height="{h:.6f}mm" viewBox="0 0 {w:.6f} {h:.6f}">\n'
+        + "\n".join(body)
+        + "\n</svg>\n"
+    )
+    write_text_atomic(path, text)
+    return str(path)
+
+
+def export_flat_pattern_dxf(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
+    """DXF (R12) of a flat pattern feature: layer OUTLINE (cut) and BEND (bend lines)."""
+    outline, bends = flat_pattern_polylines(obj, deflection)
+    return write_dxf_r12(path, {"OUTLINE": outline, "BEND": bends})
+
+
+def export_flat_pattern_svg(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
+    """SVG of a flat pattern feature: group OUTLINE (black) and BEND (red dashed)."""
+    outline, bends = flat_pattern_polylines(obj, deflection)
+    return write_svg(path, {"OUTLINE": outline, "BEND": bends})
+
+
+def _ask_path(title: str, filt: str, default: str) -> str | None:
+    from PySide2 import QtWidgets
+
+    import FreeCADGui as Gui
+
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(Gui.getMainWindow(), title, default, filt)
+    return path or None
+
+
+def _default_path(doc: Any, ext: str) -> str:
+    base = os.path.splitext(doc.FileName)[0] if doc.FileName else os.path.join(os.path.expanduser("~"), doc.Name)
+    return base + ext
+
+
+def _flat_patterns(objs: Iterable[Any]) -> list:
+    return [o for o in objs if getattr(getattr(o, "Proxy", None), "Type", "") == "GHT::FlatPattern"]
+
+
+class CommandExportSTEP(BaseCommand):
+    name = "GHT_ExportSTEP"
+    icon_name = "GHT_ExportSTEP"
+    menu_text = "Export STEP"
+    tooltip = "Export the selected features (their shapes, as one compound) to a STEP file"
+    #: set by tests/macros to skip the file dialog
+    target: str | None = None
+
+    def IsActive(self) -> bool:
+        import FreeCADGui as Gui
+
+        return App.ActiveDocument is not None and bool(Gui.Selection.getSelection())
+
+    def Activated(self) -> None:
+        import FreeCADGui as Gui
+
+        objs = [o for o in Gui.Selection.getSelection() if hasattr(o, "Shape")]
+        path = self.target or _ask_path("Export STEP", "STEP (*.step *.stp)", _default_path(App.ActiveDocument, ".step"))
+        if path:
+            export_step(objs, path)
+            App.Console.PrintMessage(f"GHT: wrote {path}\n")
+
+
+class _CommandExportFlat(BaseCommand):
+    ext = ".dxf"
+    target: str | None = None
+
+    def IsActive(self) -> bool:
+        import FreeCADGui as Gui
+
+        return App.ActiveDocument is not None and bool(_flat_patterns(Gui.Selection.getSelection()))
+
+    def Activated(self) -> None:
+        import FreeCADGui as Gui
+
+        pats = _flat_patterns(Gui.Selection.getSelection())
+        for i, obj in enumerate(pats):
+            path = self.target or _ask_path(self.menu_text, f"{self.ext[1:].upper()} (*{self.ext})", _default_path(App.ActiveDocument, f"_{obj.Name}{self.ext}"))
+            if not path:
+                return
+            if self.target and len(pats) > 1:
+                path = f"{os.path.splitext(path)[0]}_{i}{self.ext}"
+            (export_flat_pattern_dxf if self.ext == ".dxf" else export_flat_pattern_svg)(obj, path)
+            App.Console.PrintMessage(f"GHT: wrote {path}\n")
+
+
+class CommandExportDXF(_CommandExportFlat):
+    name = "GHT_ExportDXF"
+    icon_name = "GHT_ExportDXF"
+    menu_text = "Export flat pattern DXF"
+    tooltip = "Export the selected flat patterns to DXF (R12: layer OUTLINE = cut contour, BEND = bend lines)"
+    ext = ".dxf"
+
+
+class CommandExportSVG(_CommandExportFlat):
+    name = "GHT_ExportSVG"
+    icon_name = "GHT_ExportSVG"
+    menu_text = "Export flat pattern SVG"
+    tooltip = "Export the selected flat patterns to SVG in millimetres (outline black, bend lines red dashed)"
+    ext = ".svg"
+
+
+register_command(CommandExportSTEP())
+register_command(CommandExportDXF())
+register_command(CommandExportSVG())
