@@ -1,0 +1,673 @@
+r"""Population optimizers on a box (spec section 8): PSO, GWO, I-GWO and a scipy DE baseline.
+
+All minimize ``f`` over ``lb <= x <= ub``, evaluate the **whole population in one call**
+``f(X) -> values`` with ``X`` of shape (pop, dim) and values of shape (pop,), take a seed or a
+``numpy.random.Generator``, and stop on the first of
+
+* the iteration budget ``max_iter`` or the evaluation budget ``max_nfev`` (an iteration is only
+  started if it fits in ``max_nfev``),
+* ``target``: the best value is ``<= target``,
+* ``tol``: the best value improved by at most ``tol * max(1, |best|)`` over the last
+  ``patience`` iterations (``tol = 0``, the default, disables it),
+* the ``callback(state)`` returning True (cancellation); ``state`` is an
+  :class:`OptimizerState` (``nit``, ``nfev``, ``x``, ``fun``, ``max_iter``).
+
+Evaluations per iteration: PSO and GWO ``pop``, I-GWO ``2 pop`` (``X_GWO`` and ``X_DLH``),
+DE ``pop``; the initial population costs ``pop`` more. Non-finite objective values count as
+``+inf``. Every result is an :class:`OptimizeResult`.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ..errors import GHTError
+
+__all__ = [
+    "OptimizeResult",
+    "OptimizerState",
+    "as_bounds",
+    "as_generator",
+    "pso",
+    "gwo",
+    "igwo",
+    "differential_evolution",
+    "minimize",
+    "METHODS",
+    "vectorize",
+]
+
+Objective = Callable[[np.ndarray], Any]
+
+#: Iterations used when neither ``max_iter`` nor ``max_nfev`` is given.
+DEFAULT_MAX_ITER = 200
+
+
+@dataclass
+class OptimizeResult:
+    """Outcome of one optimizer run.
+
+    Attributes:
+        x: best parameters found, shape (dim,).
+        fun: objective value at ``x``.
+        nfev: number of objective evaluations (points, not calls).
+        nit: number of iterations after the initial population.
+        time: wall time in seconds.
+        history: best value so far after the initial population (index 0) and after each
+            iteration, shape (nit + 1,).
+        history_nfev: evaluations used at the same moments, shape (nit + 1,).
+        message: why the run stopped.
+        method: optimizer name (``"pso"``, ``"gwo"``, ``"igwo"``, ``"de"``).
+        success: False only if no finite value was found.
+    """
+
+    x: np.ndarray
+    fun: float
+    nfev: int
+    nit: int
+    time: float
+    history: np.ndarray
+    history_nfev: np.ndarray
+    message: str
+    method: str
+    success: bool = True
+
+    def nfev_to_reach(self, value: float) -> int | None:
+        """Evaluations after which the best value was first ``<= value`` (None if never).
+
+        Resolution is one iteration (the history is recorded per iteration).
+        """
+        hit = np.nonzero(self.history <= value)[0]
+        return int(self.history_nfev[hit[0]]) if hit.size else None
+
+    def __str__(self) -> str:
+        return (
+            f"{self.method}: fun={self.fun:.6g} nfev={self.nfev} nit={self.nit} "
+            f"time={self.time:.3f}s ({self.message})"
+        )
+
+
+@dataclass
+class OptimizerState:
+    """What a callback sees after each iteration (and once after the initial population).
+
+    Attributes:
+        nit: iterations done (0 after the initial population).
+        nfev: evaluations so far.
+        x: best parameters so far (a copy).
+        fun: best value so far.
+        max_iter: the iteration budget of the run.
+        method: optimizer name.
+    """
+
+    nit: int
+    nfev: int
+    x: np.ndarray
+    fun: float
+    max_iter: int
+    method: str
+
+
+def as_generator(seed: Any) -> np.random.Generator:
+    """``numpy.random.Generator`` from ``None``, an int, a SeedSequence or a Generator (as is).
+
+    Raises:
+        GHTError: for anything else (e.g. a legacy ``RandomState``, a float).
+    """
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is None or isinstance(seed, (np.random.SeedSequence, np.random.BitGenerator)):
+        return np.random.default_rng(seed)
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        if seed < 0:
+            raise GHTError(f"seed={seed} is negative; use an int >= 0 or a numpy.random.Generator")
+        return np.random.default_rng(int(seed))
+    raise GHTError(f"seed={seed!r} is not allowed; use None, an int >= 0 or a numpy.random.Generator")
+
+
+def as_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bound arrays from ``(lb, ub)`` or an object with ``.lb``/``.ub``.
+
+    Args:
+        bounds: a pair ``(lb, ub)`` of equal-length 1-D array-likes (scalars allowed for
+            dim 1), or e.g. ``scipy.optimize.Bounds``.
+
+    Returns:
+        ``(lb, ub)`` as float arrays of shape (dim,), with ``lb < ub`` componentwise.
+
+    Raises:
+        GHTError: wrong shape, non-finite values or ``lb >= ub``.
+    """
+    if hasattr(bounds, "lb") and hasattr(bounds, "ub"):
+        lb, ub = bounds.lb, bounds.ub
+    else:
+        try:
+            lb, ub = bounds
+        except (TypeError, ValueError):
+            shape = np.shape(bounds) if not isinstance(bounds, str) else "str"
+            raise GHTError(
+                f"bounds with shape {shape} are not allowed; pass (lb, ub), two arrays of the same length "
+                "(not a list of (low, high) pairs)"
+            ) from None
+    try:
+        lb = np.atleast_1d(np.asarray(lb, dtype=float))
+        ub = np.atleast_1d(np.asarray(ub, dtype=float))
+    except (TypeError, ValueError):
+        raise GHTError(f"bounds={bounds!r} are not numeric; pass (lb, ub), two arrays of numbers") from None
+    if lb.ndim != 1 or ub.shape != lb.shape:
+        raise GHTError(
+            f"bounds have lb shape {lb.shape} and ub shape {ub.shape}; pass (lb, ub) as two 1-D arrays "
+            "of the same length (not a list of (low, high) pairs)"
+        )
+    if lb.size == 0:
+        raise GHTError("bounds are empty; at least one parameter is needed")
+    if not (np.all(np.isfinite(lb)) and np.all(np.isfinite(ub))):
+        raise GHTError(f"bounds lb={lb.tolist()} ub={ub.tolist()} contain non-finite values; a finite box is required")
+    bad = np.nonzero(lb >= ub)[0]
+    if bad.size:
+        i = int(bad[0])
+        raise GHTError(f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub")
+    return lb, ub
+
+
+def vectorize(fun: Callable[[np.ndarray], float]) -> Callable[[np.ndarray], np.ndarray]:
+    """Wrap a scalar objective ``f(x) -> float`` as a population objective ``F(X) -> (pop,)``.
+
+    A convenience for objectives without a vectorized form (one Python call per point).
+    """
+
+    def F(X: np.ndarray) -> np.ndarray:
+        return np.array([float(fun(x)) for x in np.asarray(X, dtype=float)])
+
+    return F
+
+
+class _Stop(Exception):
+    """Internal: raised inside scipy's objective to end a DE run on our stopping rules."""
+
+
+class _Run:
+    """Book-keeping shared by all optimizers: budget, evaluation counting, history, stopping."""
+
+    def __init__(
+        self,
+        method: str,
+        fun: Objective,
+        bounds: Any,
+        *,
+        pop_size: int,
+        max_iter: int | None,
+        max_nfev: int | None,
+        evals_per_iter: int,
+        tol: float,
+        patience: int,
+        target: float | None,
+        seed: Any,
+        callback: Callable[[OptimizerState], Any] | None,
+        x0: Any,
+        min_pop: int = 4,
+    ) -> None:
+        self.t0 = time.perf_counter()
+        self.method = method
+        if not callable(fun):
+            raise GHTError(f"fun={fun!r} is not callable; pass f(X: (pop, dim)) -> (pop,)")
+        self.fun = fun
+        self.lb, self.ub = as_bounds(bounds)
+        self.dim = self.lb.size
+        if isinstance(pop_size, bool) or not isinstance(pop_size, (int, np.integer)) or pop_size < min_pop:
+            raise GHTError(f"pop_size={pop_size!r} is not allowed; use an integer >= {min_pop}")
+        self.pop = int(pop_size)
+        self.rng = as_generator(seed)
+        tol = float(tol)
+        if not math.isfinite(tol) or tol < 0:
+            raise GHTError(f"tol={tol!r} is not allowed; use a finite number >= 0 (0 disables it)")
+        self.tol = tol
+        if isinstance(patience, bool) or int(patience) != patience or patience < 1:
+            raise GHTError(f"patience={patience!r} is not allowed; use an integer >= 1")
+        self.patience = int(patience)
+        self.target = None if target is None else float(target)
+        if callback is not None and not callable(callback):
+            raise GHTError(f"callback={callback!r} is not callable")
+        self.callback = callback
+        self.max_iter = self._resolve_budget(max_iter, max_nfev, evals_per_iter)
+        self.max_nfev = None if max_nfev is None else int(max_nfev)
+        self.x0 = None
+        if x0 is not None:
+            x0 = np.asarray(x0, dtype=float).reshape(-1)
+            if x0.shape != (self.dim,):
+                raise GHTError(f"x0 has shape {x0.shape}; expected ({self.dim},)")
+            if np.any(x0 < self.lb) or np.any(x0 > self.ub) or not np.all(np.isfinite(x0)):
+                raise GHTError(f"x0={x0.tolist()} is outside the bounds lb={self.lb.tolist()} ub={self.ub.tolist()}")
+            self.x0 = x0
+        self.nfev = 0
+        self.best_f = math.inf
+        self.best_x = 0.5 * (self.lb + self.ub)
+        self.hist: list[float] = []
+        self.hist_nfev: list[int] = []
+
+    def _resolve_budget(self, max_iter: Any, max_nfev: Any, per_iter: int) -> int:
+        limits = []
+        if max_iter is not None:
+            if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 0:
+                raise GHTError(f"max_iter={max_iter!r} is not allowed; use an integer >= 0")
+            limits.append(int(max_iter))
+        if max_nfev is not None:
+            if isinstance(max_nfev, bool) or int(max_nfev) != max_nfev or max_nfev < self.pop:
+                raise GHTError(
+                    f"max_nfev={max_nfev!r} is not allowed; it must be an integer >= pop_size={self.pop} "
+                    "(the initial population alone costs pop_size evaluations)"
+                )
+            limits.append((int(max_nfev) - self.pop) // per_iter)
+        return min(limits) if limits else DEFAULT_MAX_ITER
+
+    # -- population helpers ----------------------------------------------------------------
+    def initial_population(self) -> np.ndarray:
+        X = self.lb + (self.ub - self.lb) * self.rng.random((self.pop, self.dim))
+        if self.x0 is not None:
+            X[0] = self.x0
+        return X
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        """``f(X)`` with shape checks, non-finite -> +inf, counting and best-so-far tracking."""
+        try:
+            raw = self.fun(X)
+        except _Stop:
+            raise
+        f = np.asarray(raw, dtype=float)
+        if f.size != X.shape[0]:
+            raise GHTError(
+                f"the objective returned shape {f.shape} for a population of shape {X.shape}; "
+                f"it must return one value per row, shape ({X.shape[0]},)"
+            )
+        f = np.where(np.isfinite(f.reshape(-1)), f.reshape(-1), np.inf)
+        self.nfev += X.shape[0]
+        i = int(np.argmin(f))
+        if f[i] < self.best_f:
+            self.best_f = float(f[i])
+            self.best_x = np.array(X[i], dtype=float)
+        return f
+
+    # -- iteration bookkeeping -------------------------------------------------------------
+    def record(self, nit: int) -> str | None:
+        """Record history after iteration ``nit``; return a stop message or None."""
+        self.hist.append(self.best_f)
+        self.hist_nfev.append(self.nfev)
+        if self.target is not None and self.best_f <= self.target:
+            return f"target {self.target:g} reached"
+        if self.tol > 0 and nit >= self.patience:
+            old = self.hist[-1 - self.patience]
+            if old - self.best_f <= self.tol * max(1.0, abs(self.best_f)):
+                return f"converged: improvement <= tol={self.tol:g} over {self.patience} iterations"
+        if self.callback is not None:
+            state = OptimizerState(nit, self.nfev, self.best_x.copy(), self.best_f, self.max_iter, self.method)
+            if self.callback(state) is True:
+                return "stopped by callback"
+        if nit >= self.max_iter:
+            if self.max_nfev is not None and self.nfev + self._per_iter_hint > self.max_nfev:
+                return "evaluation budget max_nfev reached"
+            return "iteration budget max_iter reached"
+        return None
+
+    _per_iter_hint = 0
+
+    def result(self, nit: int, message: str) -> OptimizeResult:
+        return OptimizeResult(
+            x=self.best_x.copy(),
+            fun=self.best_f,
+            nfev=self.nfev,
+            nit=nit,
+            time=time.perf_counter() - self.t0,
+            history=np.asarray(self.hist, dtype=float),
+            history_nfev=np.asarray(self.hist_nfev, dtype=int),
+            message=message,
+            method=self.method,
+            success=bool(math.isfinite(self.best_f)),
+        )
+
+
+_COMMON_ARGS = """
+    Args:
+        fun: population objective ``f(X) -> values``, X of shape (pop, dim), values (pop,).
+        bounds: ``(lb, ub)``, two arrays of length dim (or an object with ``.lb``/``.ub``).
+        pop_size: number of agents (>= 4).
+        max_iter: iteration budget (default 200 if ``max_nfev`` is not given either).
+        max_nfev: evaluation budget (iterations that would exceed it are not started).
+        tol: stop when the best value improved by <= ``tol * max(1, |best|)`` over the last
+            ``patience`` iterations (0 disables).
+        patience: window of the ``tol`` test, in iterations.
+        target: stop as soon as the best value is ``<= target``.
+        seed: None, an int or a ``numpy.random.Generator``; fixed seed -> identical run.
+        callback: ``callback(state: OptimizerState)``, called after the initial population and
+            each iteration; returning True stops the run (cancellation).
+        x0: optional starting point placed in the initial population (so the result is never
+            worse than ``f(x0)``).
+
+    Returns:
+        OptimizeResult.
+
+    Raises:
+        GHTError: bad bounds, budget, seed, population size, ``x0`` outside the bounds, or an
+            objective returning the wrong shape.
+"""
+
+
+def pso(
+    fun: Objective,
+    bounds: Any,
+    *,
+    pop_size: int = 30,
+    max_iter: int | None = None,
+    max_nfev: int | None = None,
+    tol: float = 0.0,
+    patience: int = 10,
+    target: float | None = None,
+    seed: Any = None,
+    callback: Callable[[OptimizerState], Any] | None = None,
+    x0: Any = None,
+    w_start: float = 0.9,
+    w_end: float = 0.4,
+    c1: float = 2.0,
+    c2: float = 2.0,
+    v_max: float = 0.2,
+) -> OptimizeResult:
+    """Particle swarm optimization (spec section 8).
+
+    ``v ← w v + c1 r1 ∘ (pbest - x) + c2 r2 ∘ (gbest - x)``, ``|v| ≤ v_max (ub - lb)``
+    componentwise, ``x ← clip(x + v, lb, ub)``; inertia ``w`` decreases linearly from
+    ``w_start`` (0.9) at the first iteration to ``w_end`` (0.4) at the last; ``r1, r2 ~ U(0,1)``
+    per component. Initial velocities are uniform in ``[-v_max (ub-lb), v_max (ub-lb)]``.
+    """
+    run = _Run("pso", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
+               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               target=target, seed=seed, callback=callback, x0=x0)
+    run._per_iter_hint = run.pop
+    rng, lb, ub = run.rng, run.lb, run.ub
+    vmax = float(v_max) * (ub - lb)
+    x = run.initial_population()
+    v = rng.uniform(-1.0, 1.0, x.shape) * vmax
+    fx = run.evaluate(x)
+    pbest, pf = x.copy(), fx.copy()
+    g = int(np.argmin(pf))
+    msg = run.record(0)
+    nit = 0
+    T = max(run.max_iter - 1, 1)
+    while msg is None:
+        w = w_start - (w_start - w_end) * nit / T
+        r1 = rng.random(x.shape)
+        r2 = rng.random(x.shape)
+        v = w * v + c1 * r1 * (pbest - x) + c2 * r2 * (pbest[g] - x)
+        np.clip(v, -vmax, vmax, out=v)
+        x = np.clip(x + v, lb, ub)
+        fx = run.evaluate(x)
+        better = fx < pf
+        pbest[better] = x[better]
+        pf[better] = fx[better]
+        g = int(np.argmin(pf))
+        nit += 1
+        msg = run.record(nit)
+    return run.result(nit, msg)
+
+
+pso.__doc__ = (pso.__doc__ or "") + _COMMON_ARGS
+
+
+def _gwo_candidates(X: np.ndarray, leaders: np.ndarray, a: float, rng: np.random.Generator) -> np.ndarray:
+    """``X_GWO = (X_α* + X_β* + X_δ*) / 3`` with ``X_L* = X_L - A |C X_L - X|``.
+
+    ``A = 2 a r1 - a``, ``C = 2 r2``, fresh ``r1, r2 ~ U(0,1)`` per wolf, leader and component.
+    """
+    out = np.zeros_like(X)
+    for L in leaders:
+        r1 = rng.random(X.shape)
+        r2 = rng.random(X.shape)
+        A = 2.0 * a * r1 - a
+        C = 2.0 * r2
+        out += L - A * np.abs(C * L - X)
+    out /= len(leaders)
+    return out
+
+
+def gwo(
+    fun: Objective,
+    bounds: Any,
+    *,
+    pop_size: int = 30,
+    max_iter: int | None = None,
+    max_nfev: int | None = None,
+    tol: float = 0.0,
+    patience: int = 10,
+    target: float | None = None,
+    seed: Any = None,
+    callback: Callable[[OptimizerState], Any] | None = None,
+    x0: Any = None,
+) -> OptimizeResult:
+    """Grey wolf optimizer (spec section 8).
+
+    Leaders α, β, δ are the three best positions found so far; ``a = 2 - 2 it / max_iter``; for
+    each leader ``A = 2a r1 - a``, ``C = 2 r2``, ``D = |C X_L - X|``, ``X_L* = X_L - A D``; every
+    wolf moves to ``X_GWO = (X_α* + X_β* + X_δ*) / 3``, clipped to the box.
+    """
+    run = _Run("gwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
+               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               target=target, seed=seed, callback=callback, x0=x0)
+    run._per_iter_hint = run.pop
+    rng, lb, ub = run.rng, run.lb, run.ub
+    X = run.initial_population()
+    fX = run.evaluate(X)
+    order = np.argsort(fX, kind="stable")[:3]
+    lead_x, lead_f = X[order].copy(), fX[order].copy()
+    msg = run.record(0)
+    nit = 0
+    T = max(run.max_iter, 1)
+    while msg is None:
+        a = 2.0 - 2.0 * nit / T
+        X = np.clip(_gwo_candidates(X, lead_x, a, rng), lb, ub)
+        fX = run.evaluate(X)
+        allf = np.concatenate([lead_f, fX])
+        allx = np.concatenate([lead_x, X])
+        order = np.argsort(allf, kind="stable")[:3]
+        lead_x, lead_f = allx[order].copy(), allf[order].copy()
+        nit += 1
+        msg = run.record(nit)
+    return run.result(nit, msg)
+
+
+gwo.__doc__ = (gwo.__doc__ or "") + _COMMON_ARGS
+
+
+def _midpoint_bounds(Y: np.ndarray, X_old: np.ndarray, lb: np.ndarray, ub: np.ndarray) -> np.ndarray:
+    """Out-of-bound components go to the midpoint between the old position and the violated bound."""
+    Y = np.where(Y < lb, 0.5 * (X_old + lb), Y)
+    return np.where(Y > ub, 0.5 * (X_old + ub), Y)
+
+
+def igwo(
+    fun: Objective,
+    bounds: Any,
+    *,
+    pop_size: int = 30,
+    max_iter: int | None = None,
+    max_nfev: int | None = None,
+    tol: float = 0.0,
+    patience: int = 10,
+    target: float | None = None,
+    seed: Any = None,
+    callback: Callable[[OptimizerState], Any] | None = None,
+    x0: Any = None,
+) -> OptimizeResult:
+    r"""Improved grey wolf optimizer with dimension-learning-based hunting (spec section 8).
+
+    Per iteration, with α, β, δ the three best wolves of the population (each wolf holds the
+    best position it has found) and ``a = 2 - 2 it / max_iter``:
+
+    1. ``X_GWO,i`` as in :func:`gwo`;
+    2. radius ``R_i = |X_i - X_GWO,i|``, neighbourhood ``N_i = {X_j : |X_i - X_j| <= R_i}``;
+    3. ``X_DLH,i,d = X_i,d + rand · (X_n,d - X_r,d)`` with ``X_n`` a random neighbour drawn per
+       dimension d, ``X_r`` a random wolf (one per i: a random permutation, as in the reference
+       implementation of Nadimi-Shahraki et al. 2021), ``rand ~ U(0,1)`` per component;
+    4. out-of-bound components of both candidates go to the midpoint between ``X_i`` and the
+       violated bound;
+    5. both candidate sets are evaluated (one call of 2·pop points: ``X_GWO`` and ``X_DLH``, never
+       ``X_GWO`` twice); the better candidate replaces ``X_i`` only if it improves on it.
+    """
+    run = _Run("igwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
+               evals_per_iter=2 * pop_size if isinstance(pop_size, int) else 1, tol=tol,
+               patience=patience, target=target, seed=seed, callback=callback, x0=x0)
+    run._per_iter_hint = 2 * run.pop
+    rng, lb, ub = run.rng, run.lb, run.ub
+    N, D = run.pop, run.dim
+    X = run.initial_population()
+    fX = run.evaluate(X)
+    msg = run.record(0)
+    nit = 0
+    T = max(run.max_iter, 1)
+    rows = np.arange(N)[:, None]
+    while msg is None:
+        a = 2.0 - 2.0 * nit / T
+        leaders = X[np.argsort(fX, kind="stable")[:3]]
+        Xg = _midpoint_bounds(_gwo_candidates(X, leaders, a, rng), X, lb, ub)
+        # dimension-learning-based hunting
+        radius = np.sqrt(np.sum((X - Xg) ** 2, axis=1))
+        diff = X[:, None, :] - X[None, :, :]
+        dist = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+        mask = dist <= radius[:, None]
+        np.fill_diagonal(mask, True)  # a wolf is always its own neighbour (R_i >= 0 = |X_i - X_i|)
+        count = mask.sum(axis=1)
+        # k-th True entry of row i, k drawn uniformly per dimension: stable argsort puts True first
+        members = np.argsort(~mask, axis=1, kind="stable")
+        k = np.minimum((rng.random((N, D)) * count[:, None]).astype(np.intp), count[:, None] - 1)
+        nb = members[rows, k]
+        rw = rng.permutation(N)  # one random wolf per i (a permutation, as in the reference code)
+        cols = np.arange(D)[None, :]
+        Xd = X + rng.random((N, D)) * (X[nb, cols] - X[rw])
+        Xd = _midpoint_bounds(Xd, X, lb, ub)
+        f_both = run.evaluate(np.concatenate([Xg, Xd]))
+        fg, fd = f_both[:N], f_both[N:]
+        use_g = fg < fd
+        cand = np.where(use_g[:, None], Xg, Xd)
+        fc = np.where(use_g, fg, fd)
+        better = fc < fX
+        X[better] = cand[better]
+        fX[better] = fc[better]
+        nit += 1
+        msg = run.record(nit)
+    return run.result(nit, msg)
+
+
+igwo.__doc__ = (igwo.__doc__ or "") + _COMMON_ARGS
+
+
+def differential_evolution(
+    fun: Objective,
+    bounds: Any,
+    *,
+    pop_size: int = 30,
+    max_iter: int | None = None,
+    max_nfev: int | None = None,
+    tol: float = 0.0,
+    patience: int = 10,
+    target: float | None = None,
+    seed: Any = None,
+    callback: Callable[[OptimizerState], Any] | None = None,
+    x0: Any = None,
+    strategy: str = "best1bin",
+    mutation: float | tuple[float, float] = (0.5, 1.0),
+    recombination: float = 0.7,
+    polish: bool = False,
+) -> OptimizeResult:
+    """Baseline: ``scipy.optimize.differential_evolution`` with the same interface and result.
+
+    The population (``pop_size`` points, uniform in the box, ``x0`` first) is passed as ``init``;
+    the objective is called vectorized (``vectorized=True``, ``updating="deferred"``, scipy >= 1.9)
+    once per generation; the random stream is ``seed`` (``rng=`` on scipy >= 1.15, else
+    ``seed=``). scipy's own convergence test is switched off (``tol = atol = 0``); the stopping
+    rules of this module apply. ``polish`` (an L-BFGS-B finish, extra evaluations) is off by
+    default so evaluation counts compare fairly.
+    """
+    from scipy import optimize as _so
+
+    run = _Run("de", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
+               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               target=target, seed=seed, callback=callback, x0=x0, min_pop=5)
+    run._per_iter_hint = run.pop
+    init = run.initial_population()
+    state = {"calls": 0, "msg": None}
+
+    def wrapped(xT: np.ndarray) -> np.ndarray:
+        X = np.asarray(xT, dtype=float)
+        X = X.T if X.ndim == 2 else X.reshape(1, -1)
+        f = run.evaluate(X)
+        msg = run.record(state["calls"])
+        state["calls"] += 1
+        if msg is not None:
+            state["msg"] = msg
+            raise _Stop
+        return f
+
+    params = inspect.signature(_so.differential_evolution).parameters
+    kw: dict[str, Any] = dict(
+        strategy=strategy,
+        maxiter=max(run.max_iter, 1) + 5,
+        init=init,
+        tol=0.0,
+        atol=0.0,
+        mutation=mutation,
+        recombination=recombination,
+        polish=bool(polish),
+        updating="deferred",
+    )
+    if "vectorized" not in params:
+        raise GHTError("scipy >= 1.9 is required for the vectorized differential_evolution baseline")
+    kw["vectorized"] = True
+    if "rng" in params:
+        kw["rng"] = run.rng
+    else:
+        kw["seed"] = run.rng
+    lb, ub = run.lb, run.ub
+    try:
+        res = _so.differential_evolution(wrapped, list(zip(lb, ub)), **kw)
+        msg = f"scipy: {res.message}"
+    except _Stop:
+        msg = state["msg"]
+    nit = max(state["calls"] - 1, 0)
+    return run.result(nit, msg or "scipy finished")
+
+
+differential_evolution.__doc__ = (differential_evolution.__doc__ or "") + _COMMON_ARGS
+
+#: Optimizers by name, for :func:`minimize`, the bench and the comparison table.
+METHODS: dict[str, Callable[..., OptimizeResult]] = {
+    "pso": pso,
+    "gwo": gwo,
+    "igwo": igwo,
+    "de": differential_evolution,
+}
+
+
+def minimize(fun: Objective, bounds: Any, method: str = "igwo", **options: Any) -> OptimizeResult:
+    """Minimize a population objective with the optimizer ``method`` (``pso``, ``gwo``, ``igwo``, ``de``).
+
+    Args:
+        fun: population objective ``f(X) -> (pop,)``.
+        bounds: ``(lb, ub)``.
+        method: optimizer name (case-insensitive; ``"i-gwo"`` is accepted for ``"igwo"``).
+        **options: passed on (``pop_size``, ``max_iter``, ``max_nfev``, ``tol``, ``target``,
+            ``seed``, ``callback``, ``x0``, method-specific options).
+
+    Returns:
+        OptimizeResult.
+
+    Raises:
+        GHTError: unknown method name, or any error of the chosen optimizer.
+    """
+    key = str(method).lower().replace("-", "").replace("_", "")
+    key = {"differentialevolution": "de"}.get(key, key)
+    if key not in METHODS:
+        raise GHTError(f"method={method!r} is unknown; choose one of {', '.join(METHODS)}")
+    return METHODS[key](fun, bounds, **options)
