@@ -1,0 +1,506 @@
+r"""Development (unrolling) of developable ruled surfaces by quadrature along the rulings (spec 6).
+
+A ruled surface ``X(u, v) = a(u) + v g(u)`` with ``g = b - a``, ruling length ``L = |g|`` and unit
+ruling ``d = g / L`` is developable when its tangent plane is constant along each ruling. Then the
+orthonormal tangent frame ``(d, e)``, ``e = n × d``, ``n = a' × d / |a' × d|``, maps to a plane
+frame ``(D, D⊥)``, ``D = (cos φ, sin φ)``, ``D⊥ = (-sin φ, cos φ)``, and the development is the
+solution of three 1-D integrals:
+
+    φ(u) = ∫_0^u w,          w = d' · e                 (geodesic turning of the ruling)
+    A(u) = ∫_0^u (p D + q D⊥),  p = a' · d,  q = a' · e   (|A'| = |a'|, angle(A', D) = angle(a', d))
+    Y(u, v) = A(u) + v L(u) D(u)                          (flat image of X(u, v))
+
+so ``b(u) ↦ B(u) = A(u) + L(u) D(u)``. The integrands are smooth; they are represented on adaptive
+panels by Chebyshev interpolants of degree 24 (first-kind nodes) and integrated spectrally
+(Clenshaw–Curtis), panels being split until the trailing Chebyshev coefficients are below
+``1e-13`` of the pattern size, which gives positions to near machine precision — not the O(h²) of
+a triangle strip. The result is checked (not assumed): ruling lengths, boundary lengths (Romberg
+extrapolated chord sums), area (Green's theorem, Romberg) and the angles of the first fundamental
+form are compared with their 3-D values in :class:`ght_cad.flat_pattern.DistortionReport`.
+
+Non-ruled input (build123d / OCP faces) is handed to :mod:`ght_cad.cad.unroll_faces` (imported
+lazily: this module imports numpy and scipy only).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from .curve import gauss_legendre, integrate
+from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
+from .ruled import RuledSurface
+
+__all__ = [
+    "unroll",
+    "unroll_composite",
+    "RuledDevelopment",
+    "DEFAULT_TOL_DEG",
+]
+
+#: default developability tolerance on θ_max (degrees) above which unroll refuses a surface
+DEFAULT_TOL_DEG = 0.01
+
+_N = 24  # Chebyshev degree per panel
+_K = np.arange(_N + 1)
+_X = np.cos(np.pi * (_K + 0.5) / (_N + 1))  # first-kind nodes on [-1, 1]
+_V = np.polynomial.chebyshev.chebvander(_X, _N)  # (N+1, N+1)
+_VI = np.polynomial.chebyshev.chebvander(_X, _N + 1)  # for evaluating integrated series at nodes
+
+
+def _coefficients(f: np.ndarray) -> np.ndarray:
+    """Chebyshev coefficients of samples ``f`` (P, N+1, m) at the first-kind nodes."""
+    c = (2.0 / (_N + 1)) * np.einsum("kj,pkm->pjm", _V, f)
+    c[:, 0, :] *= 0.5
+    return c
+
+
+def _clenshaw(c: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Σ_j c[i, j, :] T_j(x[i]) for per-point coefficient rows c (n, deg+1, m)."""
+    b1 = np.zeros((c.shape[0], c.shape[2]))
+    b2 = np.zeros_like(b1)
+    x2 = 2.0 * x[:, None]
+    for j in range(c.shape[1] - 1, 0, -1):
+        b1, b2 = c[:, j, :] + x2 * b1 - b2, b1
+    return c[:, 0, :] + x[:, None] * b1 - b2
+
+
+class _PanelSeries:
+    """Piecewise Chebyshev series on panels ``edges`` (indefinite integrals or plain values)."""
+
+    def __init__(self, edges: np.ndarray, coefs: np.ndarray, offsets: np.ndarray | None = None) -> None:
+        self.edges = edges
+        self.coefs = coefs  # (P, deg+1, m)
+        self.offsets = offsets  # (P, m) value at each panel's left end (integrals) or None
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        u = np.asarray(u, dtype=float)
+        idx = np.clip(np.searchsorted(self.edges, u, side="right") - 1, 0, self.edges.size - 2)
+        lo, hi = self.edges[idx], self.edges[idx + 1]
+        x = np.clip((2.0 * u - lo - hi) / (hi - lo), -1.0, 1.0)
+        out = np.empty((u.size, self.coefs.shape[2]))
+        step = 8192
+        for s in range(0, u.size, step):
+            sl = slice(s, s + step)
+            out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
+        if self.offsets is not None:
+            out += self.offsets[idx]
+        return out
+
+
+def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
+    """Ruling frame quantities at ``u``: L, L', d, e, n, p = a'·d, q = a'·e, w = d'·e, normal part."""
+    a1 = surface.a(u, 1)
+    g = surface.ruling(u)
+    g1 = surface.ruling(u, 1)
+    L = np.linalg.norm(g, axis=1)
+    if not np.all(L > 0):
+        i = int(np.argmin(L))
+        raise DegenerateGeometryError(
+            f"ruling length |b(u) - a(u)| = {L[i]:.3g} at u={u[i]:.6g}: the rulings must have positive length"
+        )
+    d = g / L[:, None]
+    L1 = np.einsum("ij,ij->i", d, g1)
+    d1 = (g1 - d * L1[:, None]) / L[:, None]
+    c = np.cross(a1, d)
+    cn = np.linalg.norm(c, axis=1)
+    scale = np.linalg.norm(a1, axis=1)
+    if not np.all(cn > 1e-12 * np.maximum(scale, 1e-300)):
+        i = int(np.argmin(cn / np.maximum(scale, 1e-300)))
+        raise DegenerateGeometryError(
+            f"the directrix is tangent to the ruling (|a' x d| = {cn[i]:.3g}) at u={u[i]:.6g}; "
+            "a' must be transversal to the rulings"
+        )
+    n = c / cn[:, None]
+    e = np.cross(n, d)
+    return {
+        "L": L,
+        "L1": L1,
+        "d": d,
+        "e": e,
+        "n": n,
+        "p": np.einsum("ij,ij->i", a1, d),
+        "q": np.einsum("ij,ij->i", a1, e),
+        "w": np.einsum("ij,ij->i", d1, e),
+        "wn": np.einsum("ij,ij->i", d1, n),
+    }
+
+
+class RuledDevelopment:
+    r"""The development map ``Y(u, v) = A(u) + v L(u) D(u)`` of a ruled surface (see module doc).
+
+    Args:
+        surface: the ruled surface; its parameter domain is u ∈ [0, 1].
+        breakpoints: parameters in (0, 1) where a, b are not smooth (B-spline knots); panels
+            start there.
+        tol: relative tolerance of the spectral integration (w.r.t. the pattern size).
+        max_panels: cap on the number of Chebyshev panels.
+
+    Raises:
+        DegenerateGeometryError: zero-length rulings or a directrix tangent to a ruling.
+    """
+
+    def __init__(
+        self,
+        surface: RuledSurface,
+        *,
+        breakpoints: Sequence[float] = (),
+        tol: float = 1e-13,
+        max_panels: int = 2048,
+    ) -> None:
+        self.surface = surface
+        bp = np.asarray([b for b in breakpoints if 1e-12 < b < 1 - 1e-12], dtype=float)
+        edges = np.unique(np.concatenate([np.linspace(0.0, 1.0, 5), bp]))
+        for _ in range(40):
+            P = edges.size - 1
+            lo, hi = edges[:-1], edges[1:]
+            h = 0.5 * (hi - lo)
+            uu = (0.5 * (lo + hi))[:, None] + h[:, None] * _X[None, :]
+            fr = _frame(surface, uu.ravel())
+            stage1 = np.stack([fr["w"], fr["p"], fr["q"]], axis=-1).reshape(P, _N + 1, 3)
+            c1 = _coefficients(stage1)
+            # φ at the nodes: integrate w spectrally, panel offsets by cumulative sums
+            cw = np.polynomial.chebyshev.chebint(c1[:, :, :1] * h[:, None, None], lbnd=-1, axis=1)
+            tot_w = np.einsum("pjm,j->pm", cw, np.ones(_N + 2))  # value at x = +1 (T_j(1) = 1)
+            off_w = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1]
+            phi = np.einsum("kj,pjm->pkm", _VI, cw)[:, :, 0] + off_w[:, None]
+            D = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
+            Dp = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
+            Ap = stage1[:, :, 1:2] * D + stage1[:, :, 2:3] * Dp
+            c2 = _coefficients(Ap)
+            size = float(np.sum(np.abs(c1[:, 0, 1:]).max(axis=1) * 2 * h)) + float(fr["L"].max())
+            tail1 = np.abs(c1[:, -3:, :]).max(axis=1)  # (P, 3)
+            tail2 = np.abs(c2[:, -3:, :]).max(axis=(1, 2))
+            err = np.maximum(tail1[:, 0] * float(fr["L"].max()), np.maximum(tail1[:, 1:].max(axis=1), tail2)) * 2 * h
+            bad = err > tol * size
+            if not bad.any() or P >= max_panels:
+                break
+            mids = 0.5 * (lo[bad] + hi[bad])
+            edges = np.unique(np.concatenate([edges, mids]))
+        self.edges = edges
+        self.panels = edges.size - 1
+        self.quadrature_error_estimate = float(err.max() / size) if size > 0 else 0.0
+        self.normal_turning_max = float(np.max(np.abs(fr["wn"]) * fr["L"]))
+        cA = np.polynomial.chebyshev.chebint(c2 * h[:, None, None], lbnd=-1, axis=1)
+        totA = np.einsum("pjm,j->pm", cA, np.ones(_N + 2))
+        offA = np.concatenate([np.zeros((1, 2)), np.cumsum(totA, axis=0)])[:-1]
+        offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
+        self._phi = _PanelSeries(edges, cw, offw)
+        self._A = _PanelSeries(edges, cA, offA)
+        self._Ap = _PanelSeries(edges, c2)
+        # rigid placement: a-edge chord along +x, bounding box at the origin (applied in .map)
+        self._R = np.eye(2)
+        self._t = np.zeros(2)
+        A01 = self._raw_A(np.array([0.0, 1.0]))
+        chord = A01[1] - A01[0]
+        if np.linalg.norm(chord) > 1e-9 * max(size, 1e-300):
+            ang = -math.atan2(chord[1], chord[0])
+        else:
+            ang = math.pi / 2 - float(self._phi(np.array([0.0]))[0, 0])
+        ca, sa = math.cos(ang), math.sin(ang)
+        self._R = np.array([[ca, -sa], [sa, ca]])
+        uu = np.linspace(0, 1, 257)
+        pts = np.concatenate([self.map(uu, np.zeros_like(uu)), self.map(uu, np.ones_like(uu))])
+        self._t = -pts.min(axis=0)
+
+    # -- raw (unplaced) series ---------------------------------------------------------
+    def _raw_A(self, u: np.ndarray) -> np.ndarray:
+        return self._A(u)
+
+    def phi(self, u: Any) -> np.ndarray:
+        """Direction angle φ(u) of the flat ruling (after placement), radians."""
+        uu = np.atleast_1d(np.asarray(u, dtype=float))
+        return self._phi(uu)[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
+
+    def ruling_direction(self, u: Any) -> np.ndarray:
+        """Unit flat ruling direction ``D(u)``, shape (n, 2)."""
+        ph = self.phi(u)
+        return np.stack([np.cos(ph), np.sin(ph)], axis=-1)
+
+    def directrix(self, u: Any) -> np.ndarray:
+        """Flat image ``A(u)`` of the directrix, shape (n, 2)."""
+        uu = np.atleast_1d(np.asarray(u, dtype=float))
+        return self._A(uu) @ self._R.T + self._t
+
+    def map(self, u: Any, v: Any) -> np.ndarray:
+        """Flat image ``Y(u, v) = A(u) + v L(u) D(u)`` of ``X(u, v)``; u, v broadcast, shape (n, 2)."""
+        uu, vv = np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
+        L = self.surface.ruling_lengths(uu)
+        return self.directrix(uu) + (vv * L)[:, None] * self.ruling_direction(uu)
+
+    def map_points(self, u: Any, points: np.ndarray) -> np.ndarray:
+        """Flat image of 3-D points lying on the rulings at ``u`` (projected onto the ruling)."""
+        uu = np.atleast_1d(np.asarray(u, float))
+        a = self.surface.a(uu)
+        g = self.surface.ruling(uu)
+        s = np.einsum("ij,ij->i", np.asarray(points, float) - a, g) / np.einsum("ij,ij->i", g, g)
+        return self.map(uu, s)
+
+
+def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> list[BoundaryEdge]:
+    """The four boundary edges a(u), ruling u=1, b(u) reversed, ruling u=0 (counter-clockwise)."""
+
+    def curve_len(which: str) -> float:
+        f = (lambda t: np.linalg.norm(surface.a(t, 1), axis=1)) if which == "a" else (
+            lambda t: np.linalg.norm(surface.b(t, 1), axis=1)
+        )
+        return integrate(f, 0.0, 1.0, rtol=1e-14)
+
+    def edge(name: str, uv: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], length: float) -> BoundaryEdge:
+        def flat(t: np.ndarray) -> np.ndarray:
+            u, v = uv(t)
+            return dev.map(u, v)
+
+        def xyz(t: np.ndarray) -> np.ndarray:
+            u, v = uv(t)
+            return surface.evaluate(u, v)
+
+        return BoundaryEdge(name=name, flat_fn=flat, xyz_fn=xyz, length_3d=length, samples=samples)
+
+    La = curve_len("a")
+    Lb = curve_len("b")
+    g0, g1 = surface.ruling_lengths(np.array([0.0, 1.0]))
+    return [
+        edge("a", lambda t: (t, np.zeros_like(t)), La),
+        edge("ruling u=1", lambda t: (np.ones_like(t), t), float(g1)),
+        edge("b", lambda t: (1.0 - t, np.ones_like(t)), Lb),
+        edge("ruling u=0", lambda t: (np.zeros_like(t), 1.0 - t), float(g0)),
+    ]
+
+
+def ruled_area(surface: RuledSurface, rtol: float = 1e-14) -> float:
+    """3-D area ``∫_0^1 ∫_0^1 |(a' + v g') × g| dv du`` (Gauss–Legendre in v, adaptive in u)."""
+    tv, wv = gauss_legendre(16)
+
+    def f(u: np.ndarray) -> np.ndarray:
+        a1 = surface.a(u, 1)
+        g = surface.ruling(u)
+        g1 = surface.ruling(u, 1)
+        xu = a1[:, None, :] + tv[None, :, None] * g1[:, None, :]
+        return np.linalg.norm(np.cross(xu, g[:, None, :]), axis=2) @ wv
+
+    return integrate(f, 0.0, 1.0, rtol=rtol)
+
+
+def _metric_samples(surface: RuledSurface, dev: RuledDevelopment, n: int = 24) -> dict[str, np.ndarray]:
+    """First-fundamental-form check on an n × 5 grid: angles between X_u, X_v vs Y_u, Y_v.
+
+    Flat partials by a 5-point central difference of the development map (step 1e-3 · panel
+    width, O(h⁴)), independent of the construction; 3-D partials analytic.
+    """
+    u = np.linspace(0.02, 0.98, n)
+    v = np.linspace(0.0, 1.0, 5)
+    U, Vv = np.meshgrid(u, v, indexing="ij")
+    U, Vv = U.ravel(), Vv.ravel()
+    xu, xv = surface.partials(U, Vv)
+    h = 1e-3
+
+    def fd(fun: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        return (-fun(2 * h) + 8 * fun(h) - 8 * fun(-h) + fun(-2 * h)) / (12 * h)
+
+    yu = fd(lambda s: dev.map(U + s, Vv))
+    yv = fd(lambda s: dev.map(U, Vv + s))
+
+    def ang3(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        return np.arctan2(np.linalg.norm(np.cross(p, q), axis=1), np.einsum("ij,ij->i", p, q))
+
+    def ang2(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        return np.arctan2(np.abs(p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]), np.einsum("ij,ij->i", p, q))
+
+    return {
+        "angle_3d": ang3(xu, xv),
+        "angle_flat": ang2(yu, yv),
+        "xu_len": np.linalg.norm(xu, axis=1),
+        "yu_len": np.linalg.norm(yu, axis=1),
+    }
+
+
+def _check_developable(surface: RuledSurface, tol_deg: float, best_effort: bool, what: str) -> Any:
+    dev = surface.developability()
+    if not (dev.theta_max <= tol_deg) and not best_effort:
+        raise NotDevelopableError(
+            f"{what} is not developable within tol_deg={tol_deg:g}: theta_max={dev.theta_max:.6g} deg, "
+            f"theta_rms={dev.theta_rms:.6g} deg, developability degree DD={dev.dd:.12f} (1 = developable), "
+            f"R={dev.R:.3g}; pass best_effort=True to flatten it anyway with a distortion report"
+        )
+    return dev
+
+
+def unroll_ruled(
+    surface: RuledSurface,
+    *,
+    best_effort: bool = False,
+    tol_deg: float = DEFAULT_TOL_DEG,
+    rulings: int = 16,
+    samples: int = 257,
+    units: str = "mm",
+    label: str = "P1",
+    breakpoints: Sequence[float] = (),
+) -> FlatPattern:
+    """Unroll a :class:`~ght_cad.ruled.RuledSurface` (see :func:`unroll`)."""
+    dd = _check_developable(surface, tol_deg, best_effort, f"surface {label!r}")
+    dev = RuledDevelopment(surface, breakpoints=breakpoints)
+    edges = _ruled_edges(surface, dev, samples)
+    ur = (np.arange(1, rulings + 1) / (rulings + 1)) if rulings > 0 else np.zeros(0)
+    p0 = dev.map(ur, np.zeros_like(ur))
+    p1 = dev.map(ur, np.ones_like(ur))
+    bends = np.stack([p0, p1], axis=1) if ur.size else np.zeros((0, 2, 2))
+    uu = np.linspace(0.0, 1.0, 129)
+    ruling_3d = surface.ruling_lengths(uu)
+    ruling_flat = np.linalg.norm(dev.map(uu, np.ones_like(uu)) - dev.map(uu, np.zeros_like(uu)), axis=1)
+    metric = _metric_samples(surface, dev)
+    panel = FlatPanel(
+        label=label,
+        loops=[edges],
+        bend_lines=bends,
+        ruling_lengths_3d=ruling_3d,
+        ruling_lengths_flat=ruling_flat,
+        area_3d=ruled_area(surface),
+        metric=metric,
+        info={
+            "method": "quadrature along rulings (adaptive Chebyshev/Clenshaw-Curtis panels)",
+            "panels": dev.panels,
+            "quadrature_error_estimate": dev.quadrature_error_estimate,
+            "developability": dd.as_dict(),
+            "best_effort": bool(best_effort),
+        },
+        development=dev,
+    )
+    measure_panel(panel)
+    return FlatPattern([panel], units=units)
+
+
+def unroll(
+    surface_or_face: Any,
+    *,
+    best_effort: bool = False,
+    tol_deg: float = DEFAULT_TOL_DEG,
+    rulings: int = 16,
+    samples: int = 257,
+    units: str = "mm",
+    label: str = "P1",
+) -> FlatPattern:
+    r"""Unroll a developable surface or face into a flat pattern (spec section 6).
+
+    For a :class:`~ght_cad.ruled.RuledSurface` the development is computed by quadrature along the
+    rulings: ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥``, ``Y(u, v) = A(u) + v |g(u)| D(u)``
+    (adaptive Chebyshev panels, near machine precision). Anything else (a build123d/cadquery
+    ``Face`` or an OCP ``TopoDS_Face``: cylinder, cone, plane, surface of extrusion, B-spline or
+    Bézier ruled face) goes to :func:`ght_cad.cad.unroll_faces.unroll_face`, which keeps holes and
+    trimmed boundaries.
+
+    Args:
+        surface_or_face: a RuledSurface, a face, or a list of them (then see
+            :func:`unroll_composite`).
+        best_effort: flatten a surface that is not developable within ``tol_deg`` anyway; its
+            distortion is in ``.report``.
+        tol_deg: largest accepted ``θ_max`` (degrees) of the developability degree (spec 5).
+        rulings: number of interior rulings drawn as bend lines.
+        samples: points per boundary edge in the outline polylines.
+        units: length unit of the coordinates ("mm", "cm", "m", "in", "ft"); DXF $INSUNITS.
+        label: panel label.
+
+    Returns:
+        FlatPattern with ``.errors``, ``.report``, ``.export_dxf``, ``.export_svg``, ``.plot_png``.
+
+    Raises:
+        NotDevelopableError: θ_max > tol_deg (message gives θ_max, θ_rms, DD) and not best_effort.
+        GHTError: unsupported input or bad arguments.
+    """
+    if isinstance(surface_or_face, (list, tuple)):
+        return unroll_composite(
+            surface_or_face, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units
+        )
+    _check_args(tol_deg, rulings, samples, units)
+    if isinstance(surface_or_face, RuledSurface):
+        return unroll_ruled(
+            surface_or_face,
+            best_effort=best_effort,
+            tol_deg=tol_deg,
+            rulings=rulings,
+            samples=samples,
+            units=units,
+            label=label,
+            breakpoints=getattr(surface_or_face, "breakpoints", ()),
+        )
+    if hasattr(surface_or_face, "wrapped") or type(surface_or_face).__module__.startswith("OCP"):
+        from .cad.unroll_faces import unroll_face
+
+        return unroll_face(
+            surface_or_face,
+            best_effort=best_effort,
+            tol_deg=tol_deg,
+            rulings=rulings,
+            samples=samples,
+            units=units,
+            label=label,
+        )
+    raise GHTError(
+        f"cannot unroll a {type(surface_or_face).__name__}; allowed: a ght_cad RuledSurface, a "
+        "build123d/cadquery Face or an OCP TopoDS_Face, or a list of them"
+    )
+
+
+_UNITS = ("mm", "cm", "m", "in", "ft", "unitless")
+
+
+def _check_args(tol_deg: float, rulings: int, samples: int, units: str) -> None:
+    if not (isinstance(tol_deg, (int, float)) and math.isfinite(tol_deg) and tol_deg > 0):
+        raise GHTError(f"tol_deg={tol_deg!r} is not allowed; it must be a finite angle > 0 in degrees")
+    if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or rulings < 0:
+        raise GHTError(f"rulings={rulings!r} is not allowed; it must be an integer >= 0")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 9:
+        raise GHTError(f"samples={samples!r} is not allowed; it must be an integer >= 9")
+    if units not in _UNITS:
+        raise GHTError(f"units={units!r} is not allowed; allowed units are {_UNITS}")
+
+
+def unroll_composite(
+    parts: Sequence[Any],
+    *,
+    best_effort: bool = False,
+    tol_deg: float = DEFAULT_TOL_DEG,
+    rulings: int = 16,
+    samples: int = 257,
+    units: str = "mm",
+    labels: Sequence[str] | None = None,
+    gap: float | None = None,
+) -> FlatPattern:
+    """Unroll several surfaces/faces into one pattern: one labelled panel per face.
+
+    Panels are laid side by side along +x (``gap`` between bounding boxes, default 5% of the
+    largest panel). Boundary edges shared in 3-D by two panels (same points within 1e-6 of the
+    model size, either direction) get matching edge marks: a label ``E<k>`` on both panels and
+    ticks at the same 3-D arc-length fractions 1/4, 1/2, 3/4.
+
+    Args:
+        parts: RuledSurfaces and/or faces.
+        labels: panel labels (default P1, P2, ...).
+        gap: spacing between panels in model units.
+        best_effort, tol_deg, rulings, samples, units: as in :func:`unroll`.
+
+    Returns:
+        FlatPattern with one panel per part; ``.report`` aggregates all panels.
+
+    Raises:
+        GHTError: an empty list or a label count that does not match.
+    """
+    parts = list(parts)
+    if not parts:
+        raise GHTError("parts is empty; unroll_composite needs at least one surface or face")
+    if labels is None:
+        labels = [f"P{i + 1}" for i in range(len(parts))]
+    if len(labels) != len(parts):
+        raise GHTError(f"{len(labels)} labels given for {len(parts)} parts; give one label per part")
+    panels: list[FlatPanel] = []
+    for part, lab in zip(parts, labels):
+        pat = unroll(part, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units, label=lab)
+        panels.extend(pat.panels)
+    from .flat_pattern import layout_panels, mark_shared_edges
+
+    mark_shared_edges(panels)
+    layout_panels(panels, gap)
+    return FlatPattern(panels, units=units)
