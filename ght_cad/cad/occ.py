@@ -5,8 +5,9 @@ Shared by every build123d/cadquery adapter. OCCT arrays are 1-based; static meth
 
 from __future__ import annotations
 
+import contextlib
 import os
-from typing import Any, Iterable
+from typing import Any, Iterable, Iterator
 
 import numpy as np
 from OCP.BRep import BRep_Builder
@@ -15,6 +16,7 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.Geom import Geom_BSplineCurve, Geom_BSplineSurface
 from OCP.gp import gp_Pnt
 from OCP.IFSelect import IFSelect_RetDone
+from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
@@ -33,7 +35,26 @@ __all__ = [
     "write_step",
     "read_step",
     "unwrap",
+    "quiet_occt",
 ]
+
+
+@contextlib.contextmanager
+def quiet_occt() -> Iterator[None]:
+    """Silence OCCT's console messages (e.g. the STEP transfer statistics) inside the block.
+
+    Raises the trace level of every printer of ``Message::DefaultMessenger()`` to ``Message_Fail``
+    and restores the previous levels afterwards (also on error). Failures still print.
+    """
+    printers = list(Message.DefaultMessenger_s().Printers())
+    saved = [p.GetTraceLevel() for p in printers]
+    try:
+        for p in printers:
+            p.SetTraceLevel(Message_Gravity.Message_Fail)
+        yield
+    finally:
+        for p, level in zip(printers, saved):
+            p.SetTraceLevel(level)
 
 
 def unwrap(shape: Any) -> TopoDS_Shape:
@@ -137,18 +158,20 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True) -> s
         for s in raw:
             bb.Add(comp, s)
         shape = comp
-    writer = STEPControl_Writer()
-    writer.Transfer(shape, STEPControl_AsIs)
-    with atomic_path(path) as tmp:
-        if writer.Write(str(tmp)) != IFSelect_RetDone:
-            raise GHTError(f"OCCT failed to write STEP file {path}")
+    with quiet_occt():
+        writer = STEPControl_Writer()
+        writer.Transfer(shape, STEPControl_AsIs)
+        with atomic_path(path) as tmp:
+            if writer.Write(str(tmp)) != IFSelect_RetDone:
+                raise GHTError(f"OCCT failed to write STEP file {path}")
     return str(path)
 
 
 def read_step(path: str | os.PathLike) -> TopoDS_Shape:
     """Read a STEP file into one OCP shape."""
-    reader = STEPControl_Reader()
-    if reader.ReadFile(str(path)) != IFSelect_RetDone:
-        raise GHTError(f"could not read STEP file {path}")
-    reader.TransferRoots()
-    return reader.OneShape()
+    with quiet_occt():
+        reader = STEPControl_Reader()
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise GHTError(f"could not read STEP file {path}")
+        reader.TransferRoots()
+        return reader.OneShape()

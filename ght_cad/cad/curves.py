@@ -1,0 +1,263 @@
+r"""build123d adapters: GHT-Bézier curves, composite curves and patches as Edges, Wires and Faces.
+
+Every shape holds a *certified* B-spline (:func:`ght_cad.bspline.curve_to_bspline`,
+:meth:`ght_cad.patch.GHTSurface.to_bspline`): maximum deviation from the exact GHT geometry at
+matched parameters below ``tol`` (default ``1e-7 ×`` bounding-box diagonal), parametrization kept
+(the edge's parameter is the curve's t ∈ [0, 1]) and end derivatives up to order
+``min(3, degree-1)`` exact, so G2/G3 joints stay G2/G3 in the B-rep. The conversion record is
+attached as ``shape.ght_bspline``.
+
+Algebra mode: :func:`ght_edge`, :func:`ght_wire`, :func:`ght_face` return plain build123d shapes.
+Builder mode: :class:`GHTBezierLine` (an Edge) and :class:`GHTCompositeLine` (a Wire) add
+themselves to the active ``BuildLine`` like build123d's own ``Bezier``/``Spline``, so they work
+inside ``BuildSketch``/``BuildPart`` too. cadquery shapes share the same OCP objects:
+``cadquery.Edge(edge.wrapped)`` / ``build123d.Edge(cq_edge.wrapped)`` wrap, never copy.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+from build123d import Edge, Face, Mode, Vector, Wire
+from build123d.objects_curve import BaseEdgeObject, BaseLineObject
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_MakeWire
+from OCP.gp import gp_Pnt
+
+from ..bspline import BSplineCurveData, curve_to_bspline
+from ..curve import GHTCurve
+from ..errors import GHTError
+from ..patch import GHTSurface
+from .occ import geom_bspline_curve, make_face
+
+__all__ = [
+    "ght_edge",
+    "ght_wire",
+    "ght_face",
+    "segments_of",
+    "GHTBezierLine",
+    "GHTCompositeLine",
+]
+
+
+def _as_curve(curve: Any) -> GHTCurve:
+    if isinstance(curve, GHTCurve):
+        if curve.dim not in (2, 3):
+            raise GHTError(f"a CAD edge needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
+        return curve
+    raise GHTError(f"expected a GHTCurve, got {type(curve).__name__}")
+
+
+def segments_of(curves: Any) -> tuple[list[GHTCurve], bool | None]:
+    """``(segments, closed)`` of a CompositeCurve (``.segments``, ``.closed``), a GHTCurve or a list.
+
+    ``closed`` is the composite's own flag, or ``None`` when not known (then decided by geometry).
+    """
+    if isinstance(curves, GHTCurve):
+        return [curves], None
+    segs = getattr(curves, "segments", None)
+    closed = getattr(curves, "closed", None)
+    if segs is None:
+        segs = curves
+    try:
+        segs = list(segs)
+    except TypeError:
+        raise GHTError(
+            f"expected a GHTCurve, a CompositeCurve or a sequence of GHTCurves; got {type(curves).__name__}"
+        ) from None
+    if not segs:
+        raise GHTError("no segments: a wire needs at least one GHT curve")
+    return [_as_curve(s) for s in segs], (None if closed is None else bool(closed))
+
+
+def _xyz(p: np.ndarray) -> np.ndarray:
+    q = np.zeros(3)
+    q[: p.size] = p
+    return q
+
+
+def ght_edge(curve: GHTCurve, tol: float | None = None, degree: int = 5) -> Edge:
+    r"""build123d ``Edge`` on the certified B-spline of a GHT curve (2-D curves lie in z = 0).
+
+    ``|P(t) - C(t)| <= tol`` for all t (default tol = 1e-7 × bounding-box diagonal), the edge's
+    parameter equals t, ``C^(r) = P^(r)`` at both ends for r <= min(3, degree-1).
+
+    Args:
+        curve: the GHT-Bézier curve (dimension 2 or 3).
+        tol: maximum deviation.
+        degree: B-spline degree.
+
+    Returns:
+        ``Edge`` with the conversion record in ``edge.ght_bspline`` (a BSplineCurveData).
+
+    Raises:
+        GHTError: not a 2-D/3-D GHTCurve, bad tol; ConversionError: unreachable tol.
+    """
+    data = curve_to_bspline(_as_curve(curve), tol, degree)
+    edge = Edge(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge())
+    edge.ght_bspline = data
+    return edge
+
+
+def _wire_edges(curves: Any, tol: float | None, degree: int, closed: bool | None) -> tuple[Any, list[BSplineCurveData]]:
+    segs, flag = segments_of(curves)
+    if closed is None:
+        closed = flag
+    starts = np.array([_xyz(s.evaluate(0.0)) for s in segs])
+    ends = np.array([_xyz(s.evaluate(1.0)) for s in segs])
+    allpts = np.vstack([np.vstack([s.control_points for s in segs]).min(axis=0), np.vstack([s.control_points for s in segs]).max(axis=0)])
+    diag = float(np.linalg.norm(allpts[1] - allpts[0])) or 1.0
+    gap_tol = 1e-9 * diag
+    for i in range(len(segs) - 1):
+        gap = float(np.linalg.norm(ends[i] - starts[i + 1]))
+        if gap > gap_tol:
+            raise GHTError(
+                f"segment {i} ends at {ends[i].tolist()} but segment {i+1} starts at "
+                f"{starts[i+1].tolist()} (gap {gap:.3g} > {gap_tol:.3g}): join them with C0 or better"
+            )
+    closing_gap = float(np.linalg.norm(ends[-1] - starts[0]))
+    if closed is None:
+        closed = len(segs) > 1 and closing_gap <= gap_tol
+    if closed and closing_gap > gap_tol:
+        raise GHTError(f"the chain is not closed: last end and first start differ by {closing_gap:.3g}")
+    # shared vertices: joint i sits between segment i-1 and segment i
+    nodes = [starts[0]] + [0.5 * (ends[i] + starts[i + 1]) for i in range(len(segs) - 1)]
+    nodes.append(starts[0] if closed else ends[-1])
+    verts = [BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex() for p in nodes[:-1]]
+    verts.append(verts[0] if closed else BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, nodes[-1]))).Vertex())
+    mk = BRepBuilderAPI_MakeWire()
+    datas = []
+    for i, seg in enumerate(segs):
+        data = curve_to_bspline(seg, tol, degree)
+        datas.append(data)
+        me = BRepBuilderAPI_MakeEdge(geom_bspline_curve(data), verts[i], verts[i + 1])
+        if not me.IsDone():
+            raise GHTError(f"OCCT could not build the edge of segment {i} (error {me.Error()})")
+        mk.Add(me.Edge())
+        if not mk.IsDone():
+            raise GHTError(f"OCCT could not add segment {i} to the wire (error {mk.Error()})")
+    return mk.Wire(), datas
+
+
+def ght_wire(
+    curves: Any, tol: float | None = None, degree: int = 5, *, closed: bool | None = None
+) -> Wire:
+    r"""build123d ``Wire`` from a chain of GHT segments (a CompositeCurve or a list of GHTCurves).
+
+    One certified B-spline edge per segment (see :func:`ght_edge`); consecutive edges share one
+    vertex, the joint ``P_A(1) = P_B(0)`` (checked to 1e-9 × the chain's size). Because every
+    edge keeps its curve's end derivatives up to order ``min(3, degree-1)``, the continuity of
+    each joint (C1..C3/G1..G3) carries over to the B-rep.
+
+    Args:
+        curves: ``CompositeCurve`` (uses ``.segments`` and ``.closed``), GHTCurve or sequence.
+        tol: maximum deviation per segment (default 1e-7 × each segment's box diagonal).
+        degree: B-spline degree.
+        closed: force closed/open; default: the composite's flag, else closed when the last end
+            meets the first start.
+
+    Returns:
+        ``Wire`` with ``wire.ght_bspline`` = list of BSplineCurveData.
+
+    Raises:
+        GHTError: gaps between segments, a requested closure that does not close, bad input.
+    """
+    w, datas = _wire_edges(curves, tol, degree, closed)
+    wire = Wire(w)
+    wire.ght_bspline = datas
+    return wire
+
+
+def ght_face(patch: GHTSurface, tol: float | None = None, degree: int = 5) -> Face:
+    r"""build123d ``Face`` on the certified B-spline surface of a GHT patch.
+
+    ``|S(u,v) - S~(u,v)| <= tol`` (default 1e-7 × bounding-box diagonal; see
+    :meth:`ght_cad.patch.GHTSurface.to_bspline` for the bound).
+
+    Returns:
+        ``Face`` with ``face.ght_bspline`` = the BSplineSurfaceData.
+    """
+    if not isinstance(patch, GHTSurface):
+        raise GHTError(f"expected a GHTSurface, got {type(patch).__name__}")
+    if patch.dim != 3:
+        raise GHTError(f"a CAD face needs a 3-D patch; this patch has dim={patch.dim}")
+    data = patch.to_bspline(tol, degree)
+    face = make_face(data)
+    face.ght_bspline = data
+    return face
+
+
+def _points(pts: Sequence[Any]) -> np.ndarray:
+    flat: list[Any] = []
+    for p in pts:
+        if isinstance(p, (list, tuple)) and p and isinstance(p[0], (list, tuple, Vector, np.ndarray)):
+            flat.extend(p)
+        elif isinstance(p, np.ndarray) and p.ndim == 2:
+            flat.extend(list(p))
+        else:
+            flat.append(p)
+    return np.array([tuple(Vector(*p) if not isinstance(p, Vector) else p) for p in flat], dtype=float)
+
+
+class GHTBezierLine(BaseEdgeObject):
+    r"""Line object: a GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i`` as one certified edge.
+
+    Use inside ``BuildLine`` (and hence ``BuildSketch``/``BuildPart``) like build123d's
+    ``Bezier``; outside a builder it is simply an ``Edge``.
+
+    Args:
+        *control_points: three or more points (VectorLike, or one sequence of them), or a single
+            :class:`~ght_cad.curve.GHTCurve` (then mu, nu, gamma are ignored).
+        mu, nu, gamma: shape parameters in [-1, 1].
+        tol: maximum deviation of the B-spline (default 1e-7 × bounding-box diagonal).
+        degree: B-spline degree.
+        mode: combination mode.
+
+    Attributes:
+        ght_curve: the exact GHTCurve; ght_bspline: its BSplineCurveData.
+    """
+
+    _applies_to = BaseEdgeObject._applies_to
+
+    def __init__(
+        self,
+        *control_points: Any,
+        mu: float = 0.0,
+        nu: float = 0.0,
+        gamma: float = 0.0,
+        tol: float | None = None,
+        degree: int = 5,
+        mode: Mode = Mode.ADD,
+    ) -> None:
+        if len(control_points) == 1 and isinstance(control_points[0], GHTCurve):
+            curve = control_points[0]
+        else:
+            curve = GHTCurve(_points(control_points), mu, nu, gamma)
+        edge = ght_edge(curve, tol, degree)
+        super().__init__(edge, mode=mode)
+        self.ght_curve = curve
+        self.ght_bspline = edge.ght_bspline
+
+
+class GHTCompositeLine(BaseLineObject):
+    r"""Line object: a chain of GHT segments (CompositeCurve or list of GHTCurves) as one Wire.
+
+    Use inside ``BuildLine``; ``BuildSketch``'s ``make_face()`` turns a closed chain into a face.
+    See :func:`ght_wire` for the arguments.
+    """
+
+    _applies_to = BaseLineObject._applies_to
+
+    def __init__(
+        self,
+        curves: Any,
+        tol: float | None = None,
+        degree: int = 5,
+        *,
+        closed: bool | None = None,
+        mode: Mode = Mode.ADD,
+    ) -> None:
+        wire = ght_wire(curves, tol, degree, closed=closed)
+        super().__init__(wire, mode=mode)
+        self.ght_bspline = wire.ght_bspline
+
