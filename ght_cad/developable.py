@@ -1,0 +1,1088 @@
+r"""Developable surfaces from GHT curves (spec section 5): planes (duality), spines, geodesics.
+
+* :class:`EnvelopeDevelopable` (5.2): the envelope of the one-parameter family of planes
+  ``U(t) = Σ b_{i,m}(t) U_i`` (the *dual curve*, a 4-D :class:`~ght_cad.curve.GHTCurve`).
+  Ruling ``U ∩ U'``, edge of regression ``U ∩ U' ∩ U''``, boundary curves
+  ``a(t) = U ∩ U' ∩ E_a`` and ``b(t) = U ∩ U' ∩ E_b`` (pairing kept), surface
+  ``X(t, v) = (1-v) a(t) + v b(t)``. Derivatives of ``a, b`` are analytic: the meet
+  (:func:`ght_cad.planes.meet`) is trilinear, so with ``X = meet(U, U', E)``
+  ``X' = meet(U, U'', E)``, ``X'' = meet(U', U'', E) + meet(U, U''', E)`` and the Cartesian point
+  ``x = (X1, X2, X3)/X0`` follows by the quotient rule.
+* :class:`TangentDevelopable` (5.3): ``X(t, v) = C(t) + v T(t)``, trimmed to ``v ∈ [v0, v1]`` not
+  containing 0 (C is the edge of regression).
+* :class:`RectifyingDevelopable` (5.4): ``X(t, v) = C(t) + v D(t)``,
+  ``D = (τT + κB)/sqrt(κ² + τ²)``; C is a geodesic of it.
+* :class:`CanalSurface` (5.5): envelope of spheres ``(C(t), r(t))``; developable only as a cone or
+  cylinder of revolution, otherwise only its (sampled Gaussian-curvature) report is given.
+* Joins (5.6): :func:`join_developable` applies :func:`ght_cad.continuity.join` to the 4-D dual
+  curves; :func:`measure_developable_joint` measures the achieved order independently (projective
+  contact of the dual curves, i.e. common tangent plane, ruling, edge-of-regression point ...);
+  :class:`CompositeDevelopable` chains segments that share their joint rulings.
+
+All surfaces are parametrized on ``(u, v) ∈ [0, 1]²`` (``u`` is the surface parameter; with a
+``t_range`` the dual-curve parameter is ``t = t0 + u (t1 - t0)``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from math import comb
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ._validate import as_parameter_array, check_finite_array
+from .basis import bernstein
+from .curve import GHTCurve
+from .errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
+from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, normalize_planes
+from .ruled import Developability, RuledSurface
+from .seeds import GHTSeed, ReversedSeed
+
+__all__ = [
+    "EnvelopeDevelopable",
+    "developable_from_planes",
+    "TangentDevelopable",
+    "RectifyingDevelopable",
+    "CanalSurface",
+    "CanalReport",
+    "CompositeDevelopable",
+    "DevelopableJointReport",
+    "join_developable",
+    "measure_developable_joint",
+    "curve_derivatives",
+]
+
+_Jet = list  # list of arrays: value and derivatives 0..K
+
+
+# ----------------------------------------------------------------------------------------------
+# jets: values + derivatives propagated by Leibniz' rule
+# ----------------------------------------------------------------------------------------------
+def _jprod(f: Callable[[np.ndarray, np.ndarray], np.ndarray], A: _Jet, B: _Jet) -> _Jet:
+    """``(f(A, B))^(r) = Σ_s C(r, s) f(A^(s), B^(r-s))`` for a bilinear ``f``."""
+    K = min(len(A), len(B)) - 1
+    return [sum(comb(r, s) * f(A[s], B[r - s]) for s in range(r + 1)) for r in range(K + 1)]
+
+
+def _mul(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return x * y
+
+
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.sum(x * y, axis=-1, keepdims=True)
+
+
+def _cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.cross(x, y)
+
+
+def _jpow(N: _Jet, p: float) -> _Jet:
+    """Jet of ``N^p`` (Faà di Bruno up to order 3)."""
+    n0 = N[0]
+    out = [n0**p]
+    if len(N) > 1:
+        out.append(p * n0 ** (p - 1) * N[1])
+    if len(N) > 2:
+        out.append(p * (p - 1) * n0 ** (p - 2) * N[1] ** 2 + p * n0 ** (p - 1) * N[2])
+    if len(N) > 3:
+        out.append(
+            p * (p - 1) * (p - 2) * n0 ** (p - 3) * N[1] ** 3
+            + 3 * p * (p - 1) * n0 ** (p - 2) * N[1] * N[2]
+            + p * n0 ** (p - 1) * N[3]
+        )
+    return out
+
+
+def _junit(F: _Jet) -> _Jet:
+    """Jet of ``F / |F|``."""
+    return _jprod(_mul, F, _jpow(_jprod(_dot, F, F), -0.5))
+
+
+def _jcartesian(X: _Jet) -> _Jet:
+    """Jet of ``(X1, X2, X3) / X0`` from a homogeneous jet."""
+    w = [x[:, :1] for x in X]
+    Y = [x[:, 1:] for x in X]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return _jprod(_mul, Y, _jpow(w, -1.0))
+
+
+def _check_derivative(derivative: Any, max_order: int = 2) -> int:
+    try:
+        r = int(derivative)
+    except (TypeError, ValueError):
+        raise GHTError(f"derivative={derivative!r} is not an integer; allowed orders are 0..{max_order}") from None
+    if r != derivative or not 0 <= r <= max_order:
+        raise GHTError(f"derivative={derivative!r} is not allowed; analytic derivatives exist for orders 0..{max_order}")
+    return r
+
+
+def _seed_high_jet(seed: Any, t: np.ndarray, order: int) -> np.ndarray:
+    """``(f0, f1, f2)^(order)`` for orders above the seed's guaranteed 3 (GHT family only)."""
+    if order <= 3:
+        return seed.jet(t, order)
+    base = seed.base if isinstance(seed, ReversedSeed) else seed
+    if not isinstance(base, GHTSeed):
+        raise GHTError(
+            f"derivative order {order} of the seed {seed!r} is needed here but custom seeds only "
+            "guarantee orders 0..3; use the GHT/GBT/Bernstein seeds"
+        )
+    f0, f2 = seed.f0_f2(t, order)  # the GHT formulas hold for every order
+    return np.column_stack([f0, -(f0 + f2), f2])
+
+
+def curve_derivatives(curve: GHTCurve, t: Any, max_order: int) -> list[np.ndarray]:
+    r"""``[C(t), C'(t), ..., C^(max_order)(t)]`` analytically, also beyond order 3.
+
+    ``C^(r) = Σ_i b^{(r)}_{i,m} P_i`` with ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``;
+    seed derivatives of order > 3 come from the GHT seed formulas (sin/cos and polynomials), which
+    hold for every order.
+
+    Args:
+        curve: a GHT curve (GHT/GBT/Bernstein seed, possibly reversed, for orders > 3).
+        t: parameters in [0, 1].
+        max_order: highest order (0..6).
+
+    Raises:
+        GHTError: a custom seed and ``max_order > 3``.
+    """
+    tt, _ = as_parameter_array(t)
+    out = [curve.derivative(tt, r) for r in range(min(max_order, 3) + 1)]
+    n = curve.degree - 2
+    P = curve.control_points
+    for r in range(4, max_order + 1):
+        B = np.zeros((tt.size, curve.degree + 1))
+        for s in range(r + 1):
+            f = _seed_high_jet(curve.seed, tt, s)
+            Bn = bernstein(tt, n, r - s)
+            for k in range(3):
+                B[:, k : k + n + 1] += comb(r, s) * Bn * f[:, k : k + 1]
+        out.append(B @ P)
+    return out
+
+
+def _fmt(v: Any) -> str:
+    return np.array2string(np.asarray(v, dtype=float), precision=6, separator=", ")
+
+
+def _check_range(t_range: Any) -> tuple[float, float]:
+    try:
+        t0, t1 = (float(x) for x in t_range)
+    except (TypeError, ValueError):
+        raise GHTError(f"t_range={t_range!r} must be a pair (t0, t1) with 0 <= t0 < t1 <= 1") from None
+    if not (math.isfinite(t0) and math.isfinite(t1) and 0.0 <= t0 < t1 <= 1.0):
+        raise GHTError(f"t_range=({t0:g}, {t1:g}) is not allowed; it must satisfy 0 <= t0 < t1 <= 1")
+    return t0, t1
+
+
+def _sign_change_roots(f: Callable[[np.ndarray], np.ndarray], u: np.ndarray, vals: np.ndarray) -> list[float]:
+    """Parameters where the sampled scalar ``vals = f(u)`` changes sign, refined by bisection."""
+    from scipy.optimize import brentq
+
+    roots = []
+    s = np.sign(vals)
+    for i in np.nonzero(s[:-1] * s[1:] < 0)[0]:
+        try:
+            roots.append(float(brentq(lambda x: float(f(np.array([x]))[0]), u[i], u[i + 1], xtol=1e-14)))
+        except ValueError:
+            roots.append(float(0.5 * (u[i] + u[i + 1])))
+    roots.extend(float(x) for x in u[vals == 0.0])
+    return sorted(roots)
+
+
+# ----------------------------------------------------------------------------------------------
+# 5.2 enveloping developable
+# ----------------------------------------------------------------------------------------------
+class EnvelopeDevelopable(RuledSurface):
+    r"""Envelope of the planes ``U(t) = Σ b_{i,m}(t; μ,ν,γ) U_i`` cut by two boundary planes.
+
+    ``a(t) = U ∩ U' ∩ E_a``, ``b(t) = U ∩ U' ∩ E_b``, ``X(u, v) = (1-v) a + v b`` with
+    ``t = t0 + u (t1 - t0)``. Derivatives of ``a``, ``b`` (orders 0..2) are analytic, by the
+    product rule through the trilinear meet and the quotient rule for ``(X1, X2, X3)/X0``.
+
+    Use :func:`developable_from_planes` to build one (it validates the input).
+
+    Attributes:
+        dual_curve: the 4-D GHT curve of planes ``U(t)``.
+        boundary_planes: ``(E_a, E_b)`` as a (2, 4) array.
+        t_range: ``(t0, t1)``.
+    """
+
+    def __init__(
+        self,
+        planes: Any,
+        boundary_planes: Any,
+        mu: float = 0.0,
+        nu: float = 0.0,
+        gamma: float = 0.0,
+        *,
+        t_range: tuple[float, float] = (0.0, 1.0),
+        normalize: bool = False,
+        check: bool = True,
+        samples: int = 513,
+    ) -> None:
+        if isinstance(planes, GHTCurve):
+            if planes.dim != 4:
+                raise GHTError(f"a dual curve of planes must be 4-D; got a curve of dimension {planes.dim}")
+            check_control_planes(planes.control_points, "planes")
+            curve = planes
+        else:
+            arr = check_control_planes(planes, "planes")
+            if normalize:
+                arr = normalize_planes(arr)
+            curve = GHTCurve(arr, mu, nu, gamma)
+        self.dual_curve: GHTCurve = curve
+        try:
+            bp = np.array(boundary_planes, dtype=float)
+        except (TypeError, ValueError):
+            raise GHTError("boundary_planes must be two plane 4-vectors (E_a, E_b)") from None
+        if bp.shape != (2, 4):
+            raise GHTError(f"boundary_planes must have shape (2, 4) (E_a, E_b); got shape {bp.shape}")
+        self.boundary_planes = np.array([as_plane(bp[0], "E_a"), as_plane(bp[1], "E_b")])
+        self.t_range = _check_range(t_range)
+        if check:
+            self.check(samples)
+
+    # -- parameters -------------------------------------------------------------------------
+    @property
+    def planes(self) -> np.ndarray:
+        """Control planes ``U_0..U_m`` (rows of the dual curve)."""
+        return self.dual_curve.control_points
+
+    def dual_parameter(self, u: Any) -> np.ndarray:
+        """Dual-curve parameter ``t = t0 + u (t1 - t0)`` of surface parameter ``u``."""
+        uu, _ = as_parameter_array(u, "u")
+        t0, t1 = self.t_range
+        return t0 + uu * (t1 - t0)
+
+    def _U(self, u: Any, K: int) -> _Jet:
+        """``[d^r U(t(u)) / du^r for r = 0..K]`` (K <= 3)."""
+        t = self.dual_parameter(u)
+        h = self.t_range[1] - self.t_range[0]
+        return [self.dual_curve.derivative(t, r) * h**r for r in range(K + 1)]
+
+    def _boundary_h(self, u: Any, which: int, K: int) -> _Jet:
+        """Homogeneous jet of ``meet(U, U', E)`` (E = E_a for which=0, E_b for which=1)."""
+        U = self._U(u, K + 1)
+        E = self.boundary_planes[which]
+        return _jprod(lambda A, B: meet(A, B, E), U[: K + 1], U[1 : K + 2])
+
+    # -- RuledSurface interface ---------------------------------------------------------------
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        r"""``a^(r)(u)``, ``a = U ∩ U' ∩ E_a`` (analytic, r = 0..2)."""
+        r = _check_derivative(derivative)
+        return _jcartesian(self._boundary_h(u, 0, r))[r]
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        r"""``b^(r)(u)``, ``b = U ∩ U' ∩ E_b`` (analytic, r = 0..2)."""
+        r = _check_derivative(derivative)
+        return _jcartesian(self._boundary_h(u, 1, r))[r]
+
+    # -- geometry -------------------------------------------------------------------------------
+    def ruling_direction(self, u: Any) -> np.ndarray:
+        r"""Unit direction of the ruling ``U ∩ U'``: ``n(U) × n(U') / |..|`` (sign arbitrary)."""
+        U = self._U(u, 1)
+        d = np.cross(U[0][:, 1:], U[1][:, 1:])
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+    def edge_of_regression(self, u: Any, *, homogeneous: bool = False) -> np.ndarray:
+        r"""Edge of regression ``U ∩ U' ∩ U''`` at surface parameter ``u``.
+
+        Args:
+            u: surface parameter(s).
+            homogeneous: return the homogeneous 4-vectors (``X0 = 0`` at infinity, e.g. a cylinder).
+
+        Returns:
+            (len(u), 3) Cartesian points (``nan`` rows for points at infinity), or (len(u), 4).
+        """
+        U = self._U(u, 2)
+        R = meet(U[0], U[1], U[2])
+        if homogeneous:
+            return R
+        scale = np.linalg.norm(R, axis=1)
+        at_inf = np.abs(R[:, 0]) <= 1e-13 * scale
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = R[:, 1:] / R[:, :1]
+        out[at_inf] = np.nan
+        return out
+
+    def regression_parameter(self, u: Any) -> np.ndarray:
+        r"""Position ``v_R`` of the edge of regression on the ruling, ``R = a + v_R (b - a)``.
+
+        ``v_R = h / R0`` with ``h = (R_xyz - R0 a)·g / |g|²`` (``±inf`` for a point at infinity).
+        The strip ``v ∈ [0, 1]`` is singular where ``0 <= v_R <= 1``.
+        """
+        h, R0 = self._regression_hr(u)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return h / R0
+
+    def _regression_hr(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
+        U = self._U(u, 2)
+        R = meet(U[0], U[1], U[2])
+        R = R / np.maximum(np.linalg.norm(R, axis=1, keepdims=True), 1e-300)
+        A = self.a(u)
+        g = self.b(u) - A
+        h = np.sum((R[:, 1:] - R[:, :1] * A) * g, axis=1) / np.sum(g * g, axis=1)
+        return h, R[:, 0]
+
+    # -- validation -----------------------------------------------------------------------------
+    def check(self, samples: int = 513) -> None:
+        r"""Detect unusable input on ``samples`` parameters (refined where a sign changes).
+
+        Raises:
+            DegenerateGeometryError: ``U(t)`` and ``U'(t)`` with parallel normals (the ruling is at
+                infinity or undefined); a boundary plane containing or parallel to a ruling (the
+                boundary curve runs to infinity); ``E_a`` and ``E_b`` crossing on a ruling (zero
+                strip width).
+            EdgeOfRegressionError: the edge of regression ``U ∩ U' ∩ U''`` lies in the strip
+                ``0 <= v <= 1`` (message gives u, t and v).
+        """
+        u = np.linspace(0.0, 1.0, int(samples))
+        U = self._U(u, 2)
+        n0, n1 = U[0][:, 1:], U[1][:, 1:]
+        d = np.cross(n0, n1)
+        dn = np.linalg.norm(d, axis=1)
+        ref = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1)
+        bad = ~(dn > PARALLEL_TOL * ref)
+        if bad.any():
+            i = int(np.argmax(bad))
+            t = float(self.dual_parameter(u[i])[0])
+            raise DegenerateGeometryError(
+                f"at u={u[i]:.6g} (t={t:.6g}) the dual curve's plane U={_fmt(U[0][i])} and its derivative "
+                f"U'={_fmt(U[1][i])} have parallel normals, so the ruling U ∩ U' is at infinity; "
+                "the control planes must turn (neighbouring planes must not be parallel)"
+            )
+        dunit = d / dn[:, None]
+        names = ("E_a", "E_b")
+        for which in (0, 1):
+            E = self.boundary_planes[which]
+            nE = E[1:] / np.linalg.norm(E[1:])
+            sin = dunit @ nE
+            hits = [float(x) for x in u[np.abs(sin) <= PARALLEL_TOL]]
+            hits += _sign_change_roots(lambda x, nE=nE: _ruling_sin(self, x, nE), u, _ruling_sin(self, u, nE))
+            if hits:
+                x = hits[0]
+                Ux = self._U(np.array([x]), 1)
+                p = meet(Ux[0], Ux[1], np.concatenate([[0.0], np.cross(Ux[0][0, 1:], Ux[1][0, 1:])]))[0]
+                p = p[1:] / p[0]
+                dist = abs(E[0] + E[1:] @ p) / np.linalg.norm(E[1:])
+                size = max(1.0, float(np.linalg.norm(p)))
+                what = "contains" if dist <= 1e-9 * size else "is parallel to"
+                t = float(self.dual_parameter(x)[0])
+                raise DegenerateGeometryError(
+                    f"boundary plane {names[which]}={_fmt(E)} {what} the ruling at u={x:.6g} (t={t:.6g}) "
+                    f"(the line through {_fmt(p)} with direction {_fmt(self.ruling_direction(x)[0])}); "
+                    "boundary planes must cut every ruling of the strip in one point"
+                )
+        # strip width: E_a and E_b must not cross on a ruling
+        A = self.a(u)
+        G = self.b(u) - A
+        w = np.sum(G * dunit, axis=1)
+        scale = np.maximum(np.linalg.norm(A, axis=1), 1.0)
+        zero = np.abs(w) <= 1e-12 * scale
+        roots = [float(x) for x in u[zero]] + _sign_change_roots(
+            lambda x: np.sum((self.b(x) - self.a(x)) * self.ruling_direction(x), axis=1), u, w
+        )
+        if roots:
+            x = roots[0]
+            t = float(self.dual_parameter(x)[0])
+            raise DegenerateGeometryError(
+                f"boundary planes E_a={_fmt(self.boundary_planes[0])} and E_b={_fmt(self.boundary_planes[1])} "
+                f"cut the ruling at u={x:.6g} (t={t:.6g}) in the same point {_fmt(self.a(x)[0])}; "
+                "the strip has zero width there (the boundary planes must not cross inside the strip)"
+            )
+        # edge of regression inside the strip: phi = h (R0 - h) >= 0  <=>  0 <= v_R <= 1
+        self._check_regression(u)
+
+    def _check_regression(self, u: np.ndarray) -> None:
+        from scipy.optimize import minimize_scalar
+
+        h, R0 = self._regression_hr(u)
+        phi = h * (R0 - h)
+        cand = [int(np.argmax(phi))]
+        # refine around the largest local maxima (the edge may enter between samples)
+        interior = np.nonzero((phi[1:-1] >= phi[:-2]) & (phi[1:-1] >= phi[2:]))[0] + 1
+        cand += [int(i) for i in interior[np.argsort(phi[interior])[::-1][:4]]]
+        best_u, best_phi = float(u[cand[0]]), float(phi[cand[0]])
+        for i in cand:
+            lo, hi = u[max(i - 1, 0)], u[min(i + 1, u.size - 1)]
+
+            def f(x: float) -> float:
+                hh, rr = self._regression_hr(np.array([x]))
+                return -float(hh[0] * (rr[0] - hh[0]))
+
+            res = minimize_scalar(f, bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
+            if -res.fun > best_phi:
+                best_u, best_phi = float(res.x), float(-res.fun)
+        if best_phi >= 0.0:
+            vR = float(self.regression_parameter(np.array([best_u]))[0])
+            t = float(self.dual_parameter(best_u)[0])
+            R = self.edge_of_regression(np.array([best_u]))[0]
+            raise EdgeOfRegressionError(
+                f"the strip contains its edge of regression at u={best_u:.6g} (t={t:.6g}), v={vR:.6g} "
+                f"(point {_fmt(R)}); the surface is singular there. Move the boundary planes "
+                f"E_a={_fmt(self.boundary_planes[0])}, E_b={_fmt(self.boundary_planes[1])} so that the "
+                "edge of regression stays outside 0 <= v <= 1, or trim t_range"
+            )
+
+    # -- CAD ------------------------------------------------------------------------------------
+    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+        """One B-spline face (degree 1 across the rulings); see :func:`ght_cad.cad.developable_faces.developable_face`."""
+        from .cad.developable_faces import developable_face
+
+        return developable_face(self, tol=tol, **kwargs)
+
+    def trimmed(self, t_range: tuple[float, float]) -> "EnvelopeDevelopable":
+        """The same envelope restricted to the dual-curve parameters ``t_range``."""
+        return EnvelopeDevelopable(self.dual_curve, self.boundary_planes, t_range=t_range)
+
+    def __repr__(self) -> str:
+        c = self.dual_curve
+        return (
+            f"EnvelopeDevelopable(degree={c.degree}, mu={c.mu:g}, nu={c.nu:g}, gamma={c.gamma:g}, "
+            f"t_range={self.t_range})"
+        )
+
+
+def _ruling_sin(surf: EnvelopeDevelopable, u: np.ndarray, nE: np.ndarray) -> np.ndarray:
+    """Sine of the angle between the ruling at u and a plane with unit normal nE (signed)."""
+    U = surf._U(u, 1)
+    d = np.cross(U[0][:, 1:], U[1][:, 1:])
+    return (d @ nE) / np.linalg.norm(d, axis=1)
+
+
+def developable_from_planes(
+    planes: Any,
+    boundary_planes: Any,
+    mu: float = 0.0,
+    nu: float = 0.0,
+    gamma: float = 0.0,
+    *,
+    t_range: tuple[float, float] = (0.0, 1.0),
+    normalize: bool = False,
+) -> EnvelopeDevelopable:
+    r"""Enveloping developable surface of control planes (spec sections 5.2, 9).
+
+    Dual curve ``U(t) = Σ_{i=0..m} b_{i,m}(t; μ,ν,γ) U_i``; ruling ``U(t) ∩ U'(t)``; boundary
+    curves ``a(t) = U ∩ U' ∩ E_a``, ``b(t) = U ∩ U' ∩ E_b``; surface
+    ``X(t, v) = (1-v) a(t) + v b(t)`` with the pairing a(t)–b(t) kept. At t = 0 it touches ``U_0``
+    along ``U_0 ∩ U_1``, at t = 1 ``U_m`` along ``U_{m-1} ∩ U_m``.
+
+    The scale of each control plane acts like a rational weight: ``(-r, 1, 1, 0)`` as the middle
+    plane (with γ = -1, μ = ν = 0) gives the exact circular cylinder, its unit-normal rescaling
+    does not. Pass ``normalize=True`` to rescale every control plane to a unit normal first.
+
+    Args:
+        planes: (m+1, 4) control planes ``U_i = (u0, u1, u2, u3)``, m >= 2.
+        boundary_planes: ``(E_a, E_b)``, two plane 4-vectors that cut every ruling.
+        mu, nu, gamma: shape parameters in [-1, 1].
+        t_range: dual-curve parameter range ``(t0, t1)`` kept (trimming), ``0 <= t0 < t1 <= 1``.
+        normalize: rescale the control planes to unit normals before use.
+
+    Returns:
+        :class:`EnvelopeDevelopable` with ``.evaluate(u, v)``, ``.developability()``,
+        ``.to_face()``, ``.edge_of_regression(u)``, ``.dual_curve``.
+
+    Raises:
+        DegenerateGeometryError: NaN/inf, zero normals, parallel or coincident neighbouring
+            control planes, boundary planes containing or parallel to a ruling, crossing
+            boundary planes.
+        EdgeOfRegressionError: the strip contains its edge of regression.
+        ShapeParameterError: μ, ν or γ outside [-1, 1].
+        GHTError: wrong shapes, bad t_range.
+    """
+    return EnvelopeDevelopable(planes, boundary_planes, mu, nu, gamma, t_range=t_range, normalize=normalize)
+
+
+# ----------------------------------------------------------------------------------------------
+# generic check of a ruled strip against its striction/regression points
+# ----------------------------------------------------------------------------------------------
+def _check_strip_regular(surf: RuledSurface, samples: int = 513, what: str = "strip") -> None:
+    r"""Raise EdgeOfRegressionError when the singular point of a developable strip is inside it.
+
+    On a developable the tangent plane is singular where ``X_u = a' + v g'`` is parallel to ``g``:
+    ``v* = -((a' × g)·(g' × g)) / |g' × g|²``. Where ``|g' × g|`` vanishes (cylinder-like) there is
+    no singular point.
+    """
+    u = np.linspace(0.0, 1.0, samples)
+    a1 = surf.a(u, 1)
+    g = surf.ruling(u)
+    g1 = surf.ruling(u, 1)
+    c1 = np.cross(a1, g)
+    c2 = np.cross(g1, g)
+    den = np.sum(c2 * c2, axis=1)
+    scale = np.sum(g * g, axis=1) * np.sum(g1 * g1, axis=1)
+    ok = den > 1e-24 * np.maximum(scale, 1e-300)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vs = np.where(ok, -np.sum(c1 * c2, axis=1) / np.where(ok, den, 1.0), np.inf)
+    inside = ok & (vs >= 0.0) & (vs <= 1.0)
+    if inside.any():
+        i = int(np.argmax(inside))
+        raise EdgeOfRegressionError(
+            f"the {what} contains its edge of regression at u={u[i]:.6g}, v={vs[i]:.6g} "
+            f"(point {_fmt(surf.evaluate(u[i], vs[i]))}); the surface is singular there"
+        )
+
+
+def _check_3d_curve(curve: Any, name: str) -> GHTCurve:
+    if not isinstance(curve, GHTCurve):
+        raise GHTError(f"{name} must be a GHTCurve, got {type(curve).__name__}")
+    if curve.dim != 3:
+        raise GHTError(f"{name} has dimension {curve.dim}; a space curve of dimension 3 is required")
+    return curve
+
+
+def _check_v_range(v0: Any, v1: Any) -> tuple[float, float]:
+    try:
+        a, b = float(v0), float(v1)
+    except (TypeError, ValueError):
+        raise GHTError(f"v0={v0!r}, v1={v1!r} must be real numbers") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise GHTError(f"v0={a}, v1={b} must be finite")
+    if not a < b:
+        raise GHTError(f"v0={a:g} must be smaller than v1={b:g}")
+    return a, b
+
+
+# ----------------------------------------------------------------------------------------------
+# 5.3 spine-curve (tangent) developable
+# ----------------------------------------------------------------------------------------------
+class TangentDevelopable(RuledSurface):
+    r"""Tangent developable of a GHT space curve, ``X(t, v) = C(t) + v T(t)``, ``v ∈ [v0, v1]``.
+
+    ``a(t) = C + v0 T``, ``b(t) = C + v1 T`` (so the surface parameter ``v ∈ [0, 1]`` maps to
+    ``v0 + v (v1 - v0)``; v0, v1 in length units since T is a unit vector). C is the edge of
+    regression, so the range must not contain 0 (``v0 > 0`` or ``v1 < 0``).
+
+    Raises:
+        EdgeOfRegressionError: ``v0 <= 0 <= v1`` (the spine would lie in the face).
+        DegenerateGeometryError: the spine has a vanishing tangent ``C'`` or curvature (an
+            inflection: the tangent surface folds there).
+        GHTError: not a 3-D GHT curve, bad v range.
+    """
+
+    def __init__(self, curve: GHTCurve, v0: float, v1: float, *, samples: int = 257) -> None:
+        self.curve = _check_3d_curve(curve, "curve")
+        self.v0, self.v1 = _check_v_range(v0, v1)
+        if self.v0 <= 0.0 <= self.v1:
+            raise EdgeOfRegressionError(
+                f"v range [{self.v0:g}, {self.v1:g}] contains 0: the spine curve (edge of regression of "
+                "the tangent developable) would lie inside the face; use v0 > 0 or v1 < 0"
+            )
+        u = np.linspace(0.0, 1.0, samples)
+        d = curve_derivatives(self.curve, u, 2)
+        sp = np.linalg.norm(d[1], axis=1)
+        kap = np.linalg.norm(np.cross(d[1], d[2]), axis=1)
+        L = max(float(np.ptp(self.curve.control_points, axis=0).max()), 1e-300)
+        if not np.all(sp > 1e-12 * L):
+            i = int(np.argmin(sp))
+            raise DegenerateGeometryError(f"the spine curve has a vanishing tangent |C'|={sp[i]:.3g} at t={u[i]:.6g}")
+        if not np.all(kap > 1e-12 * sp**2):
+            i = int(np.argmin(kap / sp**2))
+            raise DegenerateGeometryError(
+                f"the spine curve has zero curvature at t={u[i]:.6g} (|C' x C''|={kap[i]:.3g}); "
+                "its tangent developable folds along that ruling"
+            )
+
+    def _side(self, u: Any, v: float, r: int) -> np.ndarray:
+        d = curve_derivatives(self.curve, u, r + 1)
+        T = _junit(d[1 : r + 2])
+        return d[r] + v * T[r]
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``a^(r) = C^(r) + v0 T^(r)`` (analytic, r = 0..2)."""
+        return self._side(u, self.v0, _check_derivative(derivative))
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``b^(r) = C^(r) + v1 T^(r)`` (analytic, r = 0..2)."""
+        return self._side(u, self.v1, _check_derivative(derivative))
+
+    def edge_of_regression(self, u: Any) -> np.ndarray:
+        """The spine ``C(t)``."""
+        return self.curve.evaluate(as_parameter_array(u, "u")[0])
+
+    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+        """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
+        from .cad.developable_faces import developable_face
+
+        return developable_face(self, tol=tol, **kwargs)
+
+
+# ----------------------------------------------------------------------------------------------
+# 5.4 rectifying (geodesic-interpolating) developable
+# ----------------------------------------------------------------------------------------------
+class RectifyingDevelopable(RuledSurface):
+    r"""Rectifying developable ``X(t, v) = C(t) + v D(t)``, ``D = (τT + κB)/sqrt(κ² + τ²)``.
+
+    C is a geodesic of the surface (normal ∥ N along C): the strip a flat sheet makes when laid
+    along C. ``a = C + v0 D``, ``b = C + v1 D`` with ``v0 < v1`` in length units (0 inside keeps C on
+    the face). ``D ∥ ω̃ = det(C', C'', C''') |C'|² C' + |C' × C''|² (C' × C'')`` (the Darboux vector
+    up to a positive factor); derivatives (orders 0..2) use analytic curve derivatives up to 5.
+
+    Raises:
+        DegenerateGeometryError: vanishing tangent or curvature of C (D undefined).
+        EdgeOfRegressionError: the strip ``[v0, v1]`` contains its edge of regression.
+        GHTError: not a 3-D GHT curve, bad v range, a custom seed without derivatives of order 5.
+    """
+
+    def __init__(self, curve: GHTCurve, v0: float, v1: float, *, samples: int = 257, check: bool = True) -> None:
+        self.curve = _check_3d_curve(curve, "curve")
+        self.v0, self.v1 = _check_v_range(v0, v1)
+        u = np.linspace(0.0, 1.0, samples)
+        d = curve_derivatives(self.curve, u, 2)
+        sp = np.linalg.norm(d[1], axis=1)
+        kap = np.linalg.norm(np.cross(d[1], d[2]), axis=1)
+        if not np.all(kap > 1e-12 * np.maximum(sp, 1e-300) ** 2):
+            i = int(np.argmin(kap))
+            raise DegenerateGeometryError(
+                f"the curve has zero curvature or tangent at t={u[i]:.6g} (|C' x C''|={kap[i]:.3g}); "
+                "the rectifying direction D = (τT + κB)/sqrt(κ² + τ²) is undefined there"
+            )
+        if check:
+            _check_strip_regular(self, samples, "rectifying strip")
+
+    def direction(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Unit rectifying direction ``D^(r)(t)`` (r = 0..2)."""
+        r = _check_derivative(derivative)
+        return self._D(u, r)[r]
+
+    def _D(self, u: Any, r: int) -> _Jet:
+        d = curve_derivatives(self.curve, u, r + 3)
+        p, q, w = d[1 : r + 2], d[2 : r + 3], d[3 : r + 4]
+        X = _jprod(_cross, p, q)
+        delta = _jprod(_dot, p, _jprod(_cross, q, w))
+        P2 = _jprod(_dot, p, p)
+        X2 = _jprod(_dot, X, X)
+        om = [x + y for x, y in zip(_jprod(_mul, _jprod(_mul, delta, P2), p), _jprod(_mul, X2, X))]
+        return _junit(om)
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``a^(r) = C^(r) + v0 D^(r)``."""
+        r = _check_derivative(derivative)
+        return curve_derivatives(self.curve, u, r)[r] + self.v0 * self._D(u, r)[r]
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``b^(r) = C^(r) + v1 D^(r)``."""
+        r = _check_derivative(derivative)
+        return curve_derivatives(self.curve, u, r)[r] + self.v1 * self._D(u, r)[r]
+
+    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+        """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
+        from .cad.developable_faces import developable_face
+
+        return developable_face(self, tol=tol, **kwargs)
+
+
+# ----------------------------------------------------------------------------------------------
+# 5.5 canal surfaces
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CanalReport:
+    """Developability report of a canal surface (sampled Gaussian curvature).
+
+    Attributes:
+        k_max: ``max |K| ρ²`` over the samples (scale-free; ρ = mean sphere radius).
+        k_rms: root mean square of ``K ρ²``.
+        developable: True only for a cone or cylinder of revolution whose sampled ``|K| ρ²``
+            stays below ``tol``.
+        kind: ``"cylinder of revolution"``, ``"cone of revolution"`` or ``"not developable"``.
+        tol: tolerance used on ``k_max``.
+    """
+
+    k_max: float
+    k_rms: float
+    developable: bool
+    kind: str
+    tol: float
+
+    def __str__(self) -> str:
+        return f"canal surface: {self.kind} (max |K| rho^2 = {self.k_max:.3e}, rms {self.k_rms:.3e})"
+
+
+class CanalSurface:
+    r"""Envelope of the spheres with centre ``C(t)`` and radius ``r(t)`` (spec 5.5).
+
+    ``X(t, φ) = C - r ṙ/|C'|² C' + r sqrt(1 - ṙ²/|C'|²) (cos φ e1 + sin φ e2)`` where ``e1, e2``
+    is an orthonormal frame normal to ``C'`` (``e1 = ref × T / |..|``, a fixed reference axis),
+    ``φ = φ0 + v (φ1 - φ0)``. Not a ruled surface in general: it is developable only when it is a
+    cone or a cylinder of revolution, which :meth:`developability` reports (it never calls another
+    canal surface developable).
+
+    Args:
+        center: 3-D GHT curve ``C(t)``.
+        radius: 1-D GHT curve ``r(t)`` (positive), or a positive number (pipe surface).
+        phi_range: angle range in radians, default the full circle.
+
+    Raises:
+        DegenerateGeometryError: ``r <= 0``, ``|r'| >= |C'|`` (no real envelope), ``C' = 0``.
+    """
+
+    def __init__(self, center: GHTCurve, radius: Any, *, phi_range: tuple[float, float] = (0.0, 2 * math.pi), samples: int = 257) -> None:
+        self.center = _check_3d_curve(center, "center")
+        if isinstance(radius, GHTCurve):
+            if radius.dim != 1:
+                raise GHTError(f"radius must be a 1-D GHT curve; got dimension {radius.dim}")
+            self.radius = radius
+        else:
+            try:
+                r = float(radius)
+            except (TypeError, ValueError):
+                raise GHTError(f"radius={radius!r} must be a 1-D GHTCurve or a positive number") from None
+            self.radius = GHTCurve([[r]] * 3)
+        self.phi_range = (float(phi_range[0]), float(phi_range[1]))
+        u = np.linspace(0.0, 1.0, samples)
+        rv = self.radius.evaluate(u)[:, 0]
+        if not np.all(rv > 0):
+            i = int(np.argmin(rv))
+            raise DegenerateGeometryError(f"radius r(t)={rv[i]:.6g} at t={u[i]:.6g}; sphere radii must be > 0")
+        c1 = self.center.derivative(u, 1)
+        sp = np.linalg.norm(c1, axis=1)
+        r1 = self.radius.derivative(u, 1)[:, 0]
+        if not np.all(np.abs(r1) < sp):
+            i = int(np.argmax(np.abs(r1) - sp))
+            raise DegenerateGeometryError(
+                f"at t={u[i]:.6g} |r'|={abs(r1[i]):.6g} >= |C'|={sp[i]:.6g}: the spheres are nested and "
+                "have no real envelope; the radius must change slower than the centre moves"
+            )
+        T = c1 / sp[:, None]
+        axes = np.eye(3)
+        self._ref = axes[int(np.argmin(np.abs(T @ axes.T).max(axis=0)))]
+        if not np.all(np.linalg.norm(np.cross(self._ref, T), axis=1) > 1e-6):
+            raise DegenerateGeometryError("the centre curve turns through every coordinate axis; no fixed frame reference found")
+
+    def evaluate(self, u: Any, v: Any) -> np.ndarray:
+        """Points ``X(t, φ(v))``; u, v broadcast to a common 1-D shape."""
+        uu, us = as_parameter_array(u, "u")
+        vv, vs = as_parameter_array(v, "v")
+        uu, vv = np.broadcast_arrays(uu, vv)
+        out = self._point(uu, vv)
+        return out[0] if (us and vs) else out
+
+    def _point(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        C = self.center.evaluate(u)
+        c1 = self.center.derivative(u, 1)
+        r = self.radius.evaluate(u)[:, 0]
+        r1 = self.radius.derivative(u, 1)[:, 0]
+        s2 = np.sum(c1 * c1, axis=1)
+        T = c1 / np.sqrt(s2)[:, None]
+        e1 = np.cross(self._ref, T)
+        e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+        e2 = np.cross(T, e1)
+        phi = self.phi_range[0] + v * (self.phi_range[1] - self.phi_range[0])
+        rho = r * np.sqrt(1.0 - r1**2 / s2)
+        return C - (r * r1 / s2)[:, None] * c1 + rho[:, None] * (np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2)
+
+    def gaussian_curvature(self, u: Any, v: Any, h: float = 1e-3) -> np.ndarray:
+        r"""Gaussian curvature ``K = (LN - M²)/(EG - F²)`` from 4th-order central differences."""
+        uu, _ = as_parameter_array(u, "u")
+        vv, _ = as_parameter_array(v, "v")
+        uu, vv = np.broadcast_arrays(uu, vv)
+        # keep the stencil inside [0, 1] in u (v is periodic-safe: the formula extends smoothly)
+        uc = np.clip(uu, 2 * h, 1 - 2 * h)
+
+        def X(du: float, dv: float) -> np.ndarray:
+            return self._point(uc + du * h, vv + dv * h)
+
+        w = {-2: 1 / 12, -1: -2 / 3, 1: 2 / 3, 2: -1 / 12}
+        w2 = {-2: -1 / 12, -1: 4 / 3, 0: -5 / 2, 1: 4 / 3, 2: -1 / 12}
+        Xu = sum(c * X(k, 0) for k, c in w.items()) / h
+        Xv = sum(c * X(0, k) for k, c in w.items()) / h
+        Xuu = sum(c * X(k, 0) for k, c in w2.items()) / h**2
+        Xvv = sum(c * X(0, k) for k, c in w2.items()) / h**2
+        Xuv = sum(ci * cj * X(i, j) for i, ci in w.items() for j, cj in w.items()) / h**2
+        n = np.cross(Xu, Xv)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        E, F, G = (np.sum(a * b, axis=1) for a, b in ((Xu, Xu), (Xu, Xv), (Xv, Xv)))
+        L, M, N = (np.sum(a * n, axis=1) for a in (Xuu, Xuv, Xvv))
+        return (L * N - M * M) / (E * G - F * F)
+
+    def kind(self, tol: float = 1e-9) -> str:
+        """``"cylinder of revolution"``, ``"cone of revolution"`` or ``"not developable"``.
+
+        Structural test on the control data: the centre's control points are collinear and the
+        radius is an affine function of the position along that line at every control point
+        (then r(t) is affine in the position of C(t), as the basis is a partition of unity).
+        Only valid when both curves share the shape parameters.
+        """
+        P = self.center.control_points
+        R = self.radius.control_points[:, 0]
+        if self.center.degree != self.radius.degree or self.center.shape_parameters != self.radius.shape_parameters:
+            same_r = np.allclose(R, R[0], rtol=0, atol=tol * abs(R[0])) and np.allclose(
+                self.radius.control_points, self.radius.control_points[0]
+            )
+            if not same_r:
+                return "not developable"
+        d = P[-1] - P[0]
+        L = float(np.linalg.norm(d))
+        if L == 0.0:
+            return "not developable"
+        d /= L
+        off = P - P[0]
+        if np.max(np.linalg.norm(off - np.outer(off @ d, d), axis=1)) > tol * L:
+            return "not developable"
+        s = off @ d
+        if np.allclose(R, R[0], rtol=0, atol=tol * max(abs(R[0]), L)):
+            return "cylinder of revolution"
+        A = np.column_stack([np.ones_like(s), s])
+        coef, *_ = np.linalg.lstsq(A, R, rcond=None)
+        if np.max(np.abs(A @ coef - R)) <= tol * max(L, float(np.abs(R).max())):
+            return "cone of revolution"
+        return "not developable"
+
+    def developability(self, nu: int = 41, nv: int = 24, tol: float = 1e-6) -> CanalReport:
+        """Sampled scale-free Gaussian curvature ``K ρ²`` and the structural kind (see :meth:`kind`)."""
+        u = np.linspace(0.02, 0.98, nu)
+        v = np.linspace(0.0, 1.0, nv, endpoint=False)
+        U, V = (x.ravel() for x in np.meshgrid(u, v, indexing="ij"))
+        K = self.gaussian_curvature(U, V)
+        rho = float(np.mean(self.radius.evaluate(u)[:, 0]))
+        Ks = K * rho**2
+        kmax = float(np.max(np.abs(Ks)))
+        krms = float(np.sqrt(np.mean(Ks**2)))
+        kind = self.kind()
+        dev = kind != "not developable" and kmax <= tol
+        return CanalReport(kmax, krms, dev, kind if dev else "not developable", tol)
+
+
+# ----------------------------------------------------------------------------------------------
+# 5.6 joins and composites
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DevelopableJointReport:
+    r"""Order achieved at the joint ``A(1) → B(0)`` of two enveloping developables.
+
+    Attributes:
+        order: projective contact order of the dual curves (-1..3): 0 common tangent plane,
+            1 also common ruling, 2 also common edge-of-regression point (osculating plane of the
+            dual curve), 3 third-order contact. Intrinsic: independent of plane scales and of
+            the parametrization.
+        residuals: relative residuals of the order-0..3 conditions.
+        plane_angle: angle (degrees) between the end tangent planes.
+        ruling_distance: largest distance of A's end ruling endpoints from B's start ruling,
+            relative to the size of the ruling segment.
+        dual: :class:`ght_cad.continuity.JointReport` of the 4-D dual curves (affine G/C order), or
+            None if the continuity module is unavailable.
+        tol: tolerance.
+    """
+
+    order: int
+    residuals: tuple[float, ...]
+    plane_angle: float
+    ruling_distance: float
+    dual: Any
+    tol: float
+
+    def satisfies(self, continuity: Any) -> bool:
+        """True if the geometric order is at least that of ``"G1"``, ``"G2"``, ``"G3"``."""
+        s = str(continuity).upper().strip()
+        if len(s) != 2 or s[0] != "G" or s[1] not in "0123":
+            raise GHTError(f"continuity={continuity!r} is not one of 'G0', 'G1', 'G2', 'G3'")
+        return self.order >= int(s[1])
+
+    def __str__(self) -> str:
+        return (
+            f"developable joint G{self.order} (plane angle {self.plane_angle:.3e} deg, ruling distance "
+            f"{self.ruling_distance:.3e}, residuals {', '.join(f'{r:.2e}' for r in self.residuals)})"
+        )
+
+
+def _dual_end_derivs(surf: EnvelopeDevelopable, end: int) -> list[np.ndarray]:
+    """``U^(r)`` at the surface end (u = end) with respect to u, r = 0..3."""
+    return [x[0] for x in surf._U(np.array([float(end)]), 3)]
+
+
+def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *, tol: float = 1e-9) -> DevelopableJointReport:
+    r"""Measure the geometric order of the joint ``a(u=1) → b(u=0)`` from the two surfaces alone.
+
+    Projective contact of the dual curves ``U`` (of a, at its end) and ``V`` (of b, at its start):
+    order r holds when ``V(s) = λ(s) U(φ(s))`` to r-th order for some scale ``λ`` and
+    reparametrization ``φ`` with ``φ' > 0``. Expanding,
+
+    * r=0: ``V = λ0 U``;
+    * r=1: ``V' = λ1 U + λ0 φ1 U'`` (common ruling ``U ∩ U'``);
+    * r=2: ``V'' = λ2 U + (2λ1φ1 + λ0φ2) U' + λ0φ1² U''`` (common edge-of-regression point);
+    * r=3: ``V''' = λ3 U + (3λ2φ1 + 3λ1φ2 + λ0φ3) U' + (3λ1φ1² + 3λ0φ1φ2) U'' + λ0φ1³ U'''``.
+
+    The unknowns are fitted order by order by least squares (new unknowns at order r: ``λ_r`` and
+    ``φ_r``, the rest being known), and the condition holds when the relative residual
+    ``|residual| / max(|V^(r)|, Σ|terms|) <= tol``. This is independent of how the joint was built.
+    A 4-D affine G^r join (``λ ≡ 1``, :func:`ght_cad.continuity.join`) measures at least r.
+
+    Args:
+        a, b: enveloping developables (a's end meets b's start).
+        tol: relative tolerance.
+
+    Returns:
+        :class:`DevelopableJointReport`.
+    """
+    if not isinstance(a, EnvelopeDevelopable) or not isinstance(b, EnvelopeDevelopable):
+        raise GHTError(f"measure_developable_joint needs two EnvelopeDevelopable surfaces, got {type(a).__name__} and {type(b).__name__}")
+    tol = float(tol)
+    if not (math.isfinite(tol) and tol > 0):
+        raise GHTError(f"tol={tol!r} must be a positive finite number")
+    U = _dual_end_derivs(a, 1)
+    V = _dual_end_derivs(b, 0)
+
+    def fit(target: np.ndarray, known: list[np.ndarray]) -> tuple[np.ndarray, float]:
+        """Solve ``target - Σ known = x0 U + x1 U'`` least squares; return x and relative residual."""
+        rhs = target - sum(known) if known else target.copy()
+        M = np.column_stack([U[0], U[1]])
+        x, *_ = np.linalg.lstsq(M, rhs, rcond=None)
+        res = float(np.linalg.norm(rhs - M @ x))
+        scale = max(float(np.linalg.norm(target)), sum(float(np.linalg.norm(k)) for k in known),
+                    float(np.linalg.norm(M @ x)), 1e-300)
+        return x, res / scale
+
+    res: list[float] = []
+    # order 0: V = λ0 U
+    lam0 = float(V[0] @ U[0]) / float(U[0] @ U[0])
+    res.append(float(np.linalg.norm(V[0] - lam0 * U[0])) / max(float(np.linalg.norm(V[0])), 1e-300))
+    # order 1: V' = λ1 U + (λ0 φ1) U'
+    x, r1 = fit(V[1], [])
+    lam1, phi1 = float(x[0]), float(x[1]) / lam0
+    res.append(r1 if phi1 > 0 else math.inf)
+    # order 2: V'' - λ0 φ1² U'' = λ2 U + (2λ1φ1 + λ0φ2) U'
+    x, r2 = fit(V[2], [lam0 * phi1**2 * U[2]])
+    lam2 = float(x[0])
+    phi2 = (float(x[1]) - 2 * lam1 * phi1) / lam0
+    res.append(r2)
+    # order 3: V''' - (3λ1φ1² + 3λ0φ1φ2) U'' - λ0 φ1³ U''' = λ3 U + (...) U'
+    _, r3 = fit(V[3], [(3 * lam1 * phi1**2 + 3 * lam0 * phi1 * phi2) * U[2], lam0 * phi1**3 * U[3]])
+    res.append(r3)
+    order = -1
+    for r in range(4):
+        if res[r] <= tol:
+            order = r
+        else:
+            break
+    nA = U[0][1:] / np.linalg.norm(U[0][1:])
+    nB = V[0][1:] / np.linalg.norm(V[0][1:])
+    angle = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(nA, nB)), abs(float(nA @ nB)))))
+    pa, pb = a.a(1.0)[0], a.b(1.0)[0]
+    seg = max(float(np.linalg.norm(pb - pa)), 1e-300)
+    dist = 0.0
+    for p in (pa, pb):
+        for P in (V[0], V[1]):
+            dist = max(dist, abs(float(P[0] + P[1:] @ p)) / float(np.linalg.norm(P[1:])) / seg)
+    dual = None
+    try:
+        from .continuity import measure_continuity
+
+        dual = measure_continuity(a.dual_curve, b.dual_curve, tol=tol) if a.t_range == (0.0, 1.0) == b.t_range else None
+    except ImportError:  # pragma: no cover - the continuity module ships with the package
+        dual = None
+    return DevelopableJointReport(order, tuple(res), angle, dist, dual, tol)
+
+
+def join_developable(
+    first: EnvelopeDevelopable,
+    continuity: str,
+    planes: Any,
+    boundary_planes: Any = None,
+    mu: float | None = None,
+    nu: float | None = None,
+    gamma: float | None = None,
+    *,
+    k: float = 1.0,
+    beta2: float = 0.0,
+    beta3: float = 0.0,
+) -> EnvelopeDevelopable:
+    r"""Second enveloping developable joined to ``first`` with G1, G2 or G3 through the dual curves.
+
+    Spec 5.6: section 4 applied to the 4-D dual curves, ``V(0) = U(1)``, G1 ``V'(0) = k U'(1)``,
+    G2 ``V''(0) = k² U''(1) + β2 U'(1)``, G3 ``V''' = k³ U''' + 3kβ2 U'' + β3 U'`` (all at the joint),
+    solved for ``V_0..V_r`` by :func:`ght_cad.continuity.join`; the other control planes of
+    ``planes`` are kept. G1 means a common tangent plane and a common ruling at the joint.
+
+    Args:
+        first: the first surface (untrimmed, t_range (0, 1)).
+        continuity: ``"G1"``, ``"G2"`` or ``"G3"`` (``"C1".."C3"`` accepted too).
+        planes: (n+1, 4) control planes of the second surface; rows 0..r are replaced.
+        boundary_planes: ``(E_a, E_b)`` of the second surface; default: those of ``first``
+            (then the two strips share their joint ruling segment, as a shell needs).
+        mu, nu, gamma: shape parameters of the second surface (default: those of ``first``).
+        k, beta2, beta3: G parameters (k > 0).
+
+    Raises:
+        SingularJoinError: G0 requested (the surfaces would not share a ruling), k <= 0, or an
+            order that the second surface's degree / shape parameters cannot take.
+        GHTError: a trimmed ``first``; plus every error of :func:`developable_from_planes`.
+    """
+    from .continuity import Continuity, join
+
+    if not isinstance(first, EnvelopeDevelopable):
+        raise GHTError(f"first must be an EnvelopeDevelopable, got {type(first).__name__}")
+    if first.t_range != (0.0, 1.0):
+        raise GHTError(f"first is trimmed to t_range={first.t_range}; join untrimmed surfaces (t_range (0, 1))")
+    cont = Continuity.parse(continuity)
+    if cont.order < 1:
+        raise SingularJoinError(
+            f"continuity={cont.value} joins only the tangent planes; the surfaces would not share a ruling. "
+            "Developable joins need G1, G2 or G3"
+        )
+    arr = np.array(planes, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise GHTError(f"planes must have shape (count, 4); got shape {arr.shape}")
+    check_finite_array("planes", arr)
+    c = first.dual_curve
+    mu = c.mu if mu is None else mu
+    nu = c.nu if nu is None else nu
+    gamma = c.gamma if gamma is None else gamma
+    kw = {"k": k, "beta2": beta2, "beta3": beta3} if cont.geometric else {}
+    joined = join(c, cont, arr, mu=mu, nu=nu, gamma=gamma, **kw)
+    bp = first.boundary_planes if boundary_planes is None else boundary_planes
+    return EnvelopeDevelopable(joined, bp)
+
+
+class CompositeDevelopable:
+    r"""A chain of developable strips whose consecutive joint rulings coincide.
+
+    Args:
+        segments: ruled surfaces (usually :class:`EnvelopeDevelopable`), segment i's end ruling
+            ``a_i(1) b_i(1)`` equal to segment i+1's start ruling ``a_{i+1}(0) b_{i+1}(0)``.
+        tol: relative tolerance on the joint ruling endpoints (relative to the ruling length).
+
+    Raises:
+        DegenerateGeometryError: a joint whose ruling segments differ (naming the joint and gap).
+    """
+
+    def __init__(self, segments: Sequence[RuledSurface], *, tol: float = 1e-9) -> None:
+        segs = list(segments)
+        if len(segs) < 1:
+            raise GHTError("a composite developable needs at least one segment")
+        for i, s in enumerate(segs):
+            if not isinstance(s, RuledSurface):
+                raise GHTError(f"segments[{i}] is a {type(s).__name__}, not a RuledSurface")
+        for i in range(len(segs) - 1):
+            A, B = segs[i], segs[i + 1]
+            pa, pb = A.a(1.0)[0], A.b(1.0)[0]
+            qa, qb = B.a(0.0)[0], B.b(0.0)[0]
+            L = max(float(np.linalg.norm(pb - pa)), 1e-300)
+            gap = max(float(np.linalg.norm(pa - qa)), float(np.linalg.norm(pb - qb))) / L
+            if gap > tol:
+                raise DegenerateGeometryError(
+                    f"segments {i} and {i+1} do not share their joint ruling: end points {_fmt(pa)}-{_fmt(pb)} "
+                    f"vs start points {_fmt(qa)}-{_fmt(qb)} (relative gap {gap:.3g} > tol={tol:g}); "
+                    "join them with join_developable (G1 or higher, same boundary planes)"
+                )
+        self.segments = segs
+        self.tol = tol
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+    def developability(self) -> list[Developability]:
+        """Developability degree of every segment."""
+        return [s.developability() for s in self.segments]
+
+    def joints(self, tol: float = 1e-9) -> list[DevelopableJointReport]:
+        """:func:`measure_developable_joint` at every joint (enveloping segments only)."""
+        return [measure_developable_joint(self.segments[i], self.segments[i + 1], tol=tol) for i in range(len(self.segments) - 1)]
+
+    def to_shell(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+        """A shell of one B-spline face per segment with shared joint edges; see
+        :func:`ght_cad.cad.developable_faces.composite_shell`."""
+        from .cad.developable_faces import composite_shell
+
+        return composite_shell(self, tol=tol, **kwargs)
