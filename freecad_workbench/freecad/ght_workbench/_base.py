@@ -174,8 +174,12 @@ class ShapeParameterPanel:
     OK keeps the values, Cancel restores the values the feature had when the panel opened.
     """
 
+    #: the most recently opened panel (for macros and the GUI test)
+    last: "ShapeParameterPanel | None" = None
+
     def __init__(self, obj: Any, names: Sequence[str] | None = None, title: str = "Shape parameters") -> None:
         QtCore, QtWidgets = _qt()
+        ShapeParameterPanel.last = self
         self.obj = obj
         self.names = list(names) if names is not None else [n for n, _ in SHAPE_PARAMETERS if n in obj.PropertiesList]
         self.saved = {n: float(getattr(obj, n)) for n in self.names}

@@ -1,0 +1,163 @@
+"""GUI check, run by the FreeCAD GUI binary under a virtual display (Xvfb):
+
+    xvfb-run -a freecad gui_check.py        (with GHT_FC_OUT=<dir>)
+
+The workbench must be installed in the user's Mod folder (the pytest side links it there). Once
+the event loop runs, the script activates the workbench, checks every command is registered, runs
+each one on a prepared document (selection set as a user would), exercises a task panel's live
+preview, exports STEP/DXF/SVG, saves a screenshot and writes ``gui_result.json``, then exits.
+"""
+
+import json
+import os
+import traceback
+
+import FreeCAD as App
+import FreeCADGui as Gui
+
+try:
+    from PySide2 import QtCore, QtWidgets
+except ImportError:  # pragma: no cover
+    from PySide import QtCore  # type: ignore
+    from PySide import QtGui as QtWidgets  # type: ignore
+
+OUT = os.environ.get("GHT_FC_OUT", "/tmp")
+RESULT = {"steps": [], "errors": []}
+
+
+def step(name, fn):
+    try:
+        value = fn()
+        RESULT["steps"].append({"name": name, "ok": True, "value": value})
+    except Exception:
+        RESULT["steps"].append({"name": name, "ok": False, "error": traceback.format_exc()})
+    finally:
+        if Gui.Control.activeDialog():
+            Gui.Control.closeDialog()
+
+
+def new_objects(doc, before):
+    return [o for o in doc.Objects if o.Name not in before]
+
+
+def run_command(doc, name, select=()):
+    before = {o.Name for o in doc.Objects}
+    Gui.Selection.clearSelection()
+    for obj in select:
+        Gui.Selection.addSelection(obj)
+    Gui.runCommand(name, 0)
+    App.ActiveDocument.recompute()
+    created = new_objects(doc, before)
+    shapes_ok = all(o.Shape.isValid() for o in created if hasattr(o, "Shape") and not o.Shape.isNull())
+    return created, shapes_ok
+
+
+def main():
+    from freecad.ght_workbench import _base
+
+    RESULT["workbenches"] = "GHTWorkbench" in Gui.listWorkbenches()
+    Gui.activateWorkbench("GHTWorkbench")
+    RESULT["active_workbench"] = type(Gui.activeWorkbench()).__name__
+    registered = set(Gui.listCommands())
+    RESULT["commands"] = {name: name in registered for name in _base.COMMANDS}
+    RESULT["toolbars"] = list(Gui.activeWorkbench().listToolbars())
+    doc = App.newDocument("GuiCheck")
+    ctx = {}
+
+    def curve():
+        created, ok = run_command(doc, "GHT_Curve")
+        obj = [o for o in created if o.Proxy.Type == "GHT::Curve"][0]
+        ctx["curve"] = obj
+        panel = _base.ShapeParameterPanel.last
+        dialog_open = bool(Gui.Control.activeDialog())
+        length0 = obj.Shape.Length
+        panel.spins["Mu"].setValue(0.75)  # live preview: the feature recomputes at once
+        live_length = obj.Shape.Length
+        panel.sliders["Gamma"].setValue(-1000)
+        live_gamma = obj.Gamma
+        panel.reject()  # Cancel restores the values the feature had
+        return {
+            "created": len(created), "valid": ok, "dialog_open": dialog_open,
+            "live_changed": abs(live_length - length0) > 1e-6, "slider_gamma": live_gamma,
+            "restored": [obj.Mu, obj.Gamma], "length_restored": abs(obj.Shape.Length - length0) < 1e-9,
+        }
+
+    def composite():
+        created, ok = run_command(doc, "GHT_CompositeCurve")
+        comp = [o for o in created if o.Proxy.Type == "GHT::CompositeCurve"][0]
+        return {"created": len(created), "valid": ok, "joints": list(comp.JointOrders)}
+
+    step("GHT_Curve", curve)
+    step("GHT_CompositeCurve", composite)
+
+    def generic(name, select_key=None, kind=None, store=None):
+        def run():
+            sel = [ctx[select_key]] if select_key else []
+            created, ok = run_command(doc, name, sel)
+            if store:
+                ctx[store] = [o for o in created if getattr(o, "Proxy", None) and o.Proxy.Type == kind][0]
+            return {"created": len(created), "valid": ok}
+        return run
+
+    if "GHT_Developable" in _base.COMMANDS:
+        step("GHT_Developable", generic("GHT_Developable", None, "GHT::Developable", "developable"))
+    if "GHT_SpineDevelopable" in _base.COMMANDS:
+        step("GHT_SpineDevelopable", generic("GHT_SpineDevelopable", "curve", "GHT::SpineDevelopable", "spine"))
+    if "GHT_FlatPattern" in _base.COMMANDS and "developable" in ctx:
+        step("GHT_FlatPattern", generic("GHT_FlatPattern", "developable", "GHT::FlatPattern", "flat"))
+    if "GHT_Optimization" in _base.COMMANDS and "developable" in ctx:
+        step("GHT_Optimization", generic("GHT_Optimization", "developable", "GHT::Optimization", "optimization"))
+    if "GHT_RunOptimization" in _base.COMMANDS and "optimization" in ctx:
+        def run_opt():
+            opt = ctx["optimization"]
+            Gui.Selection.clearSelection()
+            Gui.Selection.addSelection(opt)
+            Gui.runCommand("GHT_RunOptimization", 0)
+            return {"best": opt.BestValue, "initial": opt.InitialValue, "status": opt.Status}
+        step("GHT_RunOptimization", run_opt)
+
+    from freecad.ght_workbench import export
+
+    def exp_step():
+        export.CommandExportSTEP.target = os.path.join(OUT, "gui_export.step")
+        Gui.Selection.clearSelection()
+        Gui.Selection.addSelection(ctx["curve"])
+        Gui.runCommand("GHT_ExportSTEP", 0)
+        return {"exists": os.path.getsize(export.CommandExportSTEP.target) > 0}
+
+    step("GHT_ExportSTEP", exp_step)
+    for name, ext in (("GHT_ExportDXF", ".dxf"), ("GHT_ExportSVG", ".svg")):
+        if "flat" in ctx:
+            def exp_flat(name=name, ext=ext):
+                cls = type(_base.COMMANDS[name])
+                cls.target = os.path.join(OUT, "gui_flat" + ext)
+                Gui.Selection.clearSelection()
+                Gui.Selection.addSelection(ctx["flat"])
+                Gui.runCommand(name, 0)
+                return {"exists": os.path.getsize(cls.target) > 0}
+            step(name, exp_flat)
+
+    def screenshot():
+        Gui.Selection.clearSelection()
+        view = Gui.ActiveDocument.ActiveView
+        view.viewIsometric()
+        view.fitAll()
+        path = os.path.join(OUT, "ght_workbench.png")
+        view.saveImage(path, 1024, 768, "White")
+        return {"path": path, "size": os.path.getsize(path)}
+
+    step("screenshot", screenshot)
+    doc.saveAs(os.path.join(OUT, "gui_check.FCStd"))
+
+
+def finish():
+    try:
+        main()
+    except Exception:
+        RESULT["errors"].append(traceback.format_exc())
+    with open(os.path.join(OUT, "gui_result.json"), "w") as fh:
+        json.dump(RESULT, fh, indent=1, default=str)
+    os._exit(0)
+
+
+QtCore.QTimer.singleShot(200, finish)
