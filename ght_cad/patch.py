@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 from math import floor, log2
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from .curve import GHTCurve
 from .errors import GHTError
 from .seeds import Seed, make_seed
 
-__all__ = ["GHTSurface", "join_patches", "measure_patch_continuity", "basis_bspline"]
+__all__ = ["GHTSurface", "join_patches", "measure_patch_continuity", "basis_bspline", "patches_to_bspline"]
 
 _SIDES = ("u0", "u1", "v0", "v1")
 
@@ -255,7 +255,29 @@ class GHTSurface:
         return pts.min(axis=0), pts.max(axis=0)
 
     # -- conversion --------------------------------------------------------------------------
-    def to_bspline(self, tol: float | None = None, degree: int = 5) -> BSplineSurfaceData:
+    def _auto_tolerances(self, tol: float | None) -> tuple[float, float, float, float]:
+        """(tol, R, tol_u, tol_v): the requested tolerance, the net radius and the 1-D tolerances."""
+        P = self._P
+        if tol is None:
+            lo, hi = self.bounding_box()
+            diag = float(np.linalg.norm(hi - lo))
+            tol = 1e-7 * diag if diag > 0 else 1e-12
+        try:
+            tol = float(tol)
+        except (TypeError, ValueError):
+            raise GHTError(f"tol={tol!r} is not a number; it must be a positive float") from None
+        if not np.isfinite(tol) or tol <= 0:
+            raise GHTError(f"tol={tol!r} is not allowed; it must be a positive finite number")
+        c = P.reshape(-1, self.dim).mean(axis=0)
+        R = max(float(np.linalg.norm(P - c, axis=-1).max()), 1e-300)
+        tau = min(0.45 * tol / R, 0.1)  # then R (2τ + τ²) <= 0.945 tol
+
+        def quantize(x: float) -> float:
+            return 2.0 ** floor(log2(x))
+
+        return tol, R, quantize(tau / np.sqrt(self.degree_u + 1)), quantize(tau / np.sqrt(self.degree_v + 1))
+
+    def to_bspline(self, tol: float | None = None, degree: int = 5, *, basis_tol: float | None = None) -> BSplineSurfaceData:
         r"""Certified B-spline surface ``S~(u,v) = Σ_kl N_k(u) N_l(v) Q_kl`` with ``|S - S~| <= tol``.
 
         ``Q_kl = Σ_ij A_ki B_lj P_ij`` where ``A``, ``B`` are the B-spline forms of the u and v basis
@@ -274,6 +296,8 @@ class GHTSurface:
         Args:
             tol: maximum deviation; default ``1e-7 ×`` the bounding-box diagonal of the patch.
             degree: B-spline degree in u and v.
+            basis_tol: optional upper bound for both 1-D basis tolerances (used by
+                :func:`patches_to_bspline` to give joined patches identical boundary fits).
 
         Returns:
             :class:`BSplineSurfaceData` (``max_deviation`` = the bound; ``info`` holds
@@ -283,25 +307,13 @@ class GHTSurface:
             GHTError: bad tol; ConversionError: unreachable tolerance.
         """
         P = self._P
-        if tol is None:
-            lo, hi = self.bounding_box()
-            diag = float(np.linalg.norm(hi - lo))
-            tol = 1e-7 * diag if diag > 0 else 1e-12
-        tol = float(tol)
-        if not np.isfinite(tol) or tol <= 0:
-            raise GHTError(f"tol={tol!r} is not allowed; it must be a positive finite number")
         m, n = self.degree_u, self.degree_v
+        tol, R, tol_u, tol_v = self._auto_tolerances(tol)
+        if basis_tol is not None:
+            if not (np.isfinite(basis_tol) and basis_tol > 0):
+                raise GHTError(f"basis_tol={basis_tol!r} is not allowed; it must be a positive finite number")
+            tol_u, tol_v = min(tol_u, float(basis_tol)), min(tol_v, float(basis_tol))
         c = P.reshape(-1, self.dim).mean(axis=0)
-        R = float(np.linalg.norm(P - c, axis=-1).max())
-        R = max(R, 1e-300)
-        tau = 0.45 * tol / R  # 2τ + τ² <= 0.9 tol / R for τ <= 0.45 (τ <= 0.45 tol/R and tol/R small)
-        tau = min(tau, 0.1)
-
-        def quantize(x: float) -> float:
-            return 2.0 ** floor(log2(x))
-
-        tol_u = quantize(tau / np.sqrt(m + 1))
-        tol_v = quantize(tau / np.sqrt(n + 1))
         A, ku, dev_u = basis_bspline(m, self._seed_u, tol_u, degree)
         B, kv, dev_v = basis_bspline(n, self._seed_v, tol_v, degree)
         Q = np.einsum("ki,lj,ijd->kld", A, B, P - c) + c
@@ -329,6 +341,31 @@ class GHTSurface:
         if self.dim != 3:
             raise GHTError(f"a CAD face needs a 3-D patch; this patch has dim={self.dim}")
         return make_face(self.to_bspline(tol, degree))
+
+
+def patches_to_bspline(
+    patches: Sequence[GHTSurface], tol: float | None = None, degree: int = 5
+) -> list[BSplineSurfaceData]:
+    r"""Convert joined patches with one common 1-D basis tolerance (see :meth:`GHTSurface.to_bspline`).
+
+    The smallest 1-D tolerance any patch needs is used for all, so two patches that share a
+    boundary basis (as :func:`join_patches` requires) get the *same* B-spline basis along it: the
+    common boundary curves coincide and the cross-boundary derivative conditions
+    (``∂_u S_B = k ∂_u S_A`` etc.) hold in the B-splines to rounding, not just to ``tol``.
+
+    Args:
+        patches: the patches.
+        tol: per-patch maximum deviation (default: each patch's 1e-7 × box diagonal).
+        degree: B-spline degree.
+
+    Returns:
+        One :class:`BSplineSurfaceData` per patch, each within its tolerance.
+    """
+    pats = list(patches)
+    if not pats:
+        raise GHTError("patches is empty")
+    common = min(min(p._auto_tolerances(tol)[2:]) for p in pats)
+    return [p.to_bspline(tol, degree, basis_tol=common) for p in pats]
 
 
 def _row_curves(patch: GHTSurface) -> list[GHTCurve]:
