@@ -1,0 +1,610 @@
+r"""Ready objectives over named shape parameters (spec sections 5, 7, 8).
+
+Every problem is a callable ``problem(X) -> values`` on a population ``X`` of shape
+(pop, dim) whose columns are the *free* shape parameters ``problem.names`` (e.g.
+``("a.mu", "b.gamma")``); the other shape parameters keep their base values. Bounds default to
+the admissible box ``[-1, 1]`` and can be narrowed. Evaluation is vectorized over the
+population: the GHT seed jets ``f0^(r), f2^(r)`` are computed for all parameter sets at the
+Gauss–Legendre nodes at once (:func:`population_basis`), and the basis matrices are contracted
+with the control points in one ``einsum``.
+
+Problems:
+
+* :class:`StripProblem` (problem 1): the ruled strip ``X(u,v) = (1-v) A(u) + v B(u)`` between
+  two 3-D GHT curves paired by their common parameter; objective the developability measure
+  ``R = ∫ (1 - n_a·n_b) du`` (spec section 5), 64-node Gauss–Legendre.
+* :class:`DualCurveFairnessProblem` (problem 2): fairness ``AL = ∫|U'|``, ``En = ∫|U''|²``,
+  ``CVEn = ∫|U'''|²`` (spec section 7) of the dual curve of normalized control planes, singly
+  or as a weighted sum; :meth:`~DualCurveFairnessProblem.build` gives the enveloping
+  developable between two boundary planes.
+* :class:`CurveFairnessProblem`: the same measures for a 3-D (any-dim) GHT curve with a fixed
+  control polygon, and :class:`InterpolationFairnessProblem` for the curve of degree ``k-1``
+  through ``k`` given points (control points re-solved for every parameter set).
+"""
+
+from __future__ import annotations
+
+import math
+from math import comb
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ..basis import bernstein
+from ..curve import GHTCurve, gauss_legendre
+from ..errors import GHTError
+from ..ruled import CurvePairRuledSurface, FunctionRuledSurface, RuledSurface
+
+__all__ = [
+    "ght_seed_jets",
+    "population_basis",
+    "Problem",
+    "StripProblem",
+    "FairnessProblem",
+    "DualCurveFairnessProblem",
+    "CurveFairnessProblem",
+    "InterpolationFairnessProblem",
+    "FAIRNESS_MEASURES",
+    "EnvelopeStrip",
+    "default_strip_problem",
+    "default_dual_problem",
+    "default_interpolation_problem",
+]
+
+SHAPE_NAMES = ("mu", "nu", "gamma")
+FAIRNESS_MEASURES = ("AL", "En", "CVEn")
+_HALF_PI = 0.5 * math.pi
+
+
+# --------------------------------------------------------------------------------------------
+# vectorized GHT basis for many parameter sets
+# --------------------------------------------------------------------------------------------
+def _trig(t: np.ndarray, order: int, ccw: bool) -> tuple[np.ndarray, np.ndarray]:
+    """r-th derivatives of ``x`` and ``x²`` for ``x = sin(πt/2)`` (ccw) or ``cos(πt/2)``."""
+    a = _HALF_PI * t
+    if order == 0:
+        x = np.sin(a) if ccw else np.cos(a)
+        return x, x * x
+    x = _HALF_PI**order * (np.sin(a + order * _HALF_PI) if ccw else np.cos(a + order * _HALF_PI))
+    dcos = math.pi**order * np.cos(math.pi * t + order * _HALF_PI)
+    return x, (-0.5 * dcos if ccw else 0.5 * dcos)
+
+
+def ght_seed_jets(t: np.ndarray, mu: np.ndarray, nu: np.ndarray, gamma: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
+    r"""GHT seed derivatives ``f0^(r)(t), f2^(r)(t)`` for P parameter sets at once.
+
+    ``f0 = (1-w)(1-s)(1-μs) + w(1-t)²``, ``f2 = (1-w)(1-c)(1-νc) + w t²``, ``w = (1+γ)/2``,
+    ``s = sin(πt/2)``, ``c = cos(πt/2)`` (spec section 1), differentiated analytically.
+
+    Args:
+        t: nodes, shape (N,).
+        mu, nu, gamma: shape parameters, shape (P,).
+        order: derivative order 0..3.
+
+    Returns:
+        ``(f0, f2)`` each of shape (P, N).
+    """
+    mu = np.asarray(mu, dtype=float)[:, None]
+    nu = np.asarray(nu, dtype=float)[:, None]
+    w = 0.5 * (1.0 + np.asarray(gamma, dtype=float))[:, None]
+    s, s2 = _trig(t, order, True)
+    c, c2 = _trig(t, order, False)
+    const = 1.0 if order == 0 else 0.0
+    g0 = const - (1.0 + mu) * s + mu * s2
+    g2 = const - (1.0 + nu) * c + nu * c2
+    if order == 0:
+        p0, p2 = (1.0 - t) ** 2, t * t
+    elif order == 1:
+        p0, p2 = -2.0 * (1.0 - t), 2.0 * t
+    elif order == 2:
+        p0 = p2 = np.full_like(t, 2.0)
+    else:
+        p0 = p2 = np.zeros_like(t)
+    return (1.0 - w) * g0 + w * p0, (1.0 - w) * g2 + w * p2
+
+
+def population_basis(
+    t: np.ndarray, degree: int, mu: np.ndarray, nu: np.ndarray, gamma: np.ndarray, derivative: int = 0
+) -> np.ndarray:
+    r"""GHT basis ``b^{(r)}_{i,m}(t)`` for P parameter sets at once, shape (P, N, m+1).
+
+    ``b^{(r)}_{i,m} = Σ_{s=0..r} C(r,s) Σ_{k=0..2} B^{(r-s)}_{i-k,n} f_k^{(s)}``, ``n = m-2``
+    (spec section 2), equal to :func:`ght_cad.basis` row by row.
+    """
+    t = np.asarray(t, dtype=float)
+    n = degree - 2
+    P = np.asarray(mu).shape[0]
+    out = np.zeros((P, t.size, degree + 1))
+    for s in range(derivative + 1):
+        f0, f2 = ght_seed_jets(t, mu, nu, gamma, s)
+        f1 = (1.0 if s == 0 else 0.0) - f0 - f2
+        B = bernstein(t, n, derivative - s)[None, :, :]
+        c = float(comb(derivative, s))
+        for k, fk in enumerate((f0, f1, f2)):
+            out[:, :, k : k + n + 1] += c * B * fk[:, :, None]
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# base class: named free parameters over a base parameter vector
+# --------------------------------------------------------------------------------------------
+class Problem:
+    """A vectorized objective over a chosen subset of named shape parameters.
+
+    Subclasses define ``all_names`` / base values and implement :meth:`evaluate_full` on a
+    full parameter matrix (pop, len(all_names)).
+
+    Attributes:
+        names: the free parameters (columns of X), e.g. ``("a.mu", "b.gamma")``.
+        lb, ub: bounds of the free parameters (inside [-1, 1]).
+        x0: base values of the free parameters (the unoptimized design).
+        label: short name used in tables and plots.
+    """
+
+    label = "problem"
+
+    def __init__(
+        self,
+        all_names: Sequence[str],
+        base: Sequence[float],
+        free: Sequence[str] | None,
+        bounds: Mapping[str, tuple[float, float]] | None,
+    ) -> None:
+        self.all_names = tuple(all_names)
+        self.base = np.asarray(base, dtype=float)
+        if free is None:
+            free = self.all_names
+        if isinstance(free, str):
+            free = (free,)
+        free = tuple(free)
+        if not free:
+            raise GHTError(f"free is empty; choose at least one of {', '.join(self.all_names)}")
+        for name in free:
+            if name not in self.all_names:
+                raise GHTError(f"free parameter {name!r} is unknown; allowed names: {', '.join(self.all_names)}")
+        if len(set(free)) != len(free):
+            raise GHTError(f"free={free!r} repeats a parameter name")
+        self.names = free
+        self._idx = np.array([self.all_names.index(n) for n in free], dtype=int)
+        lb = -np.ones(len(free))
+        ub = np.ones(len(free))
+        for name, (lo, hi) in (bounds or {}).items():
+            if name not in free:
+                raise GHTError(f"bounds given for {name!r}, which is not a free parameter ({', '.join(free)})")
+            lo, hi = float(lo), float(hi)
+            if not (-1.0 <= lo < hi <= 1.0):
+                raise GHTError(
+                    f"bounds for {name!r} = ({lo:g}, {hi:g}) are not allowed; need -1 <= low < high <= 1 "
+                    "(shape parameters live in [-1, 1])"
+                )
+            j = free.index(name)
+            lb[j], ub[j] = lo, hi
+        self.lb, self.ub = lb, ub
+        self.x0 = np.clip(self.base[self._idx], lb, ub)
+
+    # -- parameters ------------------------------------------------------------------------
+    @property
+    def dim(self) -> int:
+        """Number of free parameters."""
+        return len(self.names)
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(lb, ub)`` of the free parameters."""
+        return self.lb.copy(), self.ub.copy()
+
+    def full(self, X: Any) -> np.ndarray:
+        """Full parameter matrix (pop, len(all_names)) with the free columns from ``X``."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if X.shape[1] != self.dim:
+            raise GHTError(f"X has {X.shape[1]} columns; this problem has {self.dim} free parameters {self.names}")
+        F = np.repeat(self.base[None, :], X.shape[0], axis=0)
+        F[:, self._idx] = X
+        return F
+
+    def parameters(self, x: Any) -> dict[str, float]:
+        """All named parameters for one free-parameter vector ``x``."""
+        F = self.full(np.asarray(x, dtype=float).reshape(1, -1))[0]
+        bad = [(n, v) for n, v in zip(self.all_names, F) if not -1.0 <= v <= 1.0]
+        if bad:
+            raise GHTError(f"parameter {bad[0][0]}={bad[0][1]:g} is outside [-1, 1]")
+        return dict(zip(self.all_names, (float(v) for v in F)))
+
+    # -- objective -------------------------------------------------------------------------
+    def evaluate_full(self, F: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def __call__(self, X: Any) -> np.ndarray:
+        """Objective values for a population ``X`` (pop, dim) of free parameters -> (pop,)."""
+        return self.evaluate_full(self.full(X))
+
+    def value(self, x: Any) -> float:
+        """Objective at one free-parameter vector."""
+        return float(self(np.asarray(x, dtype=float).reshape(1, -1))[0])
+
+    # -- result objects --------------------------------------------------------------------
+    def build(self, x: Any) -> Any:  # pragma: no cover - abstract
+        """The geometric object (curve or surface) for free parameters ``x``."""
+        raise NotImplementedError
+
+    def report(self, x: Any) -> dict[str, float]:
+        """Measures of the design at ``x`` (for before/after tables)."""
+        return {"objective": self.value(x)}
+
+
+def _split(all_params: np.ndarray, start: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return all_params[:, start], all_params[:, start + 1], all_params[:, start + 2]
+
+
+# --------------------------------------------------------------------------------------------
+# problem 1: quasi-developable strip between two GHT curves
+# --------------------------------------------------------------------------------------------
+class StripProblem(Problem):
+    r"""Problem 1: make the strip between two GHT boundary curves as developable as possible.
+
+    The ruled surface ``X(u, v) = (1-v) A(u) + v B(u)`` pairs the two curves by their common
+    parameter (:class:`~ght_cad.ruled.CurvePairRuledSurface`). Parameters ``a.mu, a.nu, a.gamma``
+    (curve A) and ``b.mu, b.nu, b.gamma`` (curve B). Objective (spec section 5):
+
+    ``R = ∫_0^1 (1 - n_a·n_b) du``, ``n_a = A'×g/|A'×g|``, ``n_b = B'×g/|B'×g|``, ``g = B - A``,
+
+    by ``nodes``-point Gauss–Legendre quadrature (>= 64). Nodes where a normal is undefined
+    (``A'×g = 0``) make the value ``+inf``.
+
+    Args:
+        curve_a, curve_b: 3-D :class:`GHTCurve` objects (their shape parameters are the base).
+        free: names of the free parameters (default all six).
+        bounds: optional narrower bounds per free name, inside [-1, 1].
+        nodes: Gauss–Legendre nodes (>= 64).
+
+    Raises:
+        GHTError: non-GHT seeds, non-3-D curves, unknown names, bad bounds, nodes < 64.
+    """
+
+    label = "strip R"
+
+    def __init__(
+        self,
+        curve_a: GHTCurve,
+        curve_b: GHTCurve,
+        free: Sequence[str] | None = None,
+        bounds: Mapping[str, tuple[float, float]] | None = None,
+        nodes: int = 64,
+    ) -> None:
+        for nm, c in (("curve_a", curve_a), ("curve_b", curve_b)):
+            if not isinstance(c, GHTCurve) or c.dim != 3:
+                raise GHTError(f"{nm} must be a 3-D GHTCurve, got {c!r}")
+            if c.seed.name != "ght":
+                raise GHTError(f"{nm} uses seed {c.seed.name!r}; shape-parameter problems need the 'ght' seed")
+        if int(nodes) < 64:
+            raise GHTError(f"nodes={nodes} is too few; R uses >= 64 Gauss–Legendre nodes")
+        names = [f"a.{s}" for s in SHAPE_NAMES] + [f"b.{s}" for s in SHAPE_NAMES]
+        super().__init__(names, list(curve_a.shape_parameters) + list(curve_b.shape_parameters), free, bounds)
+        self.curve_a, self.curve_b = curve_a, curve_b
+        self.t, self.w = gauss_legendre(int(nodes))
+
+    def jets(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``A, A', B, B'`` at the nodes for full parameter rows F: each (pop, N, 3)."""
+        out = []
+        for k, c in ((0, self.curve_a), (3, self.curve_b)):
+            mu, nu, ga = _split(F, k)
+            for r in (0, 1):
+                Bm = population_basis(self.t, c.degree, mu, nu, ga, r)
+                out.append(np.einsum("pnj,jd->pnd", Bm, c.control_points))
+        return out[0], out[1], out[2], out[3]
+
+    def evaluate_full(self, F: np.ndarray) -> np.ndarray:
+        A, A1, B, B1 = self.jets(F)
+        g = B - A
+        na = np.cross(A1, g)
+        nb = np.cross(B1, g)
+        la = np.linalg.norm(na, axis=-1)
+        lb = np.linalg.norm(nb, axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dot = np.sum(na * nb, axis=-1) / (la * lb)
+        val = (1.0 - np.clip(dot, -1.0, 1.0)) @ self.w
+        return np.where(np.isfinite(val), val, np.inf)
+
+    def curves(self, x: Any) -> tuple[GHTCurve, GHTCurve]:
+        """The two boundary curves for free parameters ``x``."""
+        p = self.parameters(x)
+        a = GHTCurve(self.curve_a.control_points, p["a.mu"], p["a.nu"], p["a.gamma"])
+        b = GHTCurve(self.curve_b.control_points, p["b.mu"], p["b.nu"], p["b.gamma"])
+        return a, b
+
+    def build(self, x: Any) -> CurvePairRuledSurface:
+        """The strip :class:`~ght_cad.ruled.CurvePairRuledSurface` for free parameters ``x``."""
+        return CurvePairRuledSurface(*self.curves(x))
+
+    def report(self, x: Any) -> dict[str, float]:
+        """``θ_max``, ``θ_rms`` (degrees), ``DD``, ``R`` of the strip (RuledSurface.developability)."""
+        d = self.build(x).developability()
+        return {"theta_max": d.theta_max, "theta_rms": d.theta_rms, "DD": d.dd, "R": d.R}
+
+
+# --------------------------------------------------------------------------------------------
+# problem 2: fairness (AL, En, CVEn)
+# --------------------------------------------------------------------------------------------
+def _weights(objective: Any) -> np.ndarray:
+    """Weights (w_AL, w_En, w_CVEn) from a measure name or a mapping name -> weight."""
+    if isinstance(objective, str):
+        if objective not in FAIRNESS_MEASURES:
+            raise GHTError(f"objective={objective!r} is unknown; use one of {FAIRNESS_MEASURES} or a dict of weights")
+        return np.array([float(objective == m) for m in FAIRNESS_MEASURES])
+    if isinstance(objective, Mapping):
+        w = np.zeros(3)
+        for k, v in objective.items():
+            if k not in FAIRNESS_MEASURES:
+                raise GHTError(f"objective weight key {k!r} is unknown; use {FAIRNESS_MEASURES}")
+            v = float(v)
+            if not (math.isfinite(v) and v >= 0):
+                raise GHTError(f"objective weight {k}={v!r} is not allowed; weights must be finite and >= 0")
+            w[FAIRNESS_MEASURES.index(k)] = v
+        if not np.any(w > 0):
+            raise GHTError(f"objective={dict(objective)!r} has no positive weight")
+        return w
+    raise GHTError(f"objective={objective!r} is not allowed; use 'AL', 'En', 'CVEn' or a dict of weights")
+
+
+class FairnessProblem(Problem):
+    r"""Shared fairness measures of one GHT curve ``X(t)`` (spec section 7).
+
+    ``AL = ∫_0^1 |X'|``, ``En = ∫_0^1 |X''|²``, ``CVEn = ∫_0^1 |X'''|²`` (analytic derivatives,
+    Gauss–Legendre); the objective is ``w1 AL + w2 En + w3 CVEn``. Parameters ``mu, nu, gamma``.
+    """
+
+    degree: int
+
+    def _init_fairness(self, base: Sequence[float], objective: Any, free: Any, bounds: Any, nodes: int) -> None:
+        if int(nodes) < 16:
+            raise GHTError(f"nodes={nodes} is too few; use >= 16 Gauss–Legendre nodes")
+        super().__init__(SHAPE_NAMES, base, free, bounds)
+        self.weights = _weights(objective)
+        self.objective = objective
+        self.t, self.w = gauss_legendre(int(nodes))
+
+    def control_points_for(self, F: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        """Control points per parameter row, (pop, m+1, dim) or (m+1, dim) if fixed."""
+        raise NotImplementedError
+
+    def measures(self, X: Any) -> np.ndarray:
+        """``(AL, En, CVEn)`` for a population of free parameters, shape (pop, 3)."""
+        return self.measures_full(self.full(X))
+
+    def measures_full(self, F: np.ndarray) -> np.ndarray:
+        mu, nu, ga = _split(F, 0)
+        P = self.control_points_for(F)
+        spec = "pnj,jd->pnd" if P.ndim == 2 else "pnj,pjd->pnd"
+        out = np.empty((F.shape[0], 3))
+        for r in (1, 2, 3):
+            D = np.einsum(spec, population_basis(self.t, self.degree, mu, nu, ga, r), P)
+            sq = np.sum(D * D, axis=-1)
+            out[:, r - 1] = (np.sqrt(sq) if r == 1 else sq) @ self.w
+        return np.where(np.isfinite(out), out, np.inf)
+
+    def evaluate_full(self, F: np.ndarray) -> np.ndarray:
+        return self.measures_full(F) @ self.weights
+
+    def report(self, x: Any) -> dict[str, float]:
+        """``AL``, ``En``, ``CVEn`` and the weighted objective at ``x``."""
+        m = self.measures(np.asarray(x, dtype=float).reshape(1, -1))[0]
+        return {"AL": float(m[0]), "En": float(m[1]), "CVEn": float(m[2]), "objective": float(m @ self.weights)}
+
+
+class CurveFairnessProblem(FairnessProblem):
+    """Fairness of a GHT curve with a fixed control polygon (any dimension).
+
+    Args:
+        curve: the :class:`GHTCurve` (its shape parameters are the base design).
+        objective: ``"AL"``, ``"En"``, ``"CVEn"`` or weights ``{"AL": w1, "En": w2, "CVEn": w3}``.
+        free: free names among ``mu, nu, gamma`` (default all).
+        bounds: optional narrower bounds per name.
+        nodes: Gauss–Legendre nodes.
+    """
+
+    label = "curve fairness"
+
+    def __init__(self, curve: GHTCurve, objective: Any = "En", free: Sequence[str] | None = None,
+                 bounds: Mapping[str, tuple[float, float]] | None = None, nodes: int = 64) -> None:
+        if not isinstance(curve, GHTCurve) or curve.seed.name != "ght":
+            raise GHTError(f"curve must be a GHTCurve with the 'ght' seed, got {curve!r}")
+        self.curve = curve
+        self.degree = curve.degree
+        self._init_fairness(curve.shape_parameters, objective, free, bounds, nodes)
+
+    def control_points_for(self, F: np.ndarray) -> np.ndarray:
+        return self.curve.control_points
+
+    def build(self, x: Any) -> GHTCurve:
+        """The curve with shape parameters from ``x``."""
+        p = self.parameters(x)
+        return GHTCurve(self.curve.control_points, p["mu"], p["nu"], p["gamma"])
+
+
+class InterpolationFairnessProblem(FairnessProblem):
+    """Fairest GHT curve of degree ``k-1`` through ``k`` given points (any dimension).
+
+    For each parameter set the control points solve ``Σ_i b_{i,m}(t_j) P_i = Q_j`` (k equations,
+    k unknown points) at parameters ``t_j`` (default: chord length, ``t_0 = 0``, ``t_{k-1} = 1``).
+    The curve passes through every point for all shape parameters; the shape parameters then
+    choose the fairest interpolant (objective as in :class:`CurveFairnessProblem`).
+
+    Raises:
+        GHTError: fewer than 3 points, coincident consecutive points, parameters not strictly
+            increasing from 0 to 1.
+    """
+
+    label = "interpolation fairness"
+
+    def __init__(self, points: Any, parameters: Any = None, objective: Any = "En",
+                 free: Sequence[str] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None,
+                 nodes: int = 64, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0) -> None:
+        Q = np.asarray(points, dtype=float)
+        if Q.ndim != 2 or Q.shape[0] < 3 or not np.all(np.isfinite(Q)):
+            raise GHTError(f"points must be a finite (k, dim) array with k >= 3, got shape {Q.shape}")
+        if parameters is None:
+            d = np.linalg.norm(np.diff(Q, axis=0), axis=1)
+            if np.any(d <= 0):
+                raise GHTError(f"points {int(np.argmin(d))} and {int(np.argmin(d)) + 1} coincide; chord-length parameters need distinct neighbours")
+            tj = np.concatenate([[0.0], np.cumsum(d)]) / np.sum(d)
+        else:
+            tj = np.asarray(parameters, dtype=float).reshape(-1)
+            if tj.size != Q.shape[0] or tj[0] != 0.0 or tj[-1] != 1.0 or np.any(np.diff(tj) <= 0):
+                raise GHTError(f"parameters={tj.tolist()} must increase strictly from 0 to 1, one per point")
+        self.points, self.tj = Q, tj
+        self.degree = Q.shape[0] - 1
+        self._init_fairness((mu, nu, gamma), objective, free, bounds, nodes)
+
+    def control_points_for(self, F: np.ndarray) -> np.ndarray:
+        mu, nu, ga = _split(F, 0)
+        M = population_basis(self.tj, self.degree, mu, nu, ga, 0)      # (pop, k, k)
+        with np.errstate(all="ignore"):
+            try:
+                return np.linalg.solve(M, np.broadcast_to(self.points, (F.shape[0],) + self.points.shape))
+            except np.linalg.LinAlgError:
+                out = np.full((F.shape[0],) + self.points.shape, np.nan)
+                for i in range(F.shape[0]):
+                    try:
+                        out[i] = np.linalg.solve(M[i], self.points)
+                    except np.linalg.LinAlgError:
+                        pass
+                return out
+
+    def build(self, x: Any) -> GHTCurve:
+        """The interpolating curve for free parameters ``x``."""
+        F = self.full(np.asarray(x, dtype=float).reshape(1, -1))
+        p = self.parameters(x)
+        return GHTCurve(self.control_points_for(F)[0], p["mu"], p["nu"], p["gamma"])
+
+
+class EnvelopeStrip(RuledSurface):
+    r"""Enveloping developable of a dual curve, cut by two boundary planes (spec section 5.2).
+
+    ``a(t) = U ∩ U' ∩ E_a``, ``b(t) = U ∩ U' ∩ E_b`` as homogeneous meets ``X = meet(U, U', E)``;
+    ``X' = meet(U, U'', E)`` (the term ``meet(U', U', E)`` vanishes), Cartesian derivative
+    ``(X'_{1:3} X_0 - X_{1:3} X'_0) / X_0²``. A self-contained construction used to check that
+    the optimized surfaces stay developable when :mod:`ght_cad.developable` is not available.
+    """
+
+    def __init__(self, dual: GHTCurve, boundary_planes: Any) -> None:
+        E = np.asarray(boundary_planes, dtype=float)
+        if E.shape != (2, 4) or not np.all(np.isfinite(E)):
+            raise GHTError(f"boundary_planes must be two finite planes, shape (2, 4); got shape {E.shape}")
+        self.dual, self.E = dual, E
+
+    def _end(self, u: Any, derivative: int, E: np.ndarray) -> np.ndarray:
+        from ..planes import meet
+
+        if derivative not in (0, 1):
+            raise GHTError(f"derivative={derivative} is not available here; EnvelopeStrip gives orders 0 and 1")
+        U, U1, U2 = (self.dual.derivative(u, r) for r in (0, 1, 2))
+        X = meet(U, U1, E)
+        if derivative == 0:
+            return X[:, 1:] / X[:, :1]
+        X1 = meet(U, U2, E)
+        return (X1[:, 1:] * X[:, :1] - X[:, 1:] * X1[:, :1]) / X[:, :1] ** 2
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._end(u, derivative, self.E[0])
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._end(u, derivative, self.E[1])
+
+
+class DualCurveFairnessProblem(FairnessProblem):
+    r"""Problem 2: fairness of the dual curve of an enveloping developable (spec sections 5.2, 7).
+
+    The control planes are normalized to unit normals (``U_i / |(u1, u2, u3)|``), the dual curve
+    is ``U(t) = Σ b_{i,m}(t; μ,ν,γ) U_i`` (4-D), and ``AL``, ``En``, ``CVEn`` are measured on it.
+    The envelope is developable for every parameter set; :meth:`build` returns the surface cut by
+    ``boundary_planes`` (``ght_cad.developable_from_planes`` when available, else
+    :class:`EnvelopeStrip`).
+
+    Args:
+        planes: control planes, shape (m+1, 4), m >= 2.
+        boundary_planes: two planes ``E_a, E_b`` (needed only by :meth:`build`).
+        objective: ``"AL"``, ``"En"``, ``"CVEn"`` or a dict of weights.
+        free, bounds, nodes: as in :class:`CurveFairnessProblem`.
+        mu, nu, gamma: base design.
+    """
+
+    label = "dual-curve fairness"
+
+    def __init__(self, planes: Any, boundary_planes: Any = None, objective: Any = "En",
+                 free: Sequence[str] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None,
+                 nodes: int = 64, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0) -> None:
+        from ..planes import check_control_planes, normalize_planes
+
+        U = check_control_planes(planes)
+        self.raw_planes = U
+        self.planes = normalize_planes(U)
+        self.boundary_planes = None if boundary_planes is None else np.asarray(boundary_planes, dtype=float)
+        self.degree = self.planes.shape[0] - 1
+        self._init_fairness((mu, nu, gamma), objective, free, bounds, nodes)
+
+    def control_points_for(self, F: np.ndarray) -> np.ndarray:
+        return self.planes
+
+    def dual_curve(self, x: Any) -> GHTCurve:
+        """The 4-D dual curve of the normalized planes for free parameters ``x``."""
+        p = self.parameters(x)
+        return GHTCurve(self.planes, p["mu"], p["nu"], p["gamma"])
+
+    def build(self, x: Any) -> RuledSurface:
+        """The enveloping developable between the boundary planes for free parameters ``x``.
+
+        Raises:
+            GHTError: no boundary planes were given.
+        """
+        if self.boundary_planes is None:
+            raise GHTError("boundary_planes were not given; the surface needs two cutting planes E_a, E_b")
+        p = self.parameters(x)
+        try:
+            from ..developable import developable_from_planes  # written by another engineer
+        except ImportError:
+            return EnvelopeStrip(self.dual_curve(x), self.boundary_planes)
+        return developable_from_planes(self.planes, self.boundary_planes, p["mu"], p["nu"], p["gamma"])
+
+    def report(self, x: Any) -> dict[str, float]:
+        """AL, En, CVEn, the objective and, with boundary planes, ``θ_max`` and the residual."""
+        out = super().report(x)
+        if self.boundary_planes is not None:
+            d = self.build(x).developability()
+            out["theta_max"] = float(d.theta_max)
+            out["residual_max"] = float(getattr(d, "residual_max", np.nan))
+        return out
+
+
+# --------------------------------------------------------------------------------------------
+# default designs (used by tests, the bench and the demo)
+# --------------------------------------------------------------------------------------------
+def default_strip_problem(free: Sequence[str] | None = None, **kw: Any) -> StripProblem:
+    """A strip between two cubic GHT curves, clearly non-developable at the base design.
+
+    Both end quadrilaterals ``A_0 A_1 B_1 B_0`` and ``A_2 A_3 B_3 B_2`` are planar, so θ(0) =
+    θ(1) = 0 (the end normals do not depend on the shape parameters); the twist is interior and
+    the shape parameters can remove most of it (θ_max 11.3° at all-zero parameters).
+    """
+    A = GHTCurve([[0.2, 0.079, 0.511], [0.982, 1.1, 0.253], [2.173, -0.764, 0.063], [3.032, 0.422, 0.054]])
+    B = GHTCurve([[0.335, 0.303, 1.623], [1.2, 1.43, 1.24], [2.255, -0.042, 1.08], [2.805, 0.769, 1.16]])
+    return StripProblem(A, B, free=free, **kw)
+
+
+def default_dual_problem(objective: Any = "En", **kw: Any) -> DualCurveFairnessProblem:
+    """Four control planes of a tilted, cylinder-like sheet, cut by ``z = 0`` and ``z = 1``.
+
+    Plane i has normal ``(cos φ_i, sin φ_i, k_i)`` and passes through ``p_i``; its edge of
+    regression stays far outside the strip for every parameter set in ``[-1, 1]^3``.
+    """
+    phi = np.radians([0.0, 35.0, 70.0, 100.0])
+    normals = np.column_stack([np.cos(phi), np.sin(phi), [0.05, 0.12, 0.08, 0.1]])
+    through = np.array([[1.0, 0.0, 0.0], [1.1, 0.5, 0.0], [0.4, 1.2, 0.0], [0.0, 1.3, 0.0]])
+    planes = np.column_stack([-np.sum(normals * through, axis=1), normals])
+    boundary = np.array([[0.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, 1.0]])
+    return DualCurveFairnessProblem(planes, boundary, objective=objective, **kw)
+
+
+def default_interpolation_problem(objective: Any = "En", **kw: Any) -> InterpolationFairnessProblem:
+    """Five points of a 3-D space curve (a helix-like arc)."""
+    pts = [[0.0, 0.0, 0.0], [1.0, 0.8, 0.3], [2.0, 1.0, 0.9], [3.0, 0.4, 1.2], [3.6, -0.5, 1.0]]
+    return InterpolationFairnessProblem(pts, objective=objective, **kw)
