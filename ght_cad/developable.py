@@ -854,9 +854,9 @@ class DevelopableJointReport:
 
     Attributes:
         order: projective contact order of the dual curves (-1..3): 0 common tangent plane,
-            1 also common ruling, 2 also common edge-of-regression point (osculating plane of the
-            dual curve), 3 third-order contact. Intrinsic: independent of plane scales and of
-            the parametrization.
+            1 also common ruling, 2 second-order contact (implies a common edge-of-regression
+            point and equal dual curvature), 3 third-order contact. Intrinsic: independent of
+            plane scales and of the parametrization.
         residuals: relative residuals of the order-0..3 conditions.
         plane_angle: angle (degrees) between the end tangent planes.
         ruling_distance: largest distance of A's end ruling endpoints from B's start ruling,
@@ -901,7 +901,8 @@ def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *,
 
     * r=0: ``V = λ0 U``;
     * r=1: ``V' = λ1 U + λ0 φ1 U'`` (common ruling ``U ∩ U'``);
-    * r=2: ``V'' = λ2 U + (2λ1φ1 + λ0φ2) U' + λ0φ1² U''`` (common edge-of-regression point);
+    * r=2: ``V'' = λ2 U + (2λ1φ1 + λ0φ2) U' + λ0φ1² U''`` (implies a common edge-of-regression
+      point ``U ∩ U' ∩ U''``);
     * r=3: ``V''' = λ3 U + (3λ2φ1 + 3λ1φ2 + λ0φ3) U' + (3λ1φ1² + 3λ0φ1φ2) U'' + λ0φ1³ U'''``.
 
     The unknowns are fitted order by order by least squares (new unknowns at order r: ``λ_r`` and
