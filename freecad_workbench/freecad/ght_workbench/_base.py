@@ -79,8 +79,11 @@ class FeatureProxy:
 
     # -- FreeCAD hooks --------------------------------------------------------------------
     def execute(self, obj: Any) -> None:
+        placement = obj.Placement if hasattr(obj, "Placement") else None
         try:
             self.compute(obj)
+            if placement is not None:  # a new Shape carries an identity placement: keep the user's
+                obj.Placement = placement
         except Exception as exc:  # report on the console, keep the old shape, mark the object
             App.Console.PrintError(f"{obj.Label}: {type(exc).__name__}: {exc}\n")
             App.Console.PrintLog(traceback.format_exc() + "\n")

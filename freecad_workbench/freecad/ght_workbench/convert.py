@@ -28,6 +28,8 @@ __all__ = [
     "part_surface",
     "edge_from_data",
     "face_from_data",
+    "ruled_surface_data",
+    "ruled_face",
 ]
 
 # Default fitting tolerance (model units) when a feature does not set one.
@@ -138,3 +140,40 @@ def edge_from_data(data: BSplineCurveData) -> "Part.Edge":
 def face_from_data(data: BSplineSurfaceData) -> "Part.Face":
     """A face on :func:`part_surface` with its natural bounds."""
     return Part.Face(part_surface(data))
+
+
+def ruled_surface_data(surface: Any, tol: float | None = None, degree: int = 5, end_order: int = 2) -> BSplineSurfaceData:
+    r"""B-spline surface data of a ruled strip ``X(u, v) = (1-v) a(u) + v b(u)`` (any ght_cad RuledSurface).
+
+    The 6-D function ``f(u) = (a(u), b(u))`` is fitted once by ``ght_cad.bspline.fit_function``
+    (deviation <= tol at matched parameters, exact end derivatives up to ``end_order``), so both
+    boundary curves share one knot vector and pole ``i`` of ``a`` and of ``b`` belong to the same
+    ruling neighbourhood; the net is ``P[i, 0] = A_i``, ``P[i, 1] = B_i``, degree 1 in v. This keeps
+    the a(u)–b(u) pairing that developability depends on (same data as
+    ``ght_cad.cad.developable_faces.developable_surface_data``, which needs OCP).
+    """
+    if tol is None:
+        g = surface.grid(33, 3).reshape(-1, 3)
+        tol = 1e-7 * max(float(np.linalg.norm(g.max(axis=0) - g.min(axis=0))), 1e-300)
+
+    def f(u: np.ndarray) -> np.ndarray:
+        return np.hstack([surface.a(u), surface.b(u)])
+
+    try:
+        from ght_cad.bspline import fit_function  # type: ignore[attr-defined]
+    except ImportError:
+        curve = _fallback_fit(f, float(tol))
+    else:
+        order = min(end_order, degree - 1)
+        ends = tuple([np.concatenate([surface.a(e, r)[0], surface.b(e, r)[0]]) for r in range(order + 1)] for e in (0.0, 1.0))
+        curve = fit_function(f, tol=float(tol), degree=degree, end_derivatives=ends)
+    poles = np.stack([curve.poles[:, :3], curve.poles[:, 3:]], axis=1)
+    return BSplineSurfaceData(
+        poles, curve.knots, np.array([0.0, 0.0, 1.0, 1.0]), curve.degree, 1, max_deviation=curve.max_deviation, info=dict(curve.info)
+    )
+
+
+def ruled_face(surface: Any, tol: float | None = None) -> tuple["Part.Face", BSplineSurfaceData]:
+    """(``Part.Face`` on :func:`ruled_surface_data`, the data)."""
+    data = ruled_surface_data(surface, tol)
+    return face_from_data(data), data
