@@ -159,9 +159,13 @@ def test_first_end_derivative_closed_form() -> None:
     np.testing.assert_allclose(c.derivative(1.0), (n + e[1, 2]) * (pts[-1] - pts[-2]), atol=1e-13)
 
 
-def test_custom_seed_registration() -> None:
+def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
     """A user-registered seed plugs into the basis and curves."""
+    import ght_cad.seeds
     from ght_cad import Seed, make_seed, register_seed, seed_names
+
+    # keep the global registry as it was after this test
+    monkeypatch.setattr(ght_cad.seeds, "_REGISTRY", dict(ght_cad.seeds._REGISTRY))
 
     class CubicSeed(Seed):
         """f0 = (1-t)^3, f2 = t^3 (admissible: f2'(0) = f0'(1) = 0)."""
