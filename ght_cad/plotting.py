@@ -159,47 +159,67 @@ def _project(points: np.ndarray, azim: float = -60.0, elev: float = 25.0) -> np.
     return np.column_stack([points @ right, points @ up])
 
 
+def _as_curves(curve: Any) -> list[Any]:
+    curves = list(curve) if isinstance(curve, (list, tuple)) else [curve]
+    if not curves:
+        raise GHTError("no curve to plot; give a GHTCurve or a non-empty list of them")
+    return curves
+
+
 def plot_curve(curve: Any, path: str | os.PathLike, show_polygon: bool = True, samples: int = 400) -> Path:
-    r"""Plot a GHT-Bézier curve ``P(t) = Σ b_{i,m}(t) P_i`` with its control polygon.
+    r"""Plot a GHT-Bézier curve ``P(t) = Σ b_{i,m}(t) P_i`` (or several) with the control polygon.
 
     2-D curves are drawn as they are; 3-D curves on a matplotlib 3-D axis; other dimensions use
-    their first two coordinates.
+    their first two coordinates. A list of curves (e.g. joined segments) is drawn in one figure.
 
     Args:
-        curve: a :class:`ght_cad.GHTCurve` (or anything with ``evaluate`` and ``control_points``).
+        curve: a :class:`ght_cad.GHTCurve` (anything with ``evaluate`` and ``control_points``)
+            or a list of them.
         path: PNG file to write (800 x 700 pixels).
-        show_polygon: also draw the control polygon and its points.
-        samples: number of parameter values.
+        show_polygon: also draw the control polygons and their points.
+        samples: number of parameter values per curve.
 
     Returns:
         The written path.
     """
+    curves = _as_curves(curve)
     t = np.linspace(0.0, 1.0, int(samples))
-    pts = np.asarray(curve.evaluate(t), dtype=float)
-    cps = np.asarray(curve.control_points, dtype=float)
     fig = _figure("curve")
-    dim = pts.shape[1]
-    title = f"GHT-Bézier curve, degree {curve.degree}"
-    if hasattr(curve, "shape_parameters"):
-        mu, nu, gamma = curve.shape_parameters
-        title += f"  (μ={mu:g}, ν={nu:g}, γ={gamma:g})"
-    if dim == 3:
-        ax = fig.add_subplot(1, 1, 1, projection="3d")
-        ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], lw=2.0, color="C0", label="curve")
-        if show_polygon:
-            ax.plot(cps[:, 0], cps[:, 1], cps[:, 2], "o--", color="C3", lw=1.0, ms=4, label="control polygon")
+    dims = {int(np.asarray(c.control_points).shape[1]) for c in curves}
+    three_d = dims == {3}
+    if len(curves) == 1:
+        c0 = curves[0]
+        title = f"GHT-Bézier curve, degree {c0.degree}"
+        if hasattr(c0, "shape_parameters"):
+            mu, nu, gamma = c0.shape_parameters
+            title += f"  (μ={mu:g}, ν={nu:g}, γ={gamma:g})"
+    else:
+        title = f"{len(curves)} GHT-Bézier curves"
+    ax = fig.add_subplot(1, 1, 1, projection="3d") if three_d else fig.add_subplot(1, 1, 1)
+    for k, c in enumerate(curves):
+        pts = np.asarray(c.evaluate(t), dtype=float)
+        cps = np.asarray(c.control_points, dtype=float)
+        col = f"C{(2 * k) % 10}"
+        lab = "curve" if len(curves) == 1 else f"curve {k + 1}"
+        poly_lab = "control polygon" if k == 0 else None
+        if three_d:
+            ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], lw=2.0, color=col, label=lab)
+            if show_polygon:
+                ax.plot(cps[:, 0], cps[:, 1], cps[:, 2], "o--", color="C3", lw=0.9, ms=3.5, label=poly_lab)
+        else:
+            y = pts[:, 1] if pts.shape[1] > 1 else np.zeros(len(pts))
+            ax.plot(pts[:, 0], y, lw=2.0, color=col, label=lab)
+            if show_polygon:
+                cy = cps[:, 1] if cps.shape[1] > 1 else np.zeros(len(cps))
+                ax.plot(cps[:, 0], cy, "o--", color="C3", lw=0.9, ms=3.5, label=poly_lab)
+                if len(curves) == 1:
+                    for i, (x, yy) in enumerate(zip(cps[:, 0], cy)):
+                        ax.annotate(f"P{i}", (x, yy), textcoords="offset points", xytext=(4, 4), fontsize=8)
+    if three_d:
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         ax.set_zlabel("z")
     else:
-        ax = fig.add_subplot(1, 1, 1)
-        y = pts[:, 1] if dim > 1 else np.zeros(len(pts))
-        ax.plot(pts[:, 0], y, lw=2.0, color="C0", label="curve")
-        if show_polygon:
-            cy = cps[:, 1] if dim > 1 else np.zeros(len(cps))
-            ax.plot(cps[:, 0], cy, "o--", color="C3", lw=1.0, ms=4, label="control polygon")
-            for i, (x, yy) in enumerate(zip(cps[:, 0], cy)):
-                ax.annotate(f"P{i}", (x, yy), textcoords="offset points", xytext=(4, 4), fontsize=8)
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, lw=0.3)
         ax.set_xlabel("x")
@@ -212,29 +232,46 @@ def plot_curve(curve: Any, path: str | os.PathLike, show_polygon: bool = True, s
 def plot_curvature(curve: Any, path: str | os.PathLike, samples: int = 400) -> Path:
     r"""Plot the curvature ``κ(t) = |P' × P''| / |P'|³`` along a curve (and torsion for 3-D).
 
+    For a list of curves (joined segments) segment k is drawn over ``[k, k+1]``, so a G2 joint
+    shows as a continuous curvature graph and a G1 joint as a jump.
+
     Args:
-        curve: a :class:`ght_cad.GHTCurve`.
+        curve: a :class:`ght_cad.GHTCurve` or a list of them.
         path: PNG file to write (900 x 500 pixels).
-        samples: number of parameter values.
+        samples: number of parameter values per curve.
 
     Returns:
         The written path.
     """
+    curves = _as_curves(curve)
     t = np.linspace(0.0, 1.0, int(samples))
-    kappa = np.asarray(curve.curvature(t), dtype=float)
     fig = _figure("curvature")
     ax = fig.add_subplot(1, 1, 1)
-    ax.plot(t, kappa, lw=1.8, color="C0", label="curvature κ(t)")
-    if getattr(curve, "dim", 0) == 3:
-        tau = np.asarray(curve.torsion(t), dtype=float)
-        if np.all(np.isfinite(tau)) and np.max(np.abs(tau)) > 1e-12:
-            ax.plot(t, tau, lw=1.2, color="C2", ls="--", label="torsion τ(t)")
-    ax.set_xlabel("t")
-    ax.set_ylabel("κ")
-    ax.set_xlim(0.0, 1.0)
+    kmax = 0.0
+    ax2 = None
+    for k, c in enumerate(curves):
+        kappa = np.asarray(c.curvature(t), dtype=float)
+        kmax = max(kmax, float(np.nanmax(kappa)))
+        ax.plot(t + k, kappa, lw=1.8, color="C0", label="curvature κ" if k == 0 else None)
+        if getattr(c, "dim", 0) == 3:
+            tau = np.asarray(c.torsion(t), dtype=float)
+            if np.all(np.isfinite(tau)) and np.max(np.abs(tau)) > 1e-12:
+                if ax2 is None:
+                    ax2 = ax.twinx()
+                    ax2.set_ylabel("torsion τ", color="C2")
+                ax2.plot(t + k, tau, lw=1.0, color="C2", ls="--", label="torsion τ (right axis)" if k == 0 else None)
+        if k:
+            ax.axvline(k, color="0.5", lw=0.6, ls=":")
+    ax.set_xlabel("t" if len(curves) == 1 else "segment index + t")
+    ax.set_ylabel("curvature κ", color="C0")
+    ax.set_xlim(0.0, float(len(curves)))
     ax.grid(True, lw=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(f"Curvature along the curve (max κ = {np.nanmax(kappa):.4g})", fontsize=11)
+    handles, labels = ax.get_legend_handles_labels()
+    if ax2 is not None:
+        h2, l2 = ax2.get_legend_handles_labels()
+        handles, labels = handles + h2, labels + l2
+    ax.legend(handles, labels, fontsize=8, loc="upper left")
+    ax.set_title(f"Curvature along the curve{'s' if len(curves) > 1 else ''} (max κ = {kmax:.4g})", fontsize=11)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -257,7 +294,7 @@ def plot_surface(
         path: PNG file to write (900 x 700 pixels).
         nu, nv: grid resolution along u and v.
         title: figure title.
-        colour_by_theta: colour map on θ(u) in degrees.
+        colour_by_theta: colour map on θ(u) in degrees when θ_max > 0.001° (else one colour).
 
     Returns:
         The written path.
@@ -268,33 +305,40 @@ def plot_surface(
     fig = _figure("surface")
     ax = fig.add_subplot(1, 1, 1, projection="3d")
     u = np.linspace(0.0, 1.0, int(nu))
-    if colour_by_theta and hasattr(surface, "theta"):
+    th = None
+    if hasattr(surface, "theta"):
         th = np.asarray(surface.theta(u), dtype=float)
         th = np.where(np.isfinite(th), th, 0.0)
-        # at least 1 degree on the scale: a developable surface stays pale, not saturated noise
-        norm = colors.Normalize(vmin=0.0, vmax=max(float(th.max()), 1.0))
+    if colour_by_theta and th is not None and float(th.max()) > 1e-3:
+        norm = colors.Normalize(vmin=0.0, vmax=float(th.max()))
         cmap = cm.YlOrRd
         face = cmap(norm(np.repeat(th[:, None], int(nv), axis=1)))
         ax.plot_surface(G[..., 0], G[..., 1], G[..., 2], facecolors=face, shade=True, lw=0.2, edgecolor="0.3")
         sm = cm.ScalarMappable(norm=norm, cmap=cmap)
         sm.set_array(th)
-        fig.colorbar(sm, ax=ax, shrink=0.6, label="θ(u) [deg]")
+        fig.colorbar(sm, ax=ax, shrink=0.5, pad=0.12, label="θ(u) [deg]")
     else:
-        ax.plot_surface(G[..., 0], G[..., 1], G[..., 2], color="#7fa7d0", shade=True, lw=0.2, edgecolor="0.3")
+        ax.plot_surface(G[..., 0], G[..., 1], G[..., 2], color="#8fb3dc", shade=True, lw=0.2, edgecolor="0.45")
     # rulings
     for i in range(0, int(nu), max(1, int(nu) // 10)):
         ax.plot(G[i, :, 0], G[i, :, 1], G[i, :, 2], color="k", lw=0.6)
     lo = G.reshape(-1, 3).min(axis=0)
     hi = G.reshape(-1, 3).max(axis=0)
     span = float(np.max(hi - lo)) or 1.0
+    # true proportions, but no axis thinner than 20 % of the largest (keeps long plates visible)
+    ext = np.maximum(hi - lo, 0.2 * span)
     mid = 0.5 * (lo + hi)
-    ax.set_xlim(mid[0] - span / 2, mid[0] + span / 2)
-    ax.set_ylim(mid[1] - span / 2, mid[1] + span / 2)
-    ax.set_zlim(mid[2] - span / 2, mid[2] + span / 2)
+    ax.set_xlim(mid[0] - ext[0] / 2, mid[0] + ext[0] / 2)
+    ax.set_ylim(mid[1] - ext[1] / 2, mid[1] + ext[1] / 2)
+    ax.set_zlim(mid[2] - ext[2] / 2, mid[2] + ext[2] / 2)
+    ax.set_box_aspect(tuple(float(e) for e in ext / ext.max()), zoom=1.1)
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     ax.set_zlabel("z")
-    ax.set_title(title or "Developable surface", fontsize=11)
+    head = title or "Ruled surface"
+    if th is not None:
+        head += f"  (θ_max = {float(th.max()):.2g}°)"
+    ax.set_title(head, fontsize=11)
     return _save(fig, path)
 
 

@@ -1,0 +1,1308 @@
+r"""Design files (TOML): schema, validation and the pipeline runner behind ``ght-cad run``/``demo``.
+
+A design file describes GHT-Bézier curves (control points and shape parameters, optional joins),
+one surface (an enveloping developable from control planes, spec 5.2, or a ruled strip between
+two curves), an optional shape-parameter optimization and the outputs to write. The schema is
+documented in ``docs/design-files.md``; :func:`parse_design` validates a parsed file completely
+before anything is computed, and every error is one line naming the file, the key and the
+allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.errors.GHTError`, so
+``ght-cad`` exits with code 2).
+
+:func:`run_design` computes everything into a temporary folder beside the output folder and moves
+the files in only when every step succeeded, so a failure leaves the output folder untouched.
+
+Imports numpy at module level only; scipy, matplotlib and the CAD kernel are imported inside the
+functions that need them.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
+
+from .errors import GHTError
+
+__all__ = [
+    "DesignError",
+    "Design",
+    "CurveSpec",
+    "JoinSpec",
+    "SurfaceSpec",
+    "OptimizeSpec",
+    "UnrollSpec",
+    "OutputSpec",
+    "FILE_OUTPUTS",
+    "FIGURE_OUTPUTS",
+    "load_design",
+    "parse_design",
+    "parse_design_text",
+    "build_curves",
+    "build_surface",
+    "BuiltSurface",
+    "surface_summary",
+    "optimize_design",
+    "unroll_surface",
+    "pattern_errors",
+    "export_step",
+    "export_files",
+    "plot_pattern",
+    "run_design",
+    "dual_curve_objectives",
+]
+
+#: file outputs a design may request
+FILE_OUTPUTS = ("step", "dxf", "svg", "json", "md")
+#: figures a design may request (PNG)
+FIGURE_OUTPUTS = ("basis", "curve", "curvature", "surface", "flat_pattern", "convergence")
+#: optimizers
+METHODS = ("pso", "gwo", "igwo")
+#: objectives: fairness of the dual curve (planes) or developability R (curve-pair strips)
+PLANE_OBJECTIVES = ("AL", "En", "CVEn", "weighted")
+STRIP_OBJECTIVES = ("R",)
+SURFACE_TYPES = ("planes", "curves")
+CONTINUITIES = ("C0", "C1", "C2", "C3", "G0", "G1", "G2", "G3")
+UNITS = ("mm", "cm", "m", "in", "ft")
+SHAPE_NAMES = ("mu", "nu", "gamma")
+
+# output file names inside the output folder
+FILE_NAMES = {
+    "step": "model.step",
+    "dxf": "flat_pattern.dxf",
+    "svg": "flat_pattern.svg",
+    "json": "report.json",
+    "md": "report.md",
+}
+FIGURE_NAMES = {k: f"{k}.png" for k in FIGURE_OUTPUTS}
+
+
+class DesignError(GHTError):
+    """An invalid design file: one line naming the file, the key and the allowed values."""
+
+
+# ---------------------------------------------------------------------------------------------
+# schema
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class CurveSpec:
+    """One GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i`` of a design."""
+
+    name: str
+    control_points: list[list[float]]
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+
+
+@dataclass
+class JoinSpec:
+    """Re-solve the first points of curve ``second`` so that it meets ``first`` (spec section 4)."""
+
+    first: str
+    second: str
+    continuity: str = "G1"
+    k: float = 1.0
+    beta2: float = 0.0
+    beta3: float = 0.0
+
+
+@dataclass
+class SurfaceSpec:
+    """The design's surface: ``type = "planes"`` (spec 5.2) or ``"curves"`` (ruled strip)."""
+
+    type: str
+    planes: list[list[float]] | None = None
+    boundary_planes: list[list[float]] | None = None
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+    curve_a: str | None = None
+    curve_b: str | None = None
+    normalize: bool = True
+
+
+@dataclass
+class OptimizeSpec:
+    """Shape-parameter optimization (spec sections 7, 8)."""
+
+    method: str = "igwo"
+    objective: str = "CVEn"
+    weights: list[float] = field(default_factory=lambda: [1.0, 0.0, 0.0])
+    parameters: list[str] = field(default_factory=lambda: list(SHAPE_NAMES))
+    population: int = 20
+    iterations: int = 40
+    seed: int = 1
+
+
+@dataclass
+class UnrollSpec:
+    """Flat-pattern options (see :func:`ght_cad.unroll`)."""
+
+    rulings: int = 16
+    tol_deg: float = 0.01
+
+
+@dataclass
+class OutputSpec:
+    """Which files and figures to write."""
+
+    files: list[str] = field(default_factory=lambda: list(FILE_OUTPUTS))
+    figures: list[str] = field(default_factory=lambda: list(FIGURE_OUTPUTS))
+
+
+@dataclass
+class Design:
+    """A validated design (see ``docs/design-files.md``)."""
+
+    name: str
+    units: str = "mm"
+    curves: list[CurveSpec] = field(default_factory=list)
+    joins: list[JoinSpec] = field(default_factory=list)
+    surface: SurfaceSpec | None = None
+    optimize: OptimizeSpec | None = None
+    unroll: UnrollSpec = field(default_factory=UnrollSpec)
+    outputs: OutputSpec = field(default_factory=OutputSpec)
+    source: str = "<design>"
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (as it would be written in TOML)."""
+        from dataclasses import asdict
+
+        d = asdict(self)
+        d.pop("source")
+        return d
+
+
+# ---------------------------------------------------------------------------------------------
+# validation
+# ---------------------------------------------------------------------------------------------
+def _tname(v: Any) -> str:
+    if isinstance(v, bool):
+        return "boolean"
+    if isinstance(v, int):
+        return "integer"
+    if isinstance(v, float):
+        return "float"
+    if isinstance(v, str):
+        return "string"
+    if isinstance(v, list):
+        return "array"
+    if isinstance(v, dict):
+        return "table"
+    return type(v).__name__
+
+
+def _short(v: Any) -> str:
+    s = repr(v)
+    return s if len(s) <= 60 else s[:57] + "..."
+
+
+class _Checker:
+    """Typed getters that raise :class:`DesignError` naming ``source``, the key and what is allowed."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, key: str, message: str) -> DesignError:
+        return DesignError(f"{self.source}: key '{key}': {message}")
+
+    def table(self, data: dict, key: str, path: str, *, required: bool = False) -> dict | None:
+        if key not in data:
+            if required:
+                raise self.fail(path, "missing; this table is required")
+            return None
+        v = data[key]
+        if not isinstance(v, dict):
+            raise self.fail(path, f"expected a table [{path}], got {_tname(v)} {_short(v)}")
+        return v
+
+    def keys(self, tbl: dict, path: str, allowed: Sequence[str]) -> None:
+        for k in tbl:
+            if k not in allowed:
+                where = f"{path}.{k}" if path else k
+                raise self.fail(where, f"unknown key; allowed keys{' in ' + path if path else ''}: {', '.join(allowed)}")
+
+    def required(self, tbl: dict, key: str, path: str, what: str) -> Any:
+        if key not in tbl:
+            raise self.fail(f"{path}.{key}" if path else key, f"missing; required: {what}")
+        return tbl[key]
+
+    def number(self, tbl: dict, key: str, path: str, default: float | None = None, *,
+               lo: float | None = None, hi: float | None = None, lo_open: bool = False,
+               required: bool = False, allowed: str | None = None) -> float:
+        full = f"{path}.{key}" if path else key
+        rng = allowed or _range_text(lo, hi, lo_open)
+        if key not in tbl:
+            if required or default is None:
+                raise self.fail(full, f"missing; required: a number {rng}")
+            return default
+        v = tbl[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise self.fail(full, f"expected a number {rng}, got {_tname(v)} {_short(v)}")
+        x = float(v)
+        if not math.isfinite(x):
+            raise self.fail(full, f"{x} is not finite; allowed: a number {rng}")
+        if (lo is not None and (x <= lo if lo_open else x < lo)) or (hi is not None and x > hi):
+            raise self.fail(full, f"{x:g} is out of range; allowed: {rng}")
+        return x
+
+    def integer(self, tbl: dict, key: str, path: str, default: int, *, lo: int, hi: int) -> int:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return default
+        v = tbl[key]
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise self.fail(full, f"expected an integer in [{lo}, {hi}], got {_tname(v)} {_short(v)}")
+        if not lo <= v <= hi:
+            raise self.fail(full, f"{v} is out of range; allowed: an integer in [{lo}, {hi}]")
+        return int(v)
+
+    def string(self, tbl: dict, key: str, path: str, default: str | None = None, *,
+               choices: Sequence[str] | None = None, required: bool = False) -> str:
+        full = f"{path}.{key}" if path else key
+        allowed = f"one of {', '.join(choices)}" if choices else "a non-empty string"
+        if key not in tbl:
+            if required or default is None:
+                raise self.fail(full, f"missing; required: {allowed}")
+            return default
+        v = tbl[key]
+        if not isinstance(v, str):
+            raise self.fail(full, f"expected a string ({allowed}), got {_tname(v)} {_short(v)}")
+        if choices is not None:
+            match = [c for c in choices if c.lower() == v.lower()]
+            if not match:
+                raise self.fail(full, f"{v!r} is not allowed; allowed: {', '.join(choices)}")
+            return match[0]
+        if not v.strip():
+            raise self.fail(full, "is empty; allowed: a non-empty string")
+        return v
+
+    def matrix(self, tbl: dict, key: str, path: str, *, cols: Sequence[int], min_rows: int,
+               max_rows: int | None = None, required: bool = True) -> list[list[float]] | None:
+        full = f"{path}.{key}" if path else key
+        colt = " or ".join(str(c) for c in cols)
+        what = f"an array of at least {min_rows} arrays of {colt} numbers" if max_rows != min_rows else \
+            f"an array of exactly {min_rows} arrays of {colt} numbers"
+        if key not in tbl:
+            if required:
+                raise self.fail(full, f"missing; required: {what}")
+            return None
+        v = tbl[key]
+        if not isinstance(v, list) or not all(isinstance(r, list) for r in v):
+            raise self.fail(full, f"expected {what}, got {_tname(v)} {_short(v)}")
+        if len(v) < min_rows or (max_rows is not None and len(v) > max_rows):
+            raise self.fail(full, f"has {len(v)} rows; allowed: {what}")
+        n = len(v[0])
+        out = []
+        for i, row in enumerate(v):
+            if len(row) != n or n not in cols:
+                raise self.fail(f"{full}[{i}]", f"has {len(row)} numbers; allowed: {colt} numbers, the same for every row")
+            vals = []
+            for j, x in enumerate(row):
+                if isinstance(x, bool) or not isinstance(x, (int, float)):
+                    raise self.fail(f"{full}[{i}][{j}]", f"expected a number, got {_tname(x)} {_short(x)}")
+                if not math.isfinite(float(x)):
+                    raise self.fail(f"{full}[{i}][{j}]", f"{x} is not finite; allowed: a finite number")
+                vals.append(float(x))
+            out.append(vals)
+        return out
+
+    def boolean(self, tbl: dict, key: str, path: str, default: bool) -> bool:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return default
+        v = tbl[key]
+        if not isinstance(v, bool):
+            raise self.fail(full, f"expected a boolean (true or false), got {_tname(v)} {_short(v)}")
+        return v
+
+    def string_list(self, tbl: dict, key: str, path: str, default: list[str], *, choices: Sequence[str]) -> list[str]:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return list(default)
+        v = tbl[key]
+        if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+            raise self.fail(full, f"expected an array of strings from: {', '.join(choices)}; got {_tname(v)} {_short(v)}")
+        out = []
+        for x in v:
+            match = [c for c in choices if c.lower() == x.lower()]
+            if not match:
+                raise self.fail(full, f"{x!r} is not allowed; allowed: {', '.join(choices)}")
+            if match[0] not in out:
+                out.append(match[0])
+        return out
+
+
+def _range_text(lo: float | None, hi: float | None, lo_open: bool = False) -> str:
+    if lo is not None and hi is not None:
+        return f"in [{lo:g}, {hi:g}]"
+    if lo is not None:
+        return f"{'>' if lo_open else '>='} {lo:g}"
+    if hi is not None:
+        return f"<= {hi:g}"
+    return ""
+
+
+_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "optimize", "unroll", "outputs")
+
+
+def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
+    """Validate a parsed design file (a dict from ``tomllib``) and return a :class:`Design`.
+
+    Every check names ``source``, the key and the allowed values.
+
+    Args:
+        data: the parsed TOML document.
+        source: file name used in error messages.
+
+    Returns:
+        The validated design.
+
+    Raises:
+        DesignError: missing key, wrong type, value out of range, unknown key or unknown output.
+    """
+    ck = _Checker(source)
+    if not isinstance(data, dict):
+        raise DesignError(f"{source}: the document must be a TOML table")
+    ck.keys(data, "", _TOP_KEYS)
+    default_name = Path(source).stem if not source.startswith("<") else "design"
+    name = ck.string(data, "name", "", default_name or "design")
+    units = ck.string(data, "units", "", "mm", choices=UNITS)
+
+    # curves
+    curves: list[CurveSpec] = []
+    raw_curves = data.get("curves", [])
+    if not isinstance(raw_curves, list) or not all(isinstance(c, dict) for c in raw_curves):
+        raise ck.fail("curves", f"expected an array of tables [[curves]], got {_tname(raw_curves)}")
+    seen: set[str] = set()
+    for i, c in enumerate(raw_curves):
+        path = f"curves[{i}]"
+        ck.keys(c, path, ("name", "control_points", "mu", "nu", "gamma"))
+        cname = ck.string(c, "name", path, f"curve{i + 1}")
+        if cname in seen:
+            raise ck.fail(f"{path}.name", f"{cname!r} is used twice; allowed: a name unique among [[curves]]")
+        seen.add(cname)
+        pts = ck.matrix(c, "control_points", path, cols=(2, 3), min_rows=3)
+        shape = {k: ck.number(c, k, path, 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
+        curves.append(CurveSpec(cname, pts, **shape))  # type: ignore[arg-type]
+
+    # joins
+    joins: list[JoinSpec] = []
+    raw_joins = data.get("joins", [])
+    if not isinstance(raw_joins, list) or not all(isinstance(j, dict) for j in raw_joins):
+        raise ck.fail("joins", f"expected an array of tables [[joins]], got {_tname(raw_joins)}")
+    for i, j in enumerate(raw_joins):
+        path = f"joins[{i}]"
+        ck.keys(j, path, ("first", "second", "continuity", "k", "beta2", "beta3"))
+        names = sorted(seen) or ["(no curves defined)"]
+        first = ck.string(j, "first", path, required=True, choices=names if seen else None)
+        second = ck.string(j, "second", path, required=True, choices=names if seen else None)
+        if not seen:
+            raise ck.fail(f"{path}.first", "refers to a curve but no [[curves]] are defined")
+        if first == second:
+            raise ck.fail(f"{path}.second", f"{second!r} equals first; allowed: another curve name from {', '.join(names)}")
+        cont = ck.string(j, "continuity", path, "G1", choices=CONTINUITIES)
+        k = ck.number(j, "k", path, 1.0, lo=0.0, lo_open=True)
+        b2 = ck.number(j, "beta2", path, 0.0)
+        b3 = ck.number(j, "beta3", path, 0.0)
+        joins.append(JoinSpec(first, second, cont, k, b2, b3))
+    seconds = [j.second for j in joins]
+    for s in seconds:
+        if seconds.count(s) > 1:
+            raise ck.fail("joins", f"curve {s!r} is the 'second' of two joins; allowed: each curve re-solved at most once")
+
+    # surface
+    surface = None
+    st = ck.table(data, "surface", "surface")
+    if st is not None:
+        stype = ck.string(st, "type", "surface", "planes", choices=SURFACE_TYPES)
+        if stype == "planes":
+            ck.keys(st, "surface", ("type", "planes", "boundary_planes", "mu", "nu", "gamma", "normalize"))
+            planes = ck.matrix(st, "planes", "surface", cols=(4,), min_rows=3)
+            bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
+            for key, rows in (("planes", planes), ("boundary_planes", bplanes)):
+                for i, r in enumerate(rows or []):
+                    if math.hypot(*r[1:]) < 1e-12:
+                        raise ck.fail(f"surface.{key}[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
+            shape = {k: ck.number(st, k, "surface", 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
+            normalize = ck.boolean(st, "normalize", "surface", True)
+            surface = SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
+        else:
+            ck.keys(st, "surface", ("type", "curve_a", "curve_b"))
+            names = sorted(seen)
+            if not names:
+                raise ck.fail("surface.curve_a", "a 'curves' surface needs two 3-D [[curves]]; none are defined")
+            ca = ck.string(st, "curve_a", "surface", required=True, choices=names)
+            cb = ck.string(st, "curve_b", "surface", required=True, choices=names)
+            for key, cn in (("curve_a", ca), ("curve_b", cb)):
+                spec = next(c for c in curves if c.name == cn)
+                if len(spec.control_points[0]) != 3:
+                    raise ck.fail(f"surface.{key}", f"curve {cn!r} is 2-D; allowed: a 3-D curve")
+            if ca == cb:
+                raise ck.fail("surface.curve_b", f"{cb!r} equals curve_a; allowed: another 3-D curve")
+            surface = SurfaceSpec("curves", curve_a=ca, curve_b=cb)
+
+    # optimize
+    optimize = None
+    ot = ck.table(data, "optimize", "optimize")
+    if ot is not None:
+        if surface is None:
+            raise ck.fail("optimize", "needs a [surface] table to optimize")
+        ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
+        method = ck.string(ot, "method", "optimize", "igwo", choices=METHODS)
+        objs = PLANE_OBJECTIVES if surface.type == "planes" else STRIP_OBJECTIVES
+        objective = ck.string(ot, "objective", "optimize", objs[2] if surface.type == "planes" else "R", choices=objs)
+        weights = [1.0, 0.0, 0.0]
+        if "weights" in ot:
+            w = ot["weights"]
+            if (not isinstance(w, list) or len(w) != 3
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in w)
+                    or not any(x > 0 for x in w)):
+                raise ck.fail("optimize.weights", f"{_short(w)} is not allowed; allowed: three numbers >= 0 (weights of AL, En, CVEn), not all 0")
+            weights = [float(x) for x in w]
+        if surface.type == "planes":
+            pchoices: tuple[str, ...] = SHAPE_NAMES
+        else:
+            pchoices = tuple(f"{s}.{k}" for s in ("a", "b") for k in SHAPE_NAMES)
+        params = ck.string_list(ot, "parameters", "optimize", list(pchoices), choices=pchoices)
+        if not params:
+            raise ck.fail("optimize.parameters", f"is empty; allowed: a non-empty subset of {', '.join(pchoices)}")
+        pop = ck.integer(ot, "population", "optimize", 20, lo=4, hi=500)
+        its = ck.integer(ot, "iterations", "optimize", 40, lo=1, hi=5000)
+        seed = ck.integer(ot, "seed", "optimize", 1, lo=0, hi=2**32 - 1)
+        optimize = OptimizeSpec(method, objective, weights, params, pop, its, seed)
+
+    # unroll
+    unroll = UnrollSpec()
+    ut = ck.table(data, "unroll", "unroll")
+    if ut is not None:
+        ck.keys(ut, "unroll", ("rulings", "tol_deg"))
+        unroll = UnrollSpec(ck.integer(ut, "rulings", "unroll", 16, lo=0, hi=1000),
+                            ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True))
+
+    # outputs
+    outputs = OutputSpec()
+    ot2 = ck.table(data, "outputs", "outputs")
+    if ot2 is not None:
+        ck.keys(ot2, "outputs", ("files", "figures"))
+        outputs = OutputSpec(ck.string_list(ot2, "files", "outputs", list(FILE_OUTPUTS), choices=FILE_OUTPUTS),
+                             ck.string_list(ot2, "figures", "outputs", list(FIGURE_OUTPUTS), choices=FIGURE_OUTPUTS))
+    if surface is None:
+        needs = [f for f in outputs.files if f in ("dxf", "svg")] + [f for f in outputs.figures if f in ("surface", "flat_pattern")]
+        if needs and ot2 is not None:
+            raise ck.fail("outputs", f"{', '.join(needs)} need a [surface] table; allowed without one: step, json, md, basis, curve, curvature")
+        outputs.files = [f for f in outputs.files if f not in ("dxf", "svg")]
+        outputs.figures = [f for f in outputs.figures if f not in ("surface", "flat_pattern")]
+        if not curves:
+            raise ck.fail("surface", "missing; a design needs a [surface] table or at least one [[curves]] entry")
+    explicit_figs = ot2 is not None and "figures" in ot2
+    if optimize is None:
+        if explicit_figs and "convergence" in outputs.figures:
+            raise ck.fail("outputs.figures", "'convergence' needs an [optimize] table; allowed without one: "
+                          + ", ".join(f for f in FIGURE_OUTPUTS if f != "convergence"))
+        outputs.figures = [f for f in outputs.figures if f != "convergence"]
+    if not curves:
+        if explicit_figs and any(f in ("curve", "curvature") for f in outputs.figures):
+            raise ck.fail("outputs.figures", "'curve' and 'curvature' need at least one [[curves]] entry; allowed without: "
+                          + ", ".join(f for f in FIGURE_OUTPUTS if f not in ("curve", "curvature")))
+        outputs.figures = [f for f in outputs.figures if f not in ("curve", "curvature")]
+    if not outputs.files and not outputs.figures:
+        raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
+    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source)
+
+
+def parse_design_text(text: str, source: str = "<design>") -> Design:
+    """Parse TOML text and validate it (see :func:`parse_design`)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib  # type: ignore[no-redef]
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise DesignError(f"{source}: not valid TOML: {' '.join(str(exc).split())}") from None
+    return parse_design(data, source)
+
+
+def load_design(path: str | os.PathLike) -> Design:
+    """Read and validate a design file.
+
+    Raises:
+        DesignError: unreadable file, invalid TOML or an invalid design (one-line message).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DesignError(f"{p}: no such design file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DesignError(f"{p}: cannot read the design file: {exc}") from None
+    return parse_design_text(text, str(p))
+
+
+# ---------------------------------------------------------------------------------------------
+# building
+# ---------------------------------------------------------------------------------------------
+GHT_DEFINITION = (
+    "GHT seed (this project's definition, spec section 1): f0 = (1-w)(1-s)(1-mu s) + w(1-t)^2, "
+    "f2 = (1-w)(1-c)(1-nu c) + w t^2, f1 = 1 - f0 - f2, s = sin(pi t/2), c = cos(pi t/2), "
+    "w = (1+gamma)/2; degree m: b_i,m = B_i,m-2 f0 + B_i-1,m-2 f1 + B_i-2,m-2 f2"
+)
+
+
+def build_curves(design: Design) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """GHT curves of the design with its joins applied, and a measured report per join.
+
+    Joins are applied in file order: ``second`` gets its first ``r+1`` control points re-solved
+    (:func:`ght_cad.continuity.join`) so that the joint ``first(1) → second(0)`` has the requested
+    continuity; :func:`ght_cad.continuity.measure_continuity` then measures it independently.
+
+    Returns:
+        ``({name: GHTCurve}, [join report dicts])``.
+    """
+    from .curve import GHTCurve
+
+    curves: dict[str, Any] = {}
+    for c in design.curves:
+        curves[c.name] = GHTCurve(c.control_points, c.mu, c.nu, c.gamma)
+    reports = []
+    for j in design.joins:
+        from .continuity import join, measure_continuity
+
+        a, b = curves[j.first], curves[j.second]
+        if a.dim != b.dim:
+            raise DesignError(
+                f"{design.source}: key 'joins': curves {j.first!r} (dim {a.dim}) and {j.second!r} (dim {b.dim}) "
+                "have different dimensions; allowed: curves of the same dimension"
+            )
+        geometric = j.continuity.startswith("G")
+        kw = {"k": j.k, "beta2": j.beta2, "beta3": j.beta3} if geometric else {}
+        curves[j.second] = join(a, j.continuity, b, **kw)
+        rep = measure_continuity(a, curves[j.second])
+        reports.append(
+            {
+                "first": j.first,
+                "second": j.second,
+                "requested": j.continuity,
+                "achieved_C": int(rep.c_order),
+                "achieved_G": int(rep.g_order),
+                "satisfied": bool(rep.satisfies(j.continuity)),
+                "c_residuals": [float(x) for x in rep.c_residuals],
+                "g_residuals": [float(x) for x in rep.g_residuals],
+                "tol": float(rep.tol),
+            }
+        )
+    return curves, reports
+
+
+@dataclass
+class BuiltSurface:
+    """A design's surface with the shape parameters it was built with."""
+
+    design: Design
+    surface: Any
+    curves: dict[str, Any]
+    shape: dict[str, float]
+
+
+def _shape_names(spec: SurfaceSpec) -> tuple[str, ...]:
+    if spec.type == "planes":
+        return SHAPE_NAMES
+    return tuple(f"{s}.{k}" for s in ("a", "b") for k in SHAPE_NAMES)
+
+
+def _initial_shape(design: Design, curves: dict[str, Any]) -> dict[str, float]:
+    spec = design.surface
+    assert spec is not None
+    if spec.type == "planes":
+        return {"mu": spec.mu, "nu": spec.nu, "gamma": spec.gamma}
+    out = {}
+    for side, cname in (("a", spec.curve_a), ("b", spec.curve_b)):
+        c = curves[cname]
+        out.update({f"{side}.mu": c.mu, f"{side}.nu": c.nu, f"{side}.gamma": c.gamma})
+    return out
+
+
+def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float]) -> Any:
+    spec = design.surface
+    assert spec is not None
+    if spec.type == "planes":
+        from .developable import developable_from_planes
+
+        return developable_from_planes(
+            spec.planes, spec.boundary_planes, shape["mu"], shape["nu"], shape["gamma"], normalize=spec.normalize
+        )
+    from .ruled import CurvePairRuledSurface
+
+    ca = curves[spec.curve_a].with_shape(shape["a.mu"], shape["a.nu"], shape["a.gamma"])
+    cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
+    return CurvePairRuledSurface(ca, cb)
+
+
+def build_surface(design: Design, shape: dict[str, float] | None = None,
+                  curves: dict[str, Any] | None = None) -> BuiltSurface:
+    """Build the design's surface with its own (or the given) shape parameters.
+
+    Raises:
+        DesignError: the design has no [surface] table.
+        GHTError: degenerate geometry (parallel planes, edge of regression inside the strip, ...).
+    """
+    if design.surface is None:
+        raise DesignError(f"{design.source}: key 'surface': missing; this command needs a [surface] table")
+    if curves is None:
+        curves, _ = build_curves(design)
+    sh = dict(_initial_shape(design, curves))
+    if shape:
+        sh.update(shape)
+    try:
+        surf = _make_surface(design, curves, sh)
+    except DesignError:
+        raise
+    except GHTError as exc:
+        raise type(exc)(f"{design.source}: [surface]: {' '.join(str(exc).split())}") from None
+    return BuiltSurface(design, surf, curves, sh)
+
+
+def ruled_area(surface: Any, nodes: int = 64) -> float:
+    r"""Area ``∫_0^1 ∫_0^1 |X_u × X_v| dv du`` of a ruled surface (Gauss–Legendre, both directions)."""
+    from .curve import gauss_legendre
+
+    t, w = gauss_legendre(nodes)
+    v, wv = gauss_legendre(16)
+    U = np.repeat(t, v.size)
+    V = np.tile(v, t.size)
+    xu, xv = surface.partials(U, V)
+    dens = np.linalg.norm(np.cross(xu, xv), axis=1)
+    return float(np.sum(dens * np.repeat(w, v.size) * np.tile(wv, t.size)))
+
+
+def surface_summary(built: BuiltSurface) -> dict[str, Any]:
+    """Developability degree (θ_max, θ_rms, DD, R), area and shape parameters of a built surface."""
+    s = built.surface
+    dev = s.developability()
+    out: dict[str, Any] = {
+        "surface": {
+            "type": built.design.surface.type if built.design.surface else None,
+            "shape_parameters": dict(built.shape),
+            "area_3d": ruled_area(s),
+            "ruling_length_min": float(np.min(s.ruling_lengths(np.linspace(0, 1, 257)))),
+            "ruling_length_max": float(np.max(s.ruling_lengths(np.linspace(0, 1, 257)))),
+        },
+        "developability": dev.as_dict(),
+    }
+    spec = built.design.surface
+    if spec is not None and spec.type == "planes":
+        out["surface"]["control_planes"] = np.asarray(s.planes).tolist()
+        out["surface"]["boundary_planes"] = np.asarray(s.boundary_planes).tolist()
+        out["surface"]["normalized"] = bool(spec.normalize)
+        out["surface"]["edge_of_regression"] = "outside the strip (checked on construction)"
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# optimization
+# ---------------------------------------------------------------------------------------------
+def dual_curve_objectives(curve: Any, nodes: int = 64) -> dict[str, float]:
+    r"""Fairness of a curve (spec section 7) by ``nodes``-point Gauss–Legendre quadrature.
+
+    ``AL = ∫|X'|``, ``En = ∫|X''|²``, ``CVEn = ∫|X'''|²`` with analytic derivatives.
+    """
+    from .curve import gauss_legendre
+
+    t, w = gauss_legendre(nodes)
+    d1 = curve.derivative(t, 1)
+    d2 = curve.derivative(t, 2)
+    d3 = curve.derivative(t, 3)
+    return {
+        "AL": float(np.sum(w * np.linalg.norm(d1, axis=1))),
+        "En": float(np.sum(w * np.sum(d2 * d2, axis=1))),
+        "CVEn": float(np.sum(w * np.sum(d3 * d3, axis=1))),
+    }
+
+
+@dataclass
+class OptimizationOutcome:
+    """Result of :func:`optimize_design`."""
+
+    method: str
+    objective: str
+    parameters: list[str]
+    x: np.ndarray
+    best_value: float
+    initial_value: float
+    history: np.ndarray
+    nfev: int
+    nit: int
+    time: float
+    shape: dict[str, float]
+    weights: list[float]
+
+    def summary(self) -> dict[str, Any]:
+        return {
+            "method": self.method,
+            "objective": self.objective,
+            "weights": list(self.weights) if self.objective == "weighted" else None,
+            "parameters": list(self.parameters),
+            "best_parameters": {k: float(v) for k, v in zip(self.parameters, self.x)},
+            "best_value": float(self.best_value),
+            "initial_value": float(self.initial_value),
+            "nfev": int(self.nfev),
+            "iterations": int(self.nit),
+            "time_s": float(self.time),
+            "history": [float(h) for h in self.history],
+        }
+
+
+def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) -> Callable[[dict[str, float]], float]:
+    surf = design.surface
+    assert surf is not None
+    if surf.type == "planes":
+        from .curve import GHTCurve
+        from .planes import normalize_planes
+
+        U = normalize_planes(np.asarray(surf.planes, dtype=float))
+        w = np.asarray(spec.weights, dtype=float)
+
+        def f(sh: dict[str, float]) -> float:
+            vals = dual_curve_objectives(GHTCurve(U, sh["mu"], sh["nu"], sh["gamma"]))
+            if spec.objective == "weighted":
+                return float(w[0] * vals["AL"] + w[1] * vals["En"] + w[2] * vals["CVEn"])
+            return vals[spec.objective]
+
+        return f
+    from .curve import gauss_legendre
+    from .ruled import developability_from_jets
+
+    t, wq = gauss_legendre(64)
+
+    def g(sh: dict[str, float]) -> float:
+        s = _make_surface(design, curves, sh)
+        return developability_from_jets(s.a(t), s.a(t, 1), s.b(t), s.b(t, 1), wq)[3]  # (θ_max, θ_rms, DD, R)
+
+    return g
+
+
+def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, progress: bool = True,
+                    curves: dict[str, Any] | None = None) -> OptimizationOutcome:
+    r"""Minimize the design's objective over its shape parameters (box ``[-1, 1]^k``).
+
+    Objectives: for a ``planes`` surface the fairness of the dual curve of unit-normal control
+    planes (``AL = ∫|U'|``, ``En = ∫|U''|²``, ``CVEn = ∫|U'''|²`` or ``w·(AL, En, CVEn)``); for a
+    ``curves`` strip the developability objective ``R = ∫(1 - n_a·n_b) du`` (spec 5, 7).
+    Optimizers: PSO, GWO, I-GWO of :mod:`ght_cad.optimize` (spec 8).
+
+    Args:
+        design: validated design with a [surface] table.
+        overrides: replaces ``method``, ``objective``, ``iterations``, ``population``, ``seed``.
+        progress: progress bar on a terminal.
+        curves: already built curves (joins applied).
+
+    Raises:
+        DesignError: no [surface], or an override that is not allowed.
+    """
+    from .optimize import minimize
+    from .progress import Progress
+
+    if design.surface is None:
+        raise DesignError(f"{design.source}: key 'surface': missing; optimization needs a [surface] table")
+    spec = design.optimize or OptimizeSpec(
+        objective="CVEn" if design.surface.type == "planes" else "R",
+        parameters=list(_shape_names(design.surface)),
+    )
+    spec = OptimizeSpec(**{**spec.__dict__})
+    for k, v in (overrides or {}).items():
+        setattr(spec, k, v)
+    # validate overrides with the same rules as the file
+    ck = _Checker(design.source + " (command-line override)")
+    objs = PLANE_OBJECTIVES if design.surface.type == "planes" else STRIP_OBJECTIVES
+    spec.method = ck.string({"method": spec.method}, "method", "optimize", choices=METHODS)
+    spec.objective = ck.string({"objective": spec.objective}, "objective", "optimize", choices=objs)
+    spec.iterations = ck.integer({"iterations": spec.iterations}, "iterations", "optimize", 40, lo=1, hi=5000)
+    spec.population = ck.integer({"population": spec.population}, "population", "optimize", 20, lo=4, hi=500)
+    spec.seed = ck.integer({"seed": spec.seed}, "seed", "optimize", 1, lo=0, hi=2**32 - 1)
+    if curves is None:
+        curves, _ = build_curves(design)
+    base = _initial_shape(design, curves)
+    f = _objective_fn(design, curves, spec)
+    names = list(spec.parameters)
+
+    def shape_of(x: np.ndarray) -> dict[str, float]:
+        sh = dict(base)
+        sh.update({k: float(np.clip(v, -1.0, 1.0)) for k, v in zip(names, x)})
+        return sh
+
+    def F(X: np.ndarray) -> np.ndarray:
+        out = np.empty(X.shape[0])
+        for i, x in enumerate(X):
+            try:
+                out[i] = f(shape_of(x))
+            except GHTError:
+                out[i] = np.inf  # a degenerate candidate (e.g. edge of regression) is rejected
+        return out
+
+    x0 = np.array([base[k] for k in names])
+    initial = float(F(x0[None, :])[0])
+    bounds = (-np.ones(len(names)), np.ones(len(names)))
+    with Progress(spec.iterations, f"optimizing ({spec.method}, {spec.objective})",
+                  enabled=None if progress else False) as bar:
+        res = minimize(F, bounds, method=spec.method, pop_size=spec.population, max_iter=spec.iterations,
+                       seed=spec.seed, callback=bar.callback, x0=x0)
+    if not np.isfinite(res.fun):
+        raise GHTError(f"{design.source}: optimization found no admissible shape parameters")
+    x = np.clip(np.asarray(res.x, dtype=float), -1.0, 1.0)
+    best = float(res.fun)
+    if initial < best:  # never report something worse than the start
+        x, best = x0, initial
+    return OptimizationOutcome(spec.method, spec.objective, names, x, best, initial, np.asarray(res.history),
+                               int(res.nfev), int(res.nit), float(res.time), shape_of(x), list(spec.weights))
+
+
+# ---------------------------------------------------------------------------------------------
+# B-rep, flat pattern, exports
+# ---------------------------------------------------------------------------------------------
+def _ruled_face(surface: Any, tol: float) -> Any:
+    """B-spline face of degree (p, 1) through the paired boundary curves ``a(u)``, ``b(u)``.
+
+    ``a`` and ``b`` are fitted together as one 6-D function (one knot vector, pole i of each at
+    the same parameter), so the face is ``(1-v) A(u) + v B(u)`` with ``|A - a|, |B - b| <= tol``.
+    """
+    from .bspline import BSplineSurfaceData, fit_function
+    from .cad.occ import make_face
+
+    fit = fit_function(lambda t: np.hstack([surface.a(t), surface.b(t)]), tol=tol, degree=5)
+    poles = np.stack([fit.poles[:, :3], fit.poles[:, 3:]], axis=1)
+    data = BSplineSurfaceData(poles, fit.knots, np.array([0.0, 0.0, 1.0, 1.0]), fit.degree, 1,
+                              max_deviation=fit.max_deviation)
+    return make_face(data)
+
+
+def brep_face(built: BuiltSurface, tol: float | None = None) -> Any:
+    """A build123d face of the built surface (``surface.to_face()`` when it has one)."""
+    s = built.surface
+    if tol is None:
+        g = s.grid(17, 3).reshape(-1, 3)
+        tol = 1e-7 * float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
+    if hasattr(s, "to_face"):
+        try:
+            return s.to_face(tol=tol)
+        except ImportError:
+            pass
+    return _ruled_face(s, tol)
+
+
+def curve_edges(curves: dict[str, Any]) -> list[Any]:
+    """Certified B-spline edges (``curve_to_bspline``) of the 2-D/3-D curves."""
+    from .bspline import curve_to_bspline
+    from .cad.occ import make_edge
+
+    return [make_edge(curve_to_bspline(c)) for c in curves.values() if c.dim in (2, 3)]
+
+
+def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bool = True) -> Path:
+    """Write the surface face (and the design's curves as edges) to one STEP file, atomically."""
+    from .cad.occ import write_step
+
+    shapes = [brep_face(built)]
+    if with_curves:
+        shapes += curve_edges(built.curves)
+    write_step(shapes, path)
+    return Path(path)
+
+
+def unroll_surface(built: BuiltSurface) -> Any:
+    """Flat pattern of the built surface (:func:`ght_cad.unroll`).
+
+    A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
+    distortion is then in the pattern's errors.
+    """
+    from .unroll import unroll
+
+    d = built.design
+    best_effort = d.surface is not None and d.surface.type == "curves"
+    return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                  units=d.units, label=d.name[:24])
+
+
+def pattern_errors(pattern: Any) -> dict[str, float]:
+    """Max relative length/area errors of a flat pattern (``FlatPattern.errors``) as floats."""
+    return {k: float(v) for k, v in pattern.errors.items()}
+
+
+def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None) -> Path:
+    """Fixed-size PNG (900 x 700) of a flat pattern: outlines and bend lines."""
+    from .plotting import plot_flat_pattern
+
+    e = pattern.errors
+    t = (title + ": " if title else "") + f"flat pattern, max rel. error {e['max']:.1e}"
+    return plot_flat_pattern(pattern.outlines, path, rulings=list(pattern.bend_lines), title=t)
+
+
+def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str, str]:
+    """Build the design with its given shape parameters and write each file by its suffix.
+
+    ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: summary;
+    ``.png``: rendered surface (or the curves when the design has no surface).
+
+    Raises:
+        DesignError: a suffix that is not allowed, or a surface output without [surface].
+    """
+    import json
+
+    from .io import write_text_atomic
+
+    files = [Path(f) for f in files]
+    allowed = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
+    for f in files:
+        if f.suffix.lower() not in allowed:
+            raise DesignError(f"{f}: unknown output suffix {f.suffix!r}; allowed: {', '.join(allowed)}")
+    curves, _ = build_curves(design)
+    built = build_surface(design, curves=curves) if design.surface is not None else None
+    pattern = None
+    out: dict[str, str] = {}
+    for f in files:
+        suf = f.suffix.lower()
+        if suf in (".dxf", ".svg") and built is None:
+            raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
+        if suf in (".step", ".stp"):
+            if built is not None:
+                export_step(built, f)
+            else:
+                from .cad.occ import write_step
+
+                write_step(curve_edges(curves), f)
+        elif suf in (".dxf", ".svg"):
+            pattern = pattern or unroll_surface(built)
+            (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(f)
+        elif suf == ".json":
+            summ = surface_summary(built) if built is not None else {}
+            summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
+            write_text_atomic(f, json.dumps(_jsonable(summ), indent=2) + "\n")
+        else:
+            from .plotting import plot_curve, plot_surface
+
+            if built is not None:
+                plot_surface(built.surface, f, title=design.name)
+            else:
+                plot_curve(list(curves.values()), f)
+        out[suf.lstrip(".") + (f"_{len(out)}" if suf.lstrip(".") in out else "")] = str(f)
+    return out
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {str(k): _jsonable(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_jsonable(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return _jsonable(o.tolist())
+    if isinstance(o, (np.floating, float)):
+        x = float(o)
+        return x if math.isfinite(x) else None
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.bool_,)):
+        return bool(o)
+    return o
+
+
+# ---------------------------------------------------------------------------------------------
+# the pipeline
+# ---------------------------------------------------------------------------------------------
+class _Stage:
+    """A temporary folder beside ``out_dir``; :meth:`commit` moves its files into ``out_dir``."""
+
+    def __init__(self, out_dir: Path) -> None:
+        self.out = out_dir
+        parent = out_dir.parent
+        parent.mkdir(parents=True, exist_ok=True)
+        self.tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".ght-cad-tmp", dir=parent))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self.tmp, 0o777 & ~umask)  # mkdtemp makes 0700; the result is an ordinary folder
+
+    def path(self, name: str) -> Path:
+        return self.tmp / name
+
+    def commit(self) -> list[str]:
+        names = sorted(p.name for p in self.tmp.iterdir() if p.is_file() and not p.name.endswith(".part"))
+        if not self.out.exists():
+            os.replace(self.tmp, self.out)  # one atomic rename: the folder appears complete
+            return names
+        if not self.out.is_dir():
+            raise GHTError(f"{self.out} exists and is not a folder; allowed: a folder or a new path")
+        for n in names:
+            os.replace(self.tmp / n, self.out / n)
+        self.cleanup()
+        return names
+
+    def cleanup(self) -> None:
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+
+def _versions() -> dict[str, str]:
+    import platform
+
+    from . import __version__
+
+    out = {"ght_cad": __version__, "python": platform.python_version(), "numpy": np.__version__}
+    try:
+        import scipy
+
+        out["scipy"] = scipy.__version__
+    except ImportError:  # pragma: no cover
+        pass
+    return out
+
+
+def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True) -> dict[str, Any]:
+    """Run the whole pipeline of a design and write its outputs into ``out_dir``.
+
+    Steps: GHT curves (+ joins, measured) → surface (developable from control planes, or a ruled
+    strip between two curves) → shape-parameter optimization (if ``[optimize]``) → developability
+    degree → B-rep face → STEP (face + curve edges) → flat pattern (DXF, SVG) → PNG figures
+    (basis, curve, curvature, surface, flat_pattern, convergence) → ``report.json`` and
+    ``report.md``. File names: ``model.step``, ``flat_pattern.dxf``, ``flat_pattern.svg``,
+    ``report.json``, ``report.md``, ``<figure>.png``.
+
+    Everything is computed into a temporary folder beside ``out_dir``; only when every step has
+    succeeded are the files moved in (a new ``out_dir`` appears by one rename). On any error the
+    temporary folder is removed and ``out_dir`` is untouched.
+
+    Args:
+        design: a validated :class:`Design`.
+        out_dir: output folder.
+        progress: progress bar on stderr when it is a terminal.
+
+    Returns:
+        The report dictionary (the content of ``report.json``).
+
+    Raises:
+        GHTError: degenerate geometry, non-developable surface, ...; nothing is written.
+    """
+    import sys
+
+    from .progress import progress_enabled
+
+    t_start = time.perf_counter()
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
+    want_files = set(design.outputs.files)
+    want_figs = set(design.outputs.figures)
+    steps = ["curves", "surface", "optimize", "measure", "B-rep + STEP", "flat pattern", "figures", "report"]
+    show = bool(progress) and progress_enabled()
+    report: dict[str, Any] = {
+        "name": design.name,
+        "source": design.source,
+        "units": design.units,
+        "ght_definition": GHT_DEFINITION,
+        "design": design.to_dict(),
+    }
+
+    def step(name: str) -> None:
+        if show:
+            i = steps.index(name) + 1
+            sys.stderr.write(f"[{i}/{len(steps)}] {design.name}: {name} ({time.perf_counter() - t_start:.1f} s)\n")
+            sys.stderr.flush()
+
+    stage = _Stage(out)
+    try:
+        if True:
+            # 1. curves
+            step("curves")
+            curves, joins = build_curves(design)
+            report["curves"] = [
+                {
+                    "name": k,
+                    "degree": c.degree,
+                    "dim": c.dim,
+                    "mu": c.mu,
+                    "nu": c.nu,
+                    "gamma": c.gamma,
+                    "control_points": c.control_points.tolist(),
+                    "arc_length": c.arc_length(),
+                    "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
+                }
+                for k, c in curves.items()
+            ]
+            report["joins"] = joins
+
+            built = None
+            opt = None
+            if design.surface is not None:
+                # 2. surface
+                step("surface")
+                built = build_surface(design, curves=curves)
+                report["developability_initial"] = built.surface.developability().as_dict()
+                # 3. optimization
+                if design.optimize is not None:
+                    step("optimize")
+                    opt = optimize_design(design, progress=progress, curves=curves)
+                    built = build_surface(design, opt.shape, curves=curves)
+                    report["optimization"] = opt.summary()
+                # 4. measures
+                step("measure")
+                report.update(surface_summary(built))
+                # 5. B-rep
+                step("B-rep + STEP")
+                face = brep_face(built)
+                from .cad.occ import is_valid
+
+                valid = is_valid(face)
+                report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": 1}
+                if not valid:
+                    raise GHTError(f"{design.source}: the B-rep face of the surface is not valid (BRepCheck)")
+                edges = curve_edges(curves)
+                report["brep"]["curve_edges"] = len(edges)
+                if "step" in want_files:
+                    from .cad.occ import write_step
+
+                    write_step([face] + edges, stage.path(FILE_NAMES["step"]))
+                # 6. flat pattern
+                step("flat pattern")
+                pattern = unroll_surface(built)
+                report["flat_pattern"] = {
+                    "area": float(pattern.area),
+                    "errors": pattern_errors(pattern),
+                    "report": pattern.report.as_dict(),
+                    "outline_points": int(sum(len(o) for o in pattern.outlines)),
+                    "bend_lines": int(len(pattern.bend_lines)),
+                    "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
+                             np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
+                }
+                if "dxf" in want_files:
+                    pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
+                if "svg" in want_files:
+                    pattern.export_svg(stage.path(FILE_NAMES["svg"]))
+            else:
+                pattern = None
+                if "step" in want_files and curves:
+                    from .cad.occ import write_step
+
+                    write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]))
+
+            # 7. figures
+            step("figures")
+            from . import plotting as P
+
+            if "basis" in want_figs:
+                if built is not None and design.surface is not None and design.surface.type == "planes":
+                    deg = built.surface.dual_curve.degree
+                    sh = built.shape
+                    params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (design.surface.mu, design.surface.nu, design.surface.gamma),
+                              (sh["mu"], sh["nu"], sh["gamma"])]
+                elif curves:
+                    c0 = next(iter(curves.values()))
+                    deg = c0.degree
+                    params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (c0.mu, c0.nu, c0.gamma)]
+                else:  # pragma: no cover - validation guarantees curves or a surface
+                    deg, params = 3, [(0.0, 0.0, 0.0)]
+                uniq = []
+                for p in params:
+                    if p not in uniq:
+                        uniq.append(p)
+                P.plot_basis(stage.path(FIGURE_NAMES["basis"]), max(deg, 2), uniq)
+            if "curve" in want_figs and curves:
+                P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
+            if "curvature" in want_figs and curves:
+                P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
+            if "surface" in want_figs and built is not None:
+                P.plot_surface(built.surface, stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
+            if "flat_pattern" in want_figs and pattern is not None:
+                plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
+            if "convergence" in want_figs and opt is not None:
+                P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
+                                   stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")
+
+            # 8. report
+            step("report")
+            files = sorted(p.name for p in stage.tmp.iterdir() if p.is_file())
+            if "json" in want_files:
+                files.append(FILE_NAMES["json"])
+            if "md" in want_files:
+                files.append(FILE_NAMES["md"])
+            report["files"] = sorted(files)
+            report["out_dir"] = str(out)
+            report["versions"] = _versions()
+            report["elapsed_s"] = time.perf_counter() - t_start
+            report = _jsonable(report)
+            from .io import write_text_atomic
+            import json
+
+            if "json" in want_files:
+                write_text_atomic(stage.path(FILE_NAMES["json"]), json.dumps(report, indent=2) + "\n")
+            if "md" in want_files:
+                write_text_atomic(stage.path(FILE_NAMES["md"]), report_markdown(report))
+        stage.commit()
+    except BaseException:
+        stage.cleanup()
+        raise
+    return report
+
+
+def _f(x: Any, fmt: str = ".6g") -> str:
+    return "n/a" if x is None else format(x, fmt)
+
+
+def report_markdown(r: dict[str, Any]) -> str:
+    """Markdown report of :func:`run_design` (tables of the measured numbers, figure links)."""
+    L = [f"# {r['name']}: ght_cad report", ""]
+    L.append(f"Design: `{r['source']}` · units: {r['units']} · ght_cad {r['versions']['ght_cad']} · "
+             f"computed in {r['elapsed_s']:.1f} s")
+    L.append("")
+    L.append(f"GHT definition: {r['ght_definition']}.")
+    L.append("")
+    if r.get("curves"):
+        L += ["## Curves", "", "| name | degree | dim | μ | ν | γ | arc length | max curvature |", "|---|---|---|---|---|---|---|---|"]
+        for c in r["curves"]:
+            L.append(f"| {c['name']} | {c['degree']} | {c['dim']} | {c['mu']:.4g} | {c['nu']:.4g} | {c['gamma']:.4g} | "
+                     f"{c['arc_length']:.6g} | {_f(c['curvature_max'], '.4g')} |")
+        L.append("")
+    if r.get("joins"):
+        L += ["### Joins (measured independently of the construction)", "",
+              "| first → second | requested | achieved C | achieved G | satisfied |", "|---|---|---|---|---|"]
+        for j in r["joins"]:
+            L.append(f"| {j['first']} → {j['second']} | {j['requested']} | C{j['achieved_C']} | G{j['achieved_G']} | "
+                     f"{'yes' if j['satisfied'] else 'NO'} |")
+        L.append("")
+    if r.get("surface"):
+        s = r["surface"]
+        L += ["## Surface", "", f"Type: `{s['type']}` · shape parameters: "
+              + ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
+              + f" · area {s['area_3d']:.9g} {r['units']}² · ruling length {s['ruling_length_min']:.6g}–"
+              f"{s['ruling_length_max']:.6g} {r['units']}", ""]
+        L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
+        for label, key in (("initial", "developability_initial"), ("final", "developability")):
+            d = r.get(key)
+            if d:
+                L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
+        L.append("")
+    if r.get("optimization"):
+        o = r["optimization"]
+        L += ["## Shape-parameter optimization", "",
+              f"{o['method']} on {o['objective']}: {o['initial_value']:.8g} → {o['best_value']:.8g} in "
+              f"{o['iterations']} iterations ({o['nfev']} evaluations, {o['time_s']:.2f} s); best "
+              + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
+    if r.get("brep"):
+        b = r["brep"]
+        L += ["## B-rep", "", f"{b['faces']} face (valid: {b['valid']}), area {b['area']:.9g} {r['units']}², "
+              f"{b['curve_edges']} curve edge(s).", ""]
+    if r.get("flat_pattern"):
+        p = r["flat_pattern"]
+        L += ["## Flat pattern (spec section 6)", "", f"Area {p['area']:.9g} {r['units']}², {p['bend_lines']} bend lines.", "",
+              "| quantity | max | rms |", "|---|---|---|"]
+        for k, v in p["report"].items():
+            L.append(f"| {k} | {v['max']:.3e} | {v['rms']:.3e} |")
+        L.append("")
+    L += ["## Files", ""]
+    for f in r.get("files", []):
+        L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))
+    L.append("")
+    return "\n".join(L)
