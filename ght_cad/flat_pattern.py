@@ -223,7 +223,7 @@ class FlatPanel:
         if self.bend_lines.size:
             self.bend_lines = self.bend_lines + delta
         self.marks = [m + delta for m in self.marks]
-        self.texts = [(x + delta[0], y + delta[1], s, h) for x, y, s, h in self.texts]
+        self.texts = [(float(x + delta[0]), float(y + delta[1]), s, h) for x, y, s, h in self.texts]
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         pts = np.concatenate(self.loop_polylines(), axis=0)
@@ -376,7 +376,7 @@ def _interp_polyline(poly: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.nd
 def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int:
     """Give boundary edges shared in 3-D by two panels matching marks (in place).
 
-    Two edges match when every 3-D sample of each lies within ``rel_tol`` · model size (plus the
+    Two edges (of different panels, or the two sides of a seam in one panel) match when every 3-D sample of each lies within ``rel_tol`` · model size (plus the
     polyline sagitta) of the other. Both get a label ``E<k>`` and ticks across the edge at the
     points of 3-D arc-length fraction 1/4, 1/2, 3/4 (the same 3-D points on both panels).
 
@@ -386,12 +386,13 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
     allpts = np.concatenate([e.xyz for p in panels for lp in p.loops for e in lp], axis=0)
     size = float(np.max(allpts.max(axis=0) - allpts.min(axis=0)))
     k = 0
+    tick = 0.02 * max(float(np.max(hi - lo)) for lo, hi in (p.bbox() for p in panels))
     items = [(pi, e) for pi, p in enumerate(panels) for lp in p.loops for e in lp]
     used: set[int] = set()
     for i in range(len(items)):
         for j in range(i + 1, len(items)):
             (pi, e1), (pj, e2) = items[i], items[j]
-            if pi == pj or i in used or j in used:
+            if i in used or j in used or e1.length_3d == 0 or e2.length_3d == 0:
                 continue
             sag = 2 * max(_chords(e1.xyz) / len(e1.xyz), _chords(e2.xyz) / len(e2.xyz)) ** 2 / max(size, 1e-300)
             tol = rel_tol * size + sag
@@ -409,8 +410,6 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
             _, s2 = _polyline_param(e2.xyz, p3)
             for panel, edge, s in ((panels[pi], e1, frac_idx), (panels[pj], e2, s2)):
                 loops = panel.loop_polylines()
-                lo, hi = panel.bbox()
-                tick = 0.02 * float(np.max(hi - lo))
                 pos, tan = _interp_polyline(edge.flat + panel.offset, s)
                 nrm = np.stack([-tan[:, 1], tan[:, 0]], axis=1)
                 probe = pos[1] + 2 * tick * nrm[1]
@@ -442,6 +441,11 @@ class FlatPattern:
     def outlines(self) -> list[np.ndarray]:
         """All closed loops (outer and holes of every panel), (n, 2) arrays, last point not repeated."""
         return [lp for p in self.panels for lp in p.loop_polylines()]
+
+    @property
+    def outline(self) -> np.ndarray:
+        """Outer loop of the first panel, (n, 2) (last point not repeated)."""
+        return self.panels[0].loop_polylines()[0]
 
     @property
     def outer_outlines(self) -> list[np.ndarray]:

@@ -32,6 +32,7 @@ from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.GeomAbs import (
     GeomAbs_BezierSurface,
+    GeomAbs_BSplineCurve,
     GeomAbs_BSplineSurface,
     GeomAbs_CN,
     GeomAbs_Cone,
@@ -128,15 +129,9 @@ class FaceRuledSurface(RuledSurface):
         u0, u1, v0, v1 = bounds
         if ruled == "v":
             self.t0, self.t1, self.s0, self.s1 = u0, u1, v0, v1
-            n = adaptor.NbUIntervals(GeomAbs_CN)
-            arr = TColStd_Array1OfReal(1, n + 1)
-            adaptor.UIntervals(arr, GeomAbs_CN)
         else:
             self.t0, self.t1, self.s0, self.s1 = v0, v1, u0, u1
-            n = adaptor.NbVIntervals(GeomAbs_CN)
-            arr = TColStd_Array1OfReal(1, n + 1)
-            adaptor.VIntervals(arr, GeomAbs_CN)
-        ks = np.array([arr.Value(i) for i in range(1, n + 2)])
+        ks = surface_breaks(adaptor, "u" if ruled == "v" else "v")
         self.breakpoints = tuple(((ks - self.t0) / (self.t1 - self.t0)).tolist())
 
     def uv(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -166,6 +161,31 @@ class FaceRuledSurface(RuledSurface):
 
     def b(self, u: Any, derivative: int = 0) -> np.ndarray:
         return self._edge(u, 1.0, derivative)
+
+
+def surface_breaks(ad: BRepAdaptor_Surface, direction: str) -> np.ndarray:
+    """Parameters in ``direction`` where the surface is not C∞: B-spline knots (of the surface or
+    of an extrusion's basis curve), else OCCT's C∞ interval ends."""
+    kind = ad.GetType()
+    if kind == GeomAbs_BSplineSurface:
+        bs = ad.BSpline()
+        if direction == "u":
+            return np.array([bs.UKnot(i) for i in range(1, bs.NbUKnots() + 1)])
+        return np.array([bs.VKnot(i) for i in range(1, bs.NbVKnots() + 1)])
+    if kind == GeomAbs_SurfaceOfExtrusion and direction == "u":
+        bc = ad.BasisCurve()
+        if bc.GetType() == GeomAbs_BSplineCurve:
+            b = bc.BSpline()
+            return np.array([b.Knot(i) for i in range(1, b.NbKnots() + 1)])
+    if direction == "u":
+        n = ad.NbUIntervals(GeomAbs_CN)
+        arr = TColStd_Array1OfReal(1, n + 1)
+        ad.UIntervals(arr, GeomAbs_CN)
+    else:
+        n = ad.NbVIntervals(GeomAbs_CN)
+        arr = TColStd_Array1OfReal(1, n + 1)
+        ad.VIntervals(arr, GeomAbs_CN)
+    return np.array([arr.Value(i) for i in range(1, n + 2)])
 
 
 def _straightness(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> float:
@@ -465,10 +485,7 @@ def unroll_face(
         if rulings:
             ua, va, ub, vb = ends(tb)
             bends = np.stack([dmap.map(ua, va), dmap.map(ub, vb)], axis=1)
-    nbu = ad.NbUIntervals(GeomAbs_CN)
-    arr = TColStd_Array1OfReal(1, nbu + 1)
-    ad.UIntervals(arr, GeomAbs_CN)
-    u_breaks = np.array([arr.Value(i) for i in range(1, nbu + 2)])
+    u_breaks = surface_breaks(ad, "u")
     area_3d = face_area(ev, loops_uv, u0, u_breaks)
     panel = FlatPanel(
         label=label,
