@@ -1,0 +1,388 @@
+"""Developable surfaces from GHT curves (spec 5.2–5.6): exact shapes, developability, errors, joins."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import ght_cad
+from ght_cad import GHTCurve
+from ght_cad.developable import (
+    CanalSurface,
+    CompositeDevelopable,
+    EnvelopeDevelopable,
+    RectifyingDevelopable,
+    TangentDevelopable,
+    curve_derivatives,
+    developable_from_planes,
+    join_developable,
+    measure_developable_joint,
+)
+from ght_cad.errors import (
+    DegenerateGeometryError,
+    EdgeOfRegressionError,
+    GHTError,
+    ShapeParameterError,
+    SingularJoinError,
+)
+from ght_cad.planes import plane_from_point_normal, signed_distance
+
+shape = st.floats(-1, 1, allow_nan=False)
+ROUND_OFF_DEG = 1e-9  # θ_max at round-off (degrees)
+ROUND_OFF_RES = 1e-10  # scale-free residual det(a', g, g') / (|a'||g||g'|)
+
+
+def cylinder(r: float, H: float) -> EnvelopeDevelopable:
+    return developable_from_planes([(-r, 1, 0, 0), (-r, 1, 1, 0), (-r, 0, 1, 0)], [(0, 0, 0, 1), (-H, 0, 0, 1)], gamma=-1)
+
+
+def cone(k: float, h: float, z1: float) -> EnvelopeDevelopable:
+    P = [(-k * h, 1, 0, k), (-k * h, 1, 1, k), (-k * h, 0, 1, k)]
+    return developable_from_planes(P, [(0, 0, 0, 1), (-z1, 0, 0, 1)], gamma=-1)
+
+
+SHIP = [
+    plane_from_point_normal((0, 5, 0), (0, 1, -0.15)),
+    plane_from_point_normal((4, 5.3, -0.5), (0.05, 1, -0.4)),
+    plane_from_point_normal((8, 5.2, -1.2), (0.1, 1, -0.8)),
+    plane_from_point_normal((12, 4.6, -2.0), (0.2, 0.8, -1.2)),
+]
+FRAMES = [(0, 1, 0, 0), (-12, 1, 0, 0)]
+
+
+def ship(mu=0.3, nu=-0.2, gamma=0.1, **kw) -> EnvelopeDevelopable:
+    return developable_from_planes(SHIP, FRAMES, mu, nu, gamma, **kw)
+
+
+SPACE = GHTCurve([(0, 0, 0), (1, 0.2, 0.1), (2, 1, 0.5), (3, 1.5, 1.5), (3.5, 3, 2)], mu=0.2, nu=-0.3, gamma=0.4)
+
+
+# -- 5.2 exact cylinder and cone (spec section 1) ---------------------------------------------
+@given(st.floats(0.1, 50), st.floats(0.1, 50))
+@settings(max_examples=15)
+def test_cylinder_from_control_planes(r, H):
+    s = cylinder(r, H)
+    u = np.linspace(0, 1, 41)
+    A, B = s.a(u), s.b(u)
+    # radius and axis (z) to 1e-9; boundary curves on z = 0 and z = H
+    for P in (A, B, s.evaluate(u, 0.37)):
+        assert np.abs(np.hypot(P[:, 0], P[:, 1]) - r).max() <= 1e-9 * r
+    assert np.abs(A[:, 2]).max() <= 1e-9 * r and np.abs(B[:, 2] - H).max() <= 1e-9 * max(r, H)
+    # uniform in angle: a(t) = r (cos πt/2, sin πt/2, 0)
+    np.testing.assert_allclose(A[:, :2], r * np.column_stack([np.cos(np.pi * u / 2), np.sin(np.pi * u / 2)]), atol=1e-12 * r)
+    d = s.ruling_direction(u)
+    assert np.abs(np.abs(d[:, 2]) - 1).max() <= 1e-12
+    # edge of regression at infinity (homogeneous X0 = 0), reported as nan
+    R = s.edge_of_regression(u, homogeneous=True)
+    assert np.abs(R[:, 0]).max() <= 1e-12 * np.abs(R).max()
+    assert np.isnan(s.edge_of_regression(u)).all()
+    dev = s.developability()
+    assert dev.theta_max <= ROUND_OFF_DEG and dev.residual_max <= ROUND_OFF_RES and abs(dev.dd - 1) <= 1e-15
+
+
+@given(st.floats(0.2, 5), st.floats(0.5, 20), st.floats(0.1, 0.9))
+@settings(max_examples=15)
+def test_cone_from_control_planes(k, h, frac):
+    s = cone(k, h, frac * h)
+    u = np.linspace(0, 1, 41)
+    apex = np.array([0.0, 0.0, h])
+    np.testing.assert_allclose(s.edge_of_regression(u), np.tile(apex, (u.size, 1)), atol=1e-9 * h, rtol=0)
+    # radius k h at z = 0 and k (h - z) at every height: circular cone around the z axis
+    A = s.a(u)
+    assert np.abs(np.hypot(A[:, 0], A[:, 1]) - k * h).max() <= 1e-9 * k * h
+    X = s.evaluate(np.repeat(u, 3), np.tile([0.0, 0.5, 1.0], u.size))
+    assert np.abs(np.hypot(X[:, 0], X[:, 1]) - k * (h - X[:, 2])).max() <= 1e-9 * k * h
+    # axis: every ruling passes through the apex
+    d = s.ruling_direction(u)
+    off = A - apex
+    assert np.abs(np.linalg.norm(np.cross(off, d), axis=1)).max() <= 1e-9 * h * (1 + k)
+    dev = s.developability()
+    assert dev.theta_max <= ROUND_OFF_DEG and dev.residual_max <= ROUND_OFF_RES
+
+
+def test_normalize_changes_the_weights():
+    """Rescaling the middle plane to a unit normal is the same plane but not the same envelope."""
+    s = developable_from_planes([(-1, 1, 0, 0), (-1, 1, 1, 0), (-1, 0, 1, 0)], [(0, 0, 0, 1), (-1, 0, 0, 1)], gamma=-1, normalize=True)
+    A = s.a(np.linspace(0, 1, 21))
+    assert np.abs(np.hypot(A[:, 0], A[:, 1]) - 1).max() > 1e-3
+    assert s.developability().theta_max <= ROUND_OFF_DEG
+
+
+# -- 5.2 general envelopes: round-off developability, analytic derivatives, end properties ---
+@given(shape, shape, shape)
+@settings(max_examples=20)
+def test_envelope_developable_at_round_off(mu, nu, gamma):
+    s = ship(mu, nu, gamma)
+    dev = s.developability()
+    assert dev.theta_max <= ROUND_OFF_DEG, dev
+    assert dev.residual_max <= ROUND_OFF_RES, dev
+    # the tangent plane is constant along each ruling (normals at v = 0, 0.5, 1 agree)
+    u = np.linspace(0, 1, 17)
+    n0, n1, n2 = (s.normal(u, v) for v in (0.0, 0.5, 1.0))
+    assert np.abs(np.cross(n0, n1)).max() <= 1e-11 and np.abs(np.cross(n0, n2)).max() <= 1e-11
+
+
+@given(shape, shape, shape, st.floats(0.05, 0.95))
+@settings(max_examples=15)
+def test_analytic_derivatives_match_finite_differences(mu, nu, gamma, u0):
+    s = ship(mu, nu, gamma)
+    h = 1e-5
+    u = np.array([u0])
+    for side in (s.a, s.b):
+        for r in (1, 2):
+            fd = (side(u + h, r - 1) - side(u - h, r - 1)) / (2 * h)
+            exact = side(u, r)
+            assert np.abs(fd - exact).max() <= 1e-6 * (1 + np.abs(exact).max())
+
+
+@given(shape, shape, shape)
+@settings(max_examples=15)
+def test_end_properties(mu, nu, gamma):
+    """At t=0 the surface touches U_0 along U_0 ∩ U_1; at t=1 U_m along U_{m-1} ∩ U_m."""
+    s = ship(mu, nu, gamma)
+    U = np.array(SHIP)
+    v = np.linspace(0, 1, 5)
+    for end, (Ui, Uj) in ((0.0, (U[0], U[1])), (1.0, (U[-2], U[-1]))):
+        pts = s.evaluate(np.full(v.size, end), v)
+        scale = 1 + np.abs(pts).max()
+        for P in (Ui, Uj):
+            assert np.abs(signed_distance(P, pts)).max() <= 1e-12 * scale
+        touching = U[0] if end == 0.0 else U[-1]
+        n = s.normal(np.full(v.size, end), v)
+        nt = touching[1:] / np.linalg.norm(touching[1:])
+        assert np.abs(np.cross(n, nt)).max() <= 1e-12
+
+
+def test_trimming_by_parameter_range():
+    full = ship()
+    part = ship(t_range=(0.2, 0.7))
+    u = np.linspace(0, 1, 11)
+    t = 0.2 + 0.5 * u
+    np.testing.assert_allclose(part.a(u), full.a(t), atol=1e-12)
+    np.testing.assert_allclose(part.b(u, 1), 0.5 * full.b(t, 1), atol=1e-11)
+    np.testing.assert_allclose(part.b(u, 2), 0.25 * full.b(t, 2), atol=1e-10)
+    assert part.developability().theta_max <= ROUND_OFF_DEG
+    np.testing.assert_allclose(full.trimmed((0.2, 0.7)).a(u), part.a(u), atol=0)
+
+
+def test_stable_lazy_name():
+    assert ght_cad.developable_from_planes is developable_from_planes
+    s = ght_cad.developable_from_planes(SHIP, FRAMES)
+    assert s.dual_curve.dim == 4 and s.dual_curve.degree == 3
+
+
+# -- bad input --------------------------------------------------------------------------------
+def test_parallel_neighbour_control_planes():
+    with pytest.raises(DegenerateGeometryError, match=r"planes\[1\]=.*planes\[2\]=.*parallel"):
+        developable_from_planes([(-1, 1, 0, 0), (-1, 0, 1, 0), (-5, 0, 1, 0)], FRAMES)
+    with pytest.raises(DegenerateGeometryError, match=r"planes\[0\]=.*planes\[1\]=.*coincident"):
+        developable_from_planes([(-1, 1, 0, 0), (-2, 2, 0, 0), (-5, 0, 1, 0)], FRAMES)
+    with pytest.raises(DegenerateGeometryError, match=r"planes\[1\].*zero normal"):
+        developable_from_planes([(-1, 1, 0, 0), (-2, 0, 0, 0), (-5, 0, 1, 0)], FRAMES)
+    with pytest.raises(DegenerateGeometryError, match=r"planes\[2\]=.*NaN"):
+        developable_from_planes([(-1, 1, 0, 0), (-2, 1, 1, 0), (np.nan, 0, 1, 0)], FRAMES)
+
+
+def test_boundary_plane_containing_a_ruling():
+    # y = 0 contains the ruling x = r, y = 0 of the cylinder at t = 0
+    with pytest.raises(DegenerateGeometryError, match=r"boundary plane E_a=.* contains the ruling at u=0 \(t=0\)"):
+        developable_from_planes([(-1, 1, 0, 0), (-1, 1, 1, 0), (-1, 0, 1, 0)], [(0, 0, 1, 0), (-1, 0, 0, 1)], gamma=-1)
+    # between samples: the cone's ruling at t = 1/3 lies in the plane through the z axis at 30°
+    c, s = math.cos(math.pi / 6), math.sin(math.pi / 6)
+    k, h = 0.5, 2.0
+    P = [(-k * h, 1, 0, k), (-k * h, 1, 1, k), (-k * h, 0, 1, k)]
+    with pytest.raises(DegenerateGeometryError, match=r"E_b=.* contains the ruling at u=0.33333\d* \(t=0.33333"):
+        developable_from_planes(P, [(0, 0, 0, 1), (0, s, -c, 0)], gamma=-1)
+
+
+def test_boundary_plane_parallel_to_a_ruling():
+    with pytest.raises(DegenerateGeometryError, match=r"boundary plane E_b=\[-5.*is parallel to the ruling at u=0"):
+        developable_from_planes([(-1, 1, 0, 0), (-1, 1, 1, 0), (-1, 0, 1, 0)], [(0, 0, 0, 1), (-5, 0, 1, 0)], gamma=-1)
+    c, s = math.cos(math.pi / 6), math.sin(math.pi / 6)
+    k, h = 0.5, 2.0
+    P = [(-k * h, 1, 0, k), (-k * h, 1, 1, k), (-k * h, 0, 1, k)]
+    with pytest.raises(DegenerateGeometryError, match=r"E_a=.* is parallel to the ruling at u=0.33333\d*"):
+        developable_from_planes(P, [(-7, s, -c, 0), (0, 0, 0, 1)], gamma=-1)
+
+
+def test_strip_containing_its_edge_of_regression():
+    # cone with apex at z = h = 2 cut by z = 0 and z = 3: the apex sits at v = 2/3 on every ruling
+    with pytest.raises(EdgeOfRegressionError, match=r"contains its edge of regression at u=[0-9.e-]+ \(t=[0-9.e-]+\), v=0.666667 \(point \[.*2\.\]\)"):
+        cone(0.5, 2.0, 3.0)
+    # a trimmed range avoids nothing here, the error names the t of the trimmed surface
+    with pytest.raises(EdgeOfRegressionError, match=r"v=0.666667"):
+        developable_from_planes([(-1, 1, 0, 0.5), (-1, 1, 1, 0.5), (-1, 0, 1, 0.5)], [(0, 0, 0, 1), (-3, 0, 0, 1)], gamma=-1, t_range=(0.25, 0.5))
+
+
+def test_boundary_planes_crossing_inside_the_strip():
+    # E_b: z = 2 (y - 1/2) meets E_a: z = 0 on the ruling through y = 1/2 (t = 1/3)
+    with pytest.raises(DegenerateGeometryError, match=r"cut the ruling at u=0.33333\d* .*zero width"):
+        developable_from_planes([(-1, 1, 0, 0), (-1, 1, 1, 0), (-1, 0, 1, 0)], [(0, 0, 0, 1), (1, 0, -2, 1)], gamma=-1)
+
+
+def test_other_bad_arguments():
+    with pytest.raises(ShapeParameterError, match=r"mu=1.5 is outside the allowed range \[-1, 1\]"):
+        developable_from_planes(SHIP, FRAMES, mu=1.5)
+    with pytest.raises(GHTError, match=r"t_range=\(0.5, 0.2\) is not allowed"):
+        ship(t_range=(0.5, 0.2))
+    with pytest.raises(GHTError, match=r"boundary_planes must have shape \(2, 4\).*\(1, 4\)"):
+        developable_from_planes(SHIP, [(0, 1, 0, 0)])
+    with pytest.raises(DegenerateGeometryError, match=r"E_b=.*zero normal"):
+        developable_from_planes(SHIP, [(0, 1, 0, 0), (1, 0, 0, 0)])
+    with pytest.raises(GHTError, match=r"derivative=3 is not allowed; .*0..2"):
+        ship().a(0.5, 3)
+
+
+# -- 5.3 tangent developable -------------------------------------------------------------------
+def test_tangent_developable():
+    s = TangentDevelopable(SPACE, 0.2, 1.0)
+    dev = s.developability()
+    assert dev.theta_max <= ROUND_OFF_DEG and dev.residual_max <= ROUND_OFF_RES
+    u = np.linspace(0, 1, 9)
+    T, _, _ = SPACE.frenet(u)
+    np.testing.assert_allclose(s.a(u), SPACE.evaluate(u) + 0.2 * T, atol=1e-13)
+    np.testing.assert_allclose(s.b(u), SPACE.evaluate(u) + 1.0 * T, atol=1e-13)
+    h = 1e-5
+    for r in (1, 2):
+        fd = (s.b(u[1:-1] + h, r - 1) - s.b(u[1:-1] - h, r - 1)) / (2 * h)
+        assert np.abs(fd - s.b(u[1:-1], r)).max() <= 1e-6
+    assert TangentDevelopable(SPACE, -1.0, -0.1).developability().theta_max <= ROUND_OFF_DEG
+
+
+def test_tangent_developable_errors():
+    with pytest.raises(EdgeOfRegressionError, match=r"v range \[-0.5, 0.5\] contains 0.*v0 > 0 or v1 < 0"):
+        TangentDevelopable(SPACE, -0.5, 0.5)
+    with pytest.raises(DegenerateGeometryError, match=r"zero curvature at t="):
+        TangentDevelopable(GHTCurve([(0, 0, 0), (1, 1, 1), (2, 2, 2)]), 0.1, 0.5)
+    with pytest.raises(GHTError, match=r"v0=1 must be smaller than v1=0.5"):
+        TangentDevelopable(SPACE, 1.0, 0.5)
+    with pytest.raises(GHTError, match=r"dimension 2; a space curve of dimension 3"):
+        TangentDevelopable(GHTCurve([(0, 0), (1, 1), (2, 0)]), 0.1, 0.5)
+
+
+# -- 5.4 rectifying developable ----------------------------------------------------------------
+@given(shape, shape, shape)
+@settings(max_examples=10)
+def test_rectifying_developable_is_developable_and_keeps_the_geodesic(mu, nu, gamma):
+    C = SPACE.with_shape(mu, nu, gamma)
+    s = RectifyingDevelopable(C, -0.15, 0.25)
+    dev = s.developability()
+    assert dev.theta_max <= ROUND_OFF_DEG and dev.residual_max <= ROUND_OFF_RES
+    u = np.linspace(0, 1, 13)
+    v_c = 0.15 / 0.4  # v where X(u, v) = C(u)
+    np.testing.assert_allclose(s.evaluate(u, v_c), C.evaluate(u), atol=1e-13)
+    _, N, _ = C.frenet(u)
+    assert np.abs(np.cross(s.normal(u, v_c), N)).max() <= 1e-10  # C is a geodesic
+    D = s.direction(u)
+    T, _, B = C.frenet(u)
+    k, tau = C.curvature(u), C.torsion(u)
+    expect = (tau[:, None] * T + k[:, None] * B) / np.hypot(k, tau)[:, None]
+    np.testing.assert_allclose(D, expect, atol=1e-12)
+
+
+def test_rectifying_derivatives_and_high_curve_derivatives():
+    s = RectifyingDevelopable(SPACE, -0.1, 0.2)
+    u = np.array([0.2, 0.55, 0.8])
+    h = 1e-5
+    for r in (1, 2):
+        fd = (s.b(u + h, r - 1) - s.b(u - h, r - 1)) / (2 * h)
+        assert np.abs(fd - s.b(u, r)).max() <= 1e-5 * (1 + np.abs(s.b(u, r)).max())
+    d = curve_derivatives(SPACE, u, 5)
+    for r in (4, 5):
+        fd = (curve_derivatives(SPACE, u + h, r - 1)[r - 1] - curve_derivatives(SPACE, u - h, r - 1)[r - 1]) / (2 * h)
+        assert np.abs(fd - d[r]).max() <= 1e-6 * np.abs(d[r]).max()
+    with pytest.raises(DegenerateGeometryError, match=r"zero curvature or tangent at t="):
+        RectifyingDevelopable(GHTCurve([(0, 0, 0), (1, 1, 1), (2, 2, 2)]), -0.1, 0.1)
+
+
+# -- 5.5 canal surfaces ------------------------------------------------------------------------
+def test_canal_cylinder_and_cone_of_revolution_are_developable():
+    axis = GHTCurve([(0, 0, 0), (0, 0, 1), (0, 0, 2)], gamma=-1)
+    cyl = CanalSurface(axis, GHTCurve([[1.0], [1.0], [1.0]], gamma=-1))
+    rep = cyl.developability()
+    assert rep.developable and rep.kind == "cylinder of revolution" and rep.k_max <= 1e-6
+    X = cyl.evaluate(np.linspace(0, 1, 7), np.linspace(0, 1, 7))
+    np.testing.assert_allclose(np.hypot(X[:, 0], X[:, 1]), 1.0, atol=1e-12)
+    cone = CanalSurface(axis, GHTCurve([[1.0], [0.8], [0.6]], gamma=-1))
+    rep = cone.developability()
+    assert rep.developable and rep.kind == "cone of revolution" and rep.k_max <= 1e-6
+    # the envelope of the spheres is the cone: r_env(z) linear in z
+    X = cone.evaluate(np.linspace(0.1, 0.9, 9), np.linspace(0, 1, 9))
+    rr = np.hypot(X[:, 0], X[:, 1])
+    coef = np.polyfit(X[:, 2], rr, 1)
+    assert np.abs(np.polyval(coef, X[:, 2]) - rr).max() <= 1e-12
+
+
+def test_curved_canal_surface_is_not_called_developable():
+    tube = CanalSurface(GHTCurve([(1, 0, 0), (1, 1, 0), (0, 1, 0)], gamma=-1), 0.3)
+    rep = tube.developability()
+    assert not rep.developable and rep.kind == "not developable"
+    # torus section: K = cos φ / (r (R + r cos φ)) → |K| r² up to r/(R - r) = 0.3/0.7
+    assert 0.3 < rep.k_max < 0.45
+    assert "not developable" in str(rep)
+
+
+def test_canal_errors():
+    axis = GHTCurve([(0, 0, 0), (0, 0, 1), (0, 0, 2)])
+    with pytest.raises(DegenerateGeometryError, match=r"radius r\(t\)=-1 .*must be > 0"):
+        CanalSurface(axis, -1.0)
+    with pytest.raises(DegenerateGeometryError, match=r"\|r'\|=.* >= \|C'\|=.*no real envelope"):
+        CanalSurface(axis, GHTCurve([[0.1], [2.0], [5.0]]))
+
+
+# -- 5.6 joins and composites ------------------------------------------------------------------
+APEX = np.array([-25.0, 0.0, -2.0])
+
+
+def _cone_plane(phi: float, tilt: float = 0.0) -> np.ndarray:
+    n = np.array([tilt, math.cos(phi), -math.sin(phi)])
+    return np.concatenate([[-n @ APEX], n])
+
+
+def _first() -> EnvelopeDevelopable:
+    P = [_cone_plane(0.0, 0.1), _cone_plane(0.3, 0.12), _cone_plane(0.6, 0.16), _cone_plane(0.9, 0.18)]
+    return developable_from_planes(P, FRAMES, 0.3, -0.2, 0.1)
+
+
+NEXT = [_cone_plane(1.0), _cone_plane(1.1), _cone_plane(1.2), _cone_plane(1.35, 0.2), _cone_plane(1.5, 0.22), _cone_plane(1.6, 0.25)]
+
+
+@pytest.mark.parametrize("order", [1, 2, 3])
+def test_g_joins_measure_exactly_their_order(order):
+    a = _first()
+    b = join_developable(a, f"G{order}", NEXT, k=1.3, beta2=0.2, beta3=-0.1)
+    rep = measure_developable_joint(a, b)
+    assert rep.order == order, rep  # reaches the order and (generic free planes) no higher
+    assert rep.satisfies(f"G{order}") and not rep.satisfies(f"G{order + 1}") if order < 3 else rep.satisfies("G3")
+    assert rep.plane_angle <= 1e-12 and rep.ruling_distance <= 1e-12
+    assert rep.dual is not None and rep.dual.g_order >= order  # 4-D affine check of the dual curves
+    assert b.developability().theta_max <= ROUND_OFF_DEG
+    comp = CompositeDevelopable([a, b])
+    assert len(comp.joints()) == 1 and comp.joints()[0].order == order
+
+
+def test_measured_order_is_projective():
+    """Rescaling the second surface's planes (same planes, λ(t) ≠ 1) keeps the geometric order."""
+    a = _first()
+    b = join_developable(a, "G2", NEXT)
+    scaled = developable_from_planes(b.planes * 3.0, FRAMES, *b.dual_curve.shape_parameters)
+    assert measure_developable_joint(a, scaled).order == 2
+    # an unrelated surface starting elsewhere is not even G0
+    other = developable_from_planes(NEXT, FRAMES)
+    assert measure_developable_joint(a, other).order == -1
+
+
+def test_join_errors():
+    a = _first()
+    with pytest.raises(SingularJoinError, match=r"G0 joins only the tangent planes.*G1, G2 or G3"):
+        join_developable(a, "G0", NEXT)
+    with pytest.raises(SingularJoinError, match=r"k=-1 is not allowed.*k > 0"):
+        join_developable(a, "G1", NEXT, k=-1.0)
+    with pytest.raises(GHTError, match=r"trimmed to t_range=\(0.0, 0.5\)"):
+        join_developable(a.trimmed((0.0, 0.5)), "G1", NEXT)
+    with pytest.raises(DegenerateGeometryError, match=r"segments 0 and 1 do not share their joint ruling.*relative gap"):
+        CompositeDevelopable([a, developable_from_planes(NEXT, FRAMES)])
