@@ -15,6 +15,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -65,9 +66,15 @@ def test_features_inside_freecadcmd(tmp_path: Path) -> None:
     assert proc.returncode == 0, _summary(proc)
     assert "Ran " in out and "\nOK" in out, _summary(proc)
     # every test class of the module ran (a silently skipped feature would hide here)
-    for name in ("GHTCurveTest", "CompositeCurveTest"):
+    for name in (
+        "GHTCurveTest", "CompositeCurveTest", "DevelopableTest", "SpineDevelopableTest", "FlatPatternTest", "OptimizationTest"
+    ):
         assert name in out, f"{name} did not run:\n{_summary(proc)}"
-    assert (tmp_path / "curve.step").stat().st_size > 0
+    ran = re.search(r"Ran (\d+) tests?", out)
+    assert ran and int(ran.group(1)) >= 16, _summary(proc)
+    assert re.search(r"\nOK\s*$", out) and "skipped=" not in out, _summary(proc)
+    for f in ("curve.step", "composite.step", "developable.step", "flat.step", "flat.dxf", "flat.svg"):
+        assert (tmp_path / f).stat().st_size > 0, f
 
 
 def _load_core_numbers():
@@ -132,7 +139,10 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
         shutil.copy(shot, dest / "freecad_ght_workbench.png")
     assert not res["errors"], res["errors"]
     assert res["workbenches"] and res["active_workbench"] == "GHTWorkbench"
-    expected = {"GHT_Curve", "GHT_CompositeCurve", "GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"}
+    expected = {
+        "GHT_Curve", "GHT_CompositeCurve", "GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern",
+        "GHT_Optimization", "GHT_RunOptimization", "GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG",
+    }
     assert expected <= set(res["commands"]), res["commands"]
     assert all(res["commands"].values()), res["commands"]
     steps = {s["name"]: s for s in res["steps"]}
@@ -143,6 +153,10 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     c = steps["GHT_Curve"]["value"]
     assert c["dialog_open"] and c["live_changed"] and c["slider_gamma"] == -1.0, c
     assert c["restored"] == [0.0, 0.0] and c["length_restored"], c
+    opt = steps["GHT_RunOptimization"]["value"]
+    assert opt["best"] <= opt["initial"] and not opt["status"].startswith("cancelled"), opt
+    for name in ("GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"):
+        assert steps[name]["value"]["exists"], name
     for name, s in steps.items():
         if isinstance(s["value"], dict) and "valid" in s["value"]:
             assert s["value"]["created"] >= 1 and s["value"]["valid"], (name, s["value"])

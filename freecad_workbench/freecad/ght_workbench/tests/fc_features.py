@@ -16,7 +16,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import composite_curve, export, ght_curve
+from freecad.ght_workbench import composite_curve, developable, export, flat_pattern, ght_curve, optimization, spine_developable
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
 QUARTER = [(1.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.0, 1.0, 0.0)]
@@ -179,6 +179,256 @@ class CompositeCurveTest(unittest.TestCase):
         back = export.read_step(path)
         self.assertEqual(len(back.Edges), 3)
         self.assertAlmostEqual(back.Length, length, delta=1e-6)
+
+
+def _radial_error(face, r: float, n: int = 15) -> float:
+    """max |sqrt(x² + y²) - r| over an n x n grid of the face."""
+    u0, u1, v0, v1 = face.ParameterRange
+    err = 0.0
+    for u in np.linspace(u0, u1, n):
+        for v in np.linspace(v0, v1, n):
+            p = face.valueAt(u, v)
+            err = max(err, abs(math.hypot(p.x, p.y) - r))
+    return err
+
+
+class DevelopableTest(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("developable")
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def test_exact_cylinder_then_gamma(self):
+        # spec section 1: planes (-r,1,0,0), (-r,1,1,0), (-r,0,1,0) at γ = -1 envelope the quarter cylinder
+        obj = developable.make_developable(gamma=-1.0, doc=self.doc)
+        face = obj.Shape.Faces[0]
+        self.assertTrue(obj.Shape.isValid())
+        self.assertEqual(obj.Degree, 2)
+        self.assertLess(_radial_error(face, 10.0), 1e-5)
+        self.assertAlmostEqual(obj.Shape.Area, 10 * math.pi / 2 * 20, delta=1e-4)
+        self.assertLess(obj.ThetaMax.Value, 1e-9)
+        self.assertAlmostEqual(obj.DD, 1.0, delta=1e-12)
+        obj.Gamma = 1.0  # polynomial dual curve: still developable, no longer circular
+        self.doc.recompute()
+        self.assertTrue(obj.Shape.isValid())
+        self.assertGreater(_radial_error(obj.Shape.Faces[0], 10.0), 0.1)
+        self.assertLess(obj.ThetaMax.Value, 1e-6)
+
+    def test_linked_planes_and_weights(self):
+        # the same cylinder from App::Plane features: the middle plane needs the weight sqrt(2)
+        def plane(normal, point, name):
+            p = self.doc.addObject("Part::Plane", name)
+            p.Length = p.Width = 5
+            p.Placement = App.Placement(App.Vector(*point), App.Rotation(App.Vector(0, 0, 1), App.Vector(*normal)))
+            return p
+
+        s = math.sqrt(0.5)
+        p0 = plane((1, 0, 0), (10, 0, 0), "P0")
+        p1 = plane((s, s, 0), (5, 5, 0), "P1")  # x + y = r: the chord plane
+        p2 = plane((0, 1, 0), (0, 10, 0), "P2")
+        ea = plane((0, 0, 1), (0, 0, 0), "Ea")
+        eb = plane((0, 0, 1), (0, 0, 20), "Eb")
+        self.doc.recompute()
+        obj = developable.make_developable(
+            [(p0, ""), (p1, ""), (p2, "")], [(ea, ""), (eb, "")], gamma=-1.0, weights=[1.0, math.sqrt(2), 1.0], doc=self.doc
+        )
+        self.assertTrue(obj.Shape.isValid())
+        self.assertLess(_radial_error(obj.Shape.Faces[0], 10.0), 1e-5)
+        # moving a control plane reshapes the surface
+        p2.Placement.Base = App.Vector(0, 12, 0)
+        self.doc.recompute()
+        self.assertGreater(_radial_error(obj.Shape.Faces[0], 10.0), 0.5)
+        self.assertTrue(obj.Shape.isValid())
+
+    def test_save_reopen_step(self):
+        obj = developable.make_developable(gamma=-0.5, mu=0.2, doc=self.doc)
+        area, name = obj.Shape.Area, obj.Name
+        doc2 = _reopen(self.doc)
+        obj2 = doc2.getObject(name)
+        self.assertAlmostEqual(obj2.Shape.Area, area, delta=1e-9)
+        obj2.Gamma = 0.5
+        doc2.recompute()
+        self.assertTrue(obj2.Shape.isValid())
+        self.assertNotAlmostEqual(obj2.Shape.Area, area, delta=1e-3)
+        path = os.path.join(OUT, "developable.step")
+        export.export_step([obj2], path)
+        back = export.read_step(path)
+        self.assertEqual(len(back.Faces), 1)
+        self.assertAlmostEqual(back.Area, obj2.Shape.Area, delta=1e-6 * area)
+        # the re-imported face is still ruled B-spline data: it unrolls to the same area
+        part = doc2.addObject("Part::Feature", "Imported")
+        part.Shape = back
+        fp = flat_pattern.make_flat_pattern(part, "Face1", doc=doc2)
+        self.assertAlmostEqual(fp.AreaFlat, back.Area, delta=1e-6 * area)
+
+
+class SpineDevelopableTest(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("spine")
+        self.curve = ght_curve.make_ght_curve([(0, 0, 0), (10, 0, 5), (20, 10, 5), (25, 20, 0)], doc=self.doc)
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def test_spine_then_geodesic(self):
+        obj = spine_developable.make_spine_developable(self.curve, "Spine", 2.0, 10.0, doc=self.doc)
+        self.assertTrue(obj.Shape.isValid())
+        self.assertLess(obj.ThetaMax.Value, 1e-6)
+        # spine: every ruling lies on the curve's tangent line: a(u) - C(u) ∥ C'(u), |a - C| = V0
+        surf = obj.Proxy.surface(obj)
+        core = ght_curve.core_curve(self.curve)
+        u = np.linspace(0, 1, 9)
+        d = surf.a(u) - core.evaluate(u)
+        t = core.derivative(u)
+        self.assertLess(np.max(np.linalg.norm(np.cross(d, t), axis=1) / np.linalg.norm(t, axis=1)), 1e-9)
+        np.testing.assert_allclose(np.linalg.norm(d, axis=1), 2.0, atol=1e-9)
+        area_spine = obj.Shape.Area
+        obj.Kind = "Geodesic"
+        obj.V0, obj.V1 = -3.0, 3.0
+        self.doc.recompute()
+        self.assertTrue(obj.Shape.isValid())
+        self.assertNotAlmostEqual(obj.Shape.Area, area_spine, delta=1.0)
+        # geodesic strip: the curve lies on the face (v = 0 is C itself)
+        face = obj.Shape.Faces[0]
+        for x in np.linspace(0, 1, 7):
+            p = core.evaluate(x)
+            self.assertLess(face.distToShape(Part.Vertex(App.Vector(*p)))[0], 1e-5)
+        # the curve's shape parameter reshapes the strip
+        self.curve.Gamma = -0.8
+        self.doc.recompute()
+        self.assertTrue(obj.Shape.isValid())
+        self.assertLess(obj.ThetaMax.Value, 1e-6)
+
+    def test_save_reopen(self):
+        obj = spine_developable.make_spine_developable(self.curve, "Geodesic", -2.0, 4.0, doc=self.doc)
+        area, name = obj.Shape.Area, obj.Name
+        doc2 = _reopen(self.doc)
+        obj2 = doc2.getObject(name)
+        self.assertEqual(obj2.Kind, "Geodesic")
+        self.assertAlmostEqual(obj2.Shape.Area, area, delta=1e-9)
+
+
+class FlatPatternTest(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("flat")
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def test_cylinder_rectangle_then_gamma(self):
+        dev = developable.make_developable(gamma=-1.0, doc=self.doc)
+        fp = flat_pattern.make_flat_pattern(dev, bend_lines=6, doc=self.doc)
+        shape = fp.Shape
+        self.assertTrue(shape.isValid())
+        self.assertEqual(len(shape.Faces), 1)
+        # the quarter cylinder r = 10, H = 20 unrolls to an exact r·π/2 × H rectangle
+        dims = sorted([shape.BoundBox.XLength, shape.BoundBox.YLength])
+        self.assertAlmostEqual(dims[0], 5 * math.pi, delta=1e-9)
+        self.assertAlmostEqual(dims[1], 20.0, delta=1e-9)
+        self.assertAlmostEqual(shape.Faces[0].Area, 100 * math.pi, delta=1e-8)
+        self.assertLess(shape.BoundBox.ZLength, 1e-12)
+        bends = [e for e in shape.Edges if not any(e.isSame(f) for f in shape.Faces[0].Edges)]
+        self.assertEqual(len(bends), 6)
+        for e in bends:  # cylinder bend lines are parallel to the height
+            self.assertAlmostEqual(e.Length, 20.0, delta=1e-9)
+        # change the source's γ: the pattern follows, keeps the 3-D area (isometry)
+        dev.Gamma = 0.3
+        self.doc.recompute()
+        self.assertTrue(fp.Shape.isValid())
+        self.assertGreater(abs(fp.Shape.Faces[0].Area - 100 * math.pi), 1.0)
+        self.assertAlmostEqual(fp.Shape.Faces[0].Area, dev.Shape.Area, delta=1e-6 * dev.Shape.Area)
+        self.assertLess(fp.MaxRelativeError, 1e-9)
+        # DXF (R12, own writer) and SVG exports
+        dxf = os.path.join(OUT, "flat.dxf")
+        svg = os.path.join(OUT, "flat.svg")
+        export.export_flat_pattern_dxf(fp, dxf)
+        export.export_flat_pattern_svg(fp, svg)
+        codes = open(dxf).read().split("\n")
+        pairs = list(zip(codes[0::2], codes[1::2]))
+        ents = [(pairs[i][1], pairs[i + 1][1]) for i in range(len(pairs) - 1) if pairs[i][0].strip() == "0" and pairs[i + 1][0].strip() == "8"]
+        self.assertEqual(sum(1 for kind, layer in ents if kind == "LINE" and layer == "BEND"), 6)
+        self.assertGreaterEqual(sum(1 for kind, layer in ents if layer == "OUTLINE" and kind in ("LINE", "POLYLINE")), 4)
+        self.assertEqual(pairs[-1][1].strip(), "EOF")
+        import xml.etree.ElementTree as ET
+
+        root = ET.parse(svg).getroot()
+        ns = "{http://www.w3.org/2000/svg}"
+        groups = {g.get("id"): g for g in root.iter(ns + "g")}
+        self.assertEqual(len(list(groups["BEND"].iter(ns + "path"))), 6)
+        self.assertEqual(len(list(groups["OUTLINE"].iter(ns + "path"))), 4)
+
+    def test_save_reopen_step(self):
+        dev = developable.make_developable(gamma=-1.0, nu=0.4, doc=self.doc)
+        fp = flat_pattern.make_flat_pattern(dev, doc=self.doc)
+        area, name = fp.Shape.Faces[0].Area, fp.Name
+        doc2 = _reopen(self.doc)
+        fp2 = doc2.getObject(name)
+        self.assertAlmostEqual(fp2.Shape.Faces[0].Area, area, delta=1e-9)
+        path = os.path.join(OUT, "flat.step")
+        export.export_step([fp2], path)
+        back = export.read_step(path)
+        self.assertEqual(len(back.Faces), 1)
+        self.assertAlmostEqual(back.Faces[0].Area, area, delta=1e-6)
+
+
+class OptimizationTest(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("optimization")
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def test_fairness_writes_parameters(self):
+        curve = ght_curve.make_ght_curve([(0, 0, 0), (10, 25, 0), (30, -10, 5), (40, 10, 0)], mu=0.9, nu=-0.9, gamma=0.5, doc=self.doc)
+        length0 = curve.Shape.Length
+        opt = optimization.make_optimization([curve], "Fairness", doc=self.doc, PopulationSize=12, MaxIterations=15)
+        self.assertGreater(opt.CurrentValue, 0)
+        start = opt.CurrentValue
+        res = optimization.run_optimization(opt, gui=False)
+        self.assertLess(opt.BestValue, 0.9 * start)
+        self.assertAlmostEqual(opt.InitialValue, start, delta=1e-12 * start)
+        # the optimum was written into the driven curve, which recomputed
+        np.testing.assert_allclose([curve.Mu, curve.Nu, curve.Gamma], res.x, atol=1e-12)
+        self.assertAlmostEqual(opt.CurrentValue, opt.BestValue, delta=1e-9 * start)
+        self.assertNotAlmostEqual(curve.Shape.Length, length0, delta=1e-6)
+        self.assertTrue(curve.Shape.isValid())
+
+    def test_developability_and_cancel(self):
+        a = ght_curve.make_ght_curve([(0, 0, 0), (10, 2, 0), (20, 0, 0)], mu=0.5, doc=self.doc, name="A")
+        b = ght_curve.make_ght_curve([(0, 0, 10), (8, 6, 10), (20, 3, 10)], nu=-0.6, doc=self.doc, name="B")
+        opt = optimization.make_optimization([a, b], "Developability", doc=self.doc, PopulationSize=10, MaxIterations=30)
+        before = (a.Mu, a.Nu, a.Gamma, b.Mu, b.Nu, b.Gamma)
+        calls = []
+        opt.Proxy.run(opt, lambda it, mx, best: calls.append(it) or it >= 2)  # cancel after 2 iterations
+        self.assertEqual(opt.Status, "cancelled: targets unchanged")
+        self.assertEqual((a.Mu, a.Nu, a.Gamma, b.Mu, b.Nu, b.Gamma), before)
+        self.assertLessEqual(max(calls), 2)
+        opt.Proxy.run(opt)
+        self.assertLess(opt.BestValue, opt.InitialValue)
+        self.assertNotEqual((a.Mu, a.Nu, a.Gamma, b.Mu, b.Nu, b.Gamma), before)
+        self.assertAlmostEqual(opt.CurrentValue, opt.BestValue, delta=1e-9 * opt.InitialValue)
+
+    def test_developable_target_and_reopen(self):
+        dev = developable.make_developable(DEVELOPABLE_PLANES, gamma=0.8, mu=-0.7, doc=self.doc)
+        dev_name = dev.Name
+        opt = optimization.make_optimization([dev], "Fairness", doc=self.doc, PopulationSize=10, MaxIterations=10, WeightAL=1.0, WeightEn=0.0)
+        optimization.run_optimization(opt, gui=False)
+        self.assertLessEqual(opt.BestValue, opt.InitialValue)
+        self.assertTrue(dev.Shape.isValid())
+        name, best = opt.Name, opt.BestValue
+        doc2 = _reopen(self.doc)
+        opt2 = doc2.getObject(name)
+        self.assertEqual(opt2.Targets[0].Proxy.Type, "GHT::Developable")
+        self.assertAlmostEqual(opt2.CurrentValue, best, delta=1e-9 * max(best, 1.0))
+        self.assertEqual(opt2.Proxy.Type, "GHT::Optimization")
+
+
+DEVELOPABLE_PLANES = [(-10.0, 1.0, 0.0, 0.2), (-10.0, 1.0, 1.0, 0.1), (-10.0, 0.0, 1.0, 0.2)]
 
 
 if __name__ == "__main__":

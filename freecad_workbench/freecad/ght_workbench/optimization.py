@@ -1,0 +1,249 @@
+r"""Optimization feature: stores a shape-parameter problem and writes the optimum into the
+features it drives (spec sections 5, 7, 8).
+
+Problems (``ght_cad.optimize.problems``), chosen by ``Problem`` and the ``Targets``:
+
+* ``Fairness``, one GHT curve target: :class:`CurveFairnessProblem`, objective
+  ``w1 AL + w2 En + w3 CVEn`` with ``AL = ∫|X'|``, ``En = ∫|X''|²``, ``CVEn = ∫|X'''|²``.
+* ``Fairness``, one developable-from-planes target: :class:`DualCurveFairnessProblem`, the same
+  measures of the dual curve of the (normalized) control planes.
+* ``Developability``, two GHT curve targets: :class:`StripProblem`, ``R = ∫(1 - n_a·n_b) du`` of the
+  ruled strip between them (parameters ``a.mu ... b.gamma``).
+
+Recomputing the feature only evaluates the objective at the targets' current parameters
+(``CurrentValue``); :meth:`OptimizationFeature.run` (command *Run optimization*) runs PSO / GWO /
+I-GWO / DE with a progress callback that can cancel, then writes the best parameters into the
+targets, which recompute. A cancelled run changes nothing.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+import FreeCAD as App
+
+from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only
+
+__all__ = ["OptimizationFeature", "make_optimization", "run_optimization", "PROBLEMS", "METHODS"]
+
+PROBLEMS = ["Fairness", "Developability"]
+METHODS = ["igwo", "pso", "gwo", "de"]
+_OUT = ("InitialValue", "BestValue", "CurrentValue", "Evaluations", "Status", "BestParameters")
+
+
+def _kind(obj: Any) -> str:
+    return getattr(getattr(obj, "Proxy", None), "Type", "")
+
+
+class OptimizationFeature(FeatureProxy):
+    """Proxy of an optimization (``App::FeaturePython``: no shape)."""
+
+    Type = "GHT::Optimization"
+
+    def setup(self, obj: Any) -> None:
+        obj.addProperty("App::PropertyLinkList", "Targets", "Problem", "Driven features: one GHT curve or developable (Fairness), two GHT curves (Developability)")
+        obj.addProperty("App::PropertyEnumeration", "Problem", "Problem", "Fairness (AL/En/CVEn) or Developability (R of the strip between two curves)")
+        obj.Problem = PROBLEMS
+        obj.addProperty("App::PropertyStringList", "Free", "Problem", "Free parameter names (empty: all), e.g. mu, gamma or a.mu, b.nu")
+        obj.addProperty("App::PropertyFloat", "WeightAL", "Problem", "Weight of the arc length AL = ∫|X'| (Fairness)")
+        obj.addProperty("App::PropertyFloat", "WeightEn", "Problem", "Weight of the bending energy En = ∫|X''|² (Fairness)")
+        obj.addProperty("App::PropertyFloat", "WeightCVEn", "Problem", "Weight of the curvature variation CVEn = ∫|X'''|² (Fairness)")
+        obj.WeightEn = 1.0
+        obj.addProperty("App::PropertyEnumeration", "Method", "Optimizer", "igwo, pso, gwo or de (scipy differential evolution)")
+        obj.Method = METHODS
+        obj.addProperty("App::PropertyInteger", "PopulationSize", "Optimizer", "Population size")
+        obj.PopulationSize = 20
+        obj.addProperty("App::PropertyInteger", "MaxIterations", "Optimizer", "Iteration budget")
+        obj.MaxIterations = 40
+        obj.addProperty("App::PropertyInteger", "Seed", "Optimizer", "Random seed (runs are reproducible)")
+        obj.Seed = 1
+        obj.addProperty("App::PropertyFloat", "InitialValue", "Result", "Objective before the last run")
+        obj.addProperty("App::PropertyFloat", "BestValue", "Result", "Objective after the last run")
+        obj.addProperty("App::PropertyFloat", "CurrentValue", "Result", "Objective at the targets' current parameters")
+        obj.addProperty("App::PropertyInteger", "Evaluations", "Result", "Objective evaluations of the last run")
+        obj.addProperty("App::PropertyString", "Status", "Result", "Outcome of the last run")
+        obj.addProperty("App::PropertyStringList", "BestParameters", "Result", "name=value of the last optimum")
+        self.restored(obj)
+
+    def restored(self, obj: Any) -> None:
+        set_read_only(obj, _OUT)
+
+    # -- problem ------------------------------------------------------------------------
+    def problem(self, obj: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
+        """(core problem, [(target feature, property, parameter name), ...])."""
+        from ght_cad.optimize.problems import CurveFairnessProblem, DualCurveFairnessProblem, StripProblem
+
+        from .ght_curve import core_curve
+
+        targets = list(obj.Targets)
+        free = [s.strip() for s in obj.Free if s.strip()] or None
+        if obj.Problem == "Developability":
+            if len(targets) != 2 or any(_kind(t) != "GHT::Curve" for t in targets):
+                raise ValueError(f"{obj.Label}: Developability needs exactly two GHT curve targets (the strip's boundaries)")
+            prob = StripProblem(core_curve(targets[0]), core_curve(targets[1]), free=free)
+            mapping = [(targets[i], p, f"{s}.{p.lower()}") for i, s in enumerate("ab") for p in ("Mu", "Nu", "Gamma")]
+            return prob, mapping
+        if len(targets) != 1:
+            raise ValueError(f"{obj.Label}: Fairness needs exactly one target (a GHT curve or a developable), got {len(targets)}")
+        weights = {"AL": float(obj.WeightAL), "En": float(obj.WeightEn), "CVEn": float(obj.WeightCVEn)}
+        t = targets[0]
+        if _kind(t) == "GHT::Curve":
+            prob = CurveFairnessProblem(core_curve(t), objective=weights, free=free)
+        elif _kind(t) == "GHT::Developable":
+            planes, boundary = t.Proxy.control_planes(t)
+            prob = DualCurveFairnessProblem(planes, boundary, objective=weights, free=free, mu=float(t.Mu), nu=float(t.Nu), gamma=float(t.Gamma))
+        else:
+            raise ValueError(f"{t.Label} is a {_kind(t) or t.TypeId}; Fairness drives a GHT curve or a developable from planes")
+        return prob, [(t, p, p.lower()) for p in ("Mu", "Nu", "Gamma")]
+
+    def compute(self, obj: Any) -> None:
+        if not obj.Targets:
+            return
+        prob, _ = self.problem(obj)
+        obj.CurrentValue = prob.value(prob.x0)
+
+    # -- run ------------------------------------------------------------------------------
+    def run(self, obj: Any, progress: Callable[[int, int, float], bool] | None = None) -> Any:
+        """Optimize and write the best parameters into the targets (then recompute).
+
+        Args:
+            progress: ``progress(iteration, max_iterations, best_value) -> cancel`` called after
+                every iteration; returning True cancels (the targets are then left unchanged).
+
+        Returns:
+            The core :class:`ght_cad.optimize.OptimizeResult`.
+        """
+        from ght_cad.optimize import minimize
+
+        prob, mapping = self.problem(obj)
+        initial = prob.value(prob.x0)
+
+        def callback(state: Any) -> bool:
+            return bool(progress(state.nit, state.max_iter, state.fun)) if progress is not None else False
+
+        res = minimize(
+            prob, prob.bounds, method=obj.Method, pop_size=int(obj.PopulationSize), max_iter=int(obj.MaxIterations),
+            seed=int(obj.Seed), x0=prob.x0, callback=callback,
+        )
+        obj.InitialValue = float(initial)
+        obj.Evaluations = int(res.nfev)
+        obj.Status = str(res.message)
+        if res.message == "stopped by callback":
+            obj.Status = "cancelled: targets unchanged"
+            return res
+        params = prob.parameters(res.x)
+        if res.fun > initial:  # optimizers keep the start point, but never make it worse
+            params = prob.parameters(prob.x0)
+        for target, prop, name in mapping:
+            setattr(target, prop, float(params[name]))
+        obj.BestValue = float(min(res.fun, initial))
+        obj.BestParameters = [f"{k}={v:.12g}" for k, v in params.items()]
+        obj.Document.recompute()
+        return res
+
+
+class ViewProviderOptimization(ViewProviderBase):
+    icon_name = "GHT_Optimization"
+
+    def claimChildren(self) -> list:
+        return []
+
+
+def make_optimization(targets: list, problem: str = "Fairness", *, method: str = "igwo", doc: Any = None, name: str = "Optimization", **props: Any) -> Any:
+    """Create an optimization feature driving ``targets`` (see module doc); ``props`` set properties."""
+    if problem not in PROBLEMS:
+        raise ValueError(f"problem={problem!r} is not allowed; use one of {PROBLEMS}")
+    obj = new_feature(doc or targets[0].Document, name, OptimizationFeature, ViewProviderOptimization, "App::FeaturePython")
+    obj.Targets = list(targets)
+    obj.Problem = problem
+    obj.Method = method
+    for k, v in props.items():
+        setattr(obj, k, v)
+    obj.Document.recompute()
+    return obj
+
+
+def run_optimization(obj: Any, *, gui: bool | None = None) -> Any:
+    """Run ``obj``'s optimization; in the GUI with a cancellable progress dialog."""
+    gui = App.GuiUp if gui is None else gui
+    if not gui:
+        return obj.Proxy.run(obj)
+    from PySide2 import QtCore, QtWidgets
+
+    import FreeCADGui as Gui
+
+    dlg = QtWidgets.QProgressDialog(f"Optimizing {obj.Label} ({obj.Method})", "Cancel", 0, int(obj.MaxIterations), Gui.getMainWindow())
+    dlg.setWindowTitle("GHT optimization")
+    dlg.setWindowModality(QtCore.Qt.WindowModal)
+    dlg.setMinimumDuration(0)
+
+    def progress(it: int, max_it: int, best: float) -> bool:
+        dlg.setMaximum(max(max_it, 1))
+        dlg.setValue(min(it, max_it))
+        dlg.setLabelText(f"Optimizing {obj.Label}: iteration {it}/{max_it}, best {best:.6g}")
+        QtWidgets.QApplication.processEvents()
+        return dlg.wasCanceled()
+
+    try:
+        return obj.Proxy.run(obj, progress)
+    finally:
+        dlg.close()
+
+
+class CommandOptimization(BaseCommand):
+    name = "GHT_Optimization"
+    icon_name = "GHT_Optimization"
+    menu_text = "Optimization"
+    tooltip = (
+        "Create an optimization of the selected features' shape parameters: one GHT curve or "
+        "developable -> fairness (AL/En/CVEn weights); two GHT curves -> developability R of the "
+        "strip between them. Run it with 'Run optimization'."
+    )
+
+    def IsActive(self) -> bool:
+        import FreeCADGui as Gui
+
+        return App.ActiveDocument is not None and bool(Gui.Selection.getSelection())
+
+    def Activated(self) -> None:
+        import FreeCADGui as Gui
+
+        sel = [o for o in Gui.Selection.getSelection() if _kind(o) in ("GHT::Curve", "GHT::Developable")]
+        if not sel:
+            App.Console.PrintError("GHT optimization: select one or two GHT curves or a developable\n")
+            return
+        problem = "Developability" if len(sel) == 2 and all(_kind(o) == "GHT::Curve" for o in sel) else "Fairness"
+        doc = App.ActiveDocument
+        doc.openTransaction("Optimization")
+        obj = make_optimization(sel if problem == "Developability" else sel[:1], problem, doc=doc)
+        doc.commitTransaction()
+        Gui.Selection.clearSelection()
+        Gui.Selection.addSelection(obj)
+
+
+class CommandRunOptimization(BaseCommand):
+    name = "GHT_RunOptimization"
+    icon_name = "GHT_RunOptimization"
+    menu_text = "Run optimization"
+    tooltip = "Run the selected optimization (progress dialog, Cancel keeps the targets unchanged) and write the optimum into its targets"
+
+    def IsActive(self) -> bool:
+        import FreeCADGui as Gui
+
+        return any(_kind(o) == "GHT::Optimization" for o in Gui.Selection.getSelection())
+
+    def Activated(self) -> None:
+        import FreeCADGui as Gui
+
+        for obj in [o for o in Gui.Selection.getSelection() if _kind(o) == "GHT::Optimization"]:
+            doc = obj.Document
+            doc.openTransaction("Run optimization")
+            res = run_optimization(obj)
+            doc.commitTransaction()
+            App.Console.PrintMessage(f"GHT: {obj.Label}: {res}\n")
+
+
+register_command(CommandOptimization())
+register_command(CommandRunOptimization())
