@@ -25,6 +25,8 @@ lazily: this module imports numpy and scipy only).
 from __future__ import annotations
 
 import math
+import sys
+import types
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -504,3 +506,15 @@ def unroll_composite(
     mark_shared_edges(panels)
     layout_panels(panels, gap)
     return FlatPattern(panels, units=units)
+
+
+class _CallableModule(types.ModuleType):
+    """Importing the submodule ``ght_cad.unroll`` rebinds the package attribute ``ght_cad.unroll``
+    to this module, shadowing the stable function name (spec section 9); calling the module
+    therefore calls :func:`unroll`, so ``ght_cad.unroll(surface)`` works either way."""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> FlatPattern:
+        return unroll(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
