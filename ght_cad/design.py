@@ -495,11 +495,13 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         outputs = OutputSpec(ck.string_list(ot2, "files", "outputs", list(FILE_OUTPUTS), choices=FILE_OUTPUTS),
                              ck.string_list(ot2, "figures", "outputs", list(FIGURE_OUTPUTS), choices=FIGURE_OUTPUTS))
     if surface is None:
-        needs = [f for f in outputs.files if f in ("dxf", "svg")] + [f for f in outputs.figures if f in ("surface", "flat_pattern")]
-        if needs and ot2 is not None:
-            raise ck.fail("outputs", f"{', '.join(needs)} need a [surface] table; allowed without one: step, json, md, basis, curve, curvature")
-        outputs.files = [f for f in outputs.files if f not in ("dxf", "svg")]
-        outputs.figures = [f for f in outputs.figures if f not in ("surface", "flat_pattern")]
+        for key, kinds in (("files", ("dxf", "svg")), ("figures", ("surface", "flat_pattern"))):
+            explicit = ot2 is not None and key in ot2
+            needs = [f for f in getattr(outputs, key) if f in kinds]
+            if explicit and needs:
+                allowed = [f for f in (FILE_OUTPUTS if key == "files" else FIGURE_OUTPUTS) if f not in kinds]
+                raise ck.fail(f"outputs.{key}", f"{', '.join(needs)} need a [surface] table; allowed without one: {', '.join(allowed)}")
+            setattr(outputs, key, [f for f in getattr(outputs, key) if f not in kinds])
         if not curves:
             raise ck.fail("surface", "missing; a design needs a [surface] table or at least one [[curves]] entry")
     explicit_figs = ot2 is not None and "figures" in ot2

@@ -1,0 +1,218 @@
+"""Design files: validation (one-line errors naming file, key and allowed values; exit code 2)
+and the staged runner (a failure leaves the output folder untouched)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from ght_cad.cli import main
+from ght_cad.design import DesignError, load_design, parse_design, parse_design_text, run_design
+
+# a small valid design: the exact quarter cone of the spec, no optimization (fast)
+GOOD = """
+name = "cone"
+units = "mm"
+
+[[curves]]
+name = "c1"
+control_points = [[0, 0, 0], [1, 2, 0], [3, 2, 1], [4, 0, 1]]
+
+[[curves]]
+name = "c2"
+control_points = [[4, 0, 1], [5, -1, 1], [6, 0, 2]]
+
+[[joins]]
+first = "c1"
+second = "c2"
+continuity = "G1"
+
+[surface]
+type = "planes"
+planes = [[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]
+boundary_planes = [[0, 0, 0, 1], [-4, 0, 0, 1]]
+gamma = -1.0
+normalize = false
+
+[outputs]
+files = ["step", "dxf", "json"]
+figures = ["surface"]
+"""
+
+
+def snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
+    return {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in sorted(folder.iterdir())}
+
+
+@pytest.fixture
+def out_dir(tmp_path: Path) -> Path:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "model.step").write_text("previous result\n")
+    (out / "notes.txt").write_text("keep me\n")
+    return out
+
+
+def run_cli(design_text: str, tmp_path: Path, out: Path, capsys: pytest.CaptureFixture) -> tuple[int, str, Path]:
+    path = tmp_path / "broken.toml"
+    path.write_text(design_text)
+    rc = main(["run", str(path), "--out", str(out)])
+    err = capsys.readouterr().err
+    return rc, err, path
+
+
+def edit(old: str, new: str) -> str:
+    assert old in GOOD
+    return GOOD.replace(old, new)
+
+
+BROKEN = {
+    # (design text, key named in the message, allowed values named in the message)
+    "missing key": (edit("planes = [[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]\n", ""),
+                    "surface.planes", "at least 3 arrays of 4 numbers"),
+    "wrong type": (edit("gamma = -1.0", 'gamma = "round"'), "surface.gamma", "[-1, 1]"),
+    "out of range": (edit("gamma = -1.0", "gamma = 1.5"), "surface.gamma", "[-1, 1]"),
+    "unknown output": (edit('files = ["step", "dxf", "json"]', 'files = ["step", "stl"]'),
+                       "outputs.files", "step, dxf, svg, json, md"),
+    "unknown figure": (edit('figures = ["surface"]', 'figures = ["rendering"]'), "outputs.figures", "basis, curve"),
+    "unknown key": (edit("normalize = false", "normalise = false"), "surface.normalise", "normalize"),
+    "bad continuity": (edit('continuity = "G1"', 'continuity = "G4"'), "joins[0].continuity", "C0, C1, C2, C3, G0"),
+    "unknown curve": (edit('second = "c2"', 'second = "c3"'), "joins[0].second", "c1, c2"),
+    "short points": (edit("[[4, 0, 1], [5, -1, 1], [6, 0, 2]]", "[[4, 0, 1], [5, -1, 1]]"),
+                     "curves[1].control_points", "at least 3"),
+    "bad units": (edit('units = "mm"', 'units = "furlong"'), "units", "mm, cm, m, in, ft"),
+}
+
+
+@pytest.mark.parametrize("case", list(BROKEN))
+def test_broken_design_one_line_exit_2_untouched(case: str, tmp_path: Path, out_dir: Path, capsys) -> None:
+    text, key, allowed = BROKEN[case]
+    before = snapshot(out_dir)
+    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
+    assert rc == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert str(path) in lines[0] and f"'{key}'" in lines[0] and allowed in lines[0], lines[0]
+    assert snapshot(out_dir) == before
+    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+
+
+def test_invalid_toml_is_one_line(tmp_path: Path, out_dir: Path, capsys) -> None:
+    rc, err, path = run_cli('name = "x\n[surface', tmp_path, out_dir, capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err and "TOML" in err
+
+
+def test_missing_design_file(tmp_path: Path, capsys) -> None:
+    rc = main(["run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "nope.toml" in err and not (tmp_path / "o").exists()
+
+
+def test_new_out_folder_not_created_on_error(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "fresh"
+    rc, _, _ = run_cli(edit("gamma = -1.0", "gamma = 2"), tmp_path, out, capsys)
+    assert rc == 2 and not out.exists()
+
+
+def test_degenerate_geometry_exit_2_untouched(tmp_path: Path, out_dir: Path, capsys) -> None:
+    """Valid schema, impossible geometry (two equal neighbouring planes): found while computing."""
+    text = edit("[[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]", "[[-4, 1, 0, 0.5], [-4, 1, 0, 0.5], [-4, 0, 1, 0.5]]")
+    before = snapshot(out_dir)
+    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err
+    assert snapshot(out_dir) == before
+    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+
+
+def test_failure_after_files_were_written_leaves_out_untouched(tmp_path: Path, out_dir: Path, monkeypatch) -> None:
+    """A crash in the last figure (after STEP and DXF were written) moves nothing into out."""
+    import ght_cad.plotting as P
+
+    def boom(*a, **k):
+        raise RuntimeError("renderer crashed")
+
+    monkeypatch.setattr(P, "plot_surface", boom)
+    before = snapshot(out_dir)
+    design = parse_design_text(GOOD, "good.toml")
+    with pytest.raises(RuntimeError, match="renderer crashed"):
+        run_design(design, out_dir, progress=False)
+    assert snapshot(out_dir) == before
+    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+
+
+def test_good_design_runs_and_replaces_only_its_files(tmp_path: Path, out_dir: Path) -> None:
+    design = parse_design_text(GOOD, "good.toml")
+    report = run_design(design, out_dir, progress=False)
+    names = {p.name for p in out_dir.iterdir()}
+    assert names == {"model.step", "flat_pattern.dxf", "report.json", "surface.png", "notes.txt"}
+    assert (out_dir / "notes.txt").read_text() == "keep me\n"
+    assert (out_dir / "model.step").read_text().startswith("ISO-10303-21")
+    assert json.loads((out_dir / "report.json").read_text())["name"] == "cone"
+    # the joined curves achieve what was asked
+    assert report["joins"][0]["achieved_G"] >= 1 and report["joins"][0]["satisfied"]
+    # exact quarter cone frustum: h = 8, k = 0.5, cut at z = 0 and z = 4
+    rho2 = math.hypot(4.0, 8.0)
+    rho1 = rho2 / 2
+    angle = (math.pi / 2) * 4.0 / rho2
+    assert report["flat_pattern"]["area"] == pytest.approx(0.5 * angle * (rho2**2 - rho1**2), rel=1e-12)
+
+
+def test_defaults_and_normalisation(tmp_path: Path) -> None:
+    d = parse_design({"curves": [{"control_points": [[0, 0], [1, 1], [2, 0]]}]}, "x.toml")
+    assert d.name == "x" and d.curves[0].name == "curve1" and d.surface is None
+    # without a surface, surface outputs are dropped from the defaults, and without [optimize] the convergence plot
+    assert "dxf" not in d.outputs.files and "flat_pattern" not in d.outputs.figures
+    assert "convergence" not in d.outputs.figures and "curve" in d.outputs.figures
+
+
+@pytest.mark.parametrize(
+    "data,key",
+    [
+        ({}, "surface"),
+        ({"surface": {"type": "cone"}}, "surface.type"),
+        ({"surface": {"type": "curves", "curve_a": "a", "curve_b": "b"}}, "surface.curve_a"),
+        ({"curves": [{"control_points": [[0, 0], [1, 1], [2, 0]], "mu": True}]}, "curves[0].mu"),
+        ({"curves": [{"control_points": [[0, 0], [1, 1], [2, float("nan")]]}]}, "curves[0].control_points[2][1]"),
+        ({"curves": [{"control_points": [[0, 0], [1, 1], [2, 0]]}], "optimize": {}}, "optimize"),
+        ({"curves": [{"control_points": [[0, 0], [1, 1], [2, 0]]}], "outputs": {"figures": ["convergence"]}}, "outputs.figures"),
+        ({"curves": [{"control_points": [[0, 0], [1, 1], [2, 0]]}], "extra": 1}, "extra"),
+    ],
+)
+def test_parse_errors_name_the_key(data: dict, key: str) -> None:
+    with pytest.raises(DesignError) as ei:
+        parse_design(data, "f.toml")
+    msg = str(ei.value)
+    assert msg.startswith("f.toml: ") and f"'{key}'" in msg and "\n" not in msg
+
+
+def test_optimize_block_validation() -> None:
+    base = {"surface": {"planes": [[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]],
+                        "boundary_planes": [[0, 0, 0, 1], [-4, 0, 0, 1]]}}
+    d = parse_design({**base, "optimize": {"method": "PSO", "objective": "en"}}, "f.toml")
+    assert (d.optimize.method, d.optimize.objective) == ("pso", "En")
+    for bad, key, allowed in [
+        ({"objective": "R"}, "optimize.objective", "AL, En, CVEn, weighted"),
+        ({"population": 2}, "optimize.population", "[4, 500]"),
+        ({"parameters": ["mu", "a.mu"]}, "optimize.parameters", "mu, nu, gamma"),
+        ({"weights": [0, 0, 0]}, "optimize.weights", "not all 0"),
+    ]:
+        with pytest.raises(DesignError, match=rf"'{key}'.*{allowed.replace('[', '.').replace(']', '.')}"):
+            parse_design({**base, "optimize": bad}, "f.toml")
+
+
+@pytest.mark.parametrize("name", ["design_duct.toml", "design_hull_plate.toml"])
+def test_example_designs_validate(name: str) -> None:
+    d = load_design(Path(__file__).parent.parent / "examples" / name)
+    assert d.surface is not None
+
+
+def test_embedded_default_design_validates() -> None:
+    from ght_cad.demo import default_design_text
+
+    d = parse_design_text(default_design_text(), "<embedded>")
+    assert d.surface.type == "planes" and d.optimize is not None and len(d.joins) == 1
+    assert set(d.outputs.files) == {"step", "dxf", "svg", "json", "md"}
+    assert set(d.outputs.figures) == {"basis", "curve", "curvature", "surface", "flat_pattern", "convergence"}
