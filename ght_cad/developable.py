@@ -55,6 +55,8 @@ __all__ = [
 ]
 
 _Jet = list  # list of arrays: value and derivatives 0..K
+_ZERO = np.array([0.0])
+_ONE = np.array([1.0])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -960,7 +962,7 @@ def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *,
     nA = U[0][1:] / np.linalg.norm(U[0][1:])
     nB = V[0][1:] / np.linalg.norm(V[0][1:])
     angle = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(nA, nB)), abs(float(nA @ nB)))))
-    pa, pb = a.a(1.0)[0], a.b(1.0)[0]
+    pa, pb = a.a(_ONE)[0], a.b(_ONE)[0]
     seg = max(float(np.linalg.norm(pb - pa)), 1e-300)
     dist = 0.0
     for p in (pa, pb):
@@ -1057,8 +1059,8 @@ class CompositeDevelopable:
                 raise GHTError(f"segments[{i}] is a {type(s).__name__}, not a RuledSurface")
         for i in range(len(segs) - 1):
             A, B = segs[i], segs[i + 1]
-            pa, pb = A.a(1.0)[0], A.b(1.0)[0]
-            qa, qb = B.a(0.0)[0], B.b(0.0)[0]
+            pa, pb = A.a(_ONE)[0], A.b(_ONE)[0]
+            qa, qb = B.a(_ZERO)[0], B.b(_ZERO)[0]
             L = max(float(np.linalg.norm(pb - pa)), 1e-300)
             gap = max(float(np.linalg.norm(pa - qa)), float(np.linalg.norm(pb - qb))) / L
             if gap > tol:

@@ -119,7 +119,7 @@ def developable_surface_data(
         return np.hstack([surface.a(u), surface.b(u)])
 
     ends = tuple(
-        [np.concatenate([surface.a(e, r)[0], surface.b(e, r)[0]]) for r in range(min(end_order, degree - 1) + 1)]
+        [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(min(end_order, degree - 1) + 1)]
         for e in (0.0, 1.0)
     )
     try:
