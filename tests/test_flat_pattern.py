@@ -1,0 +1,155 @@
+"""FlatPattern: report, DXF/SVG/PNG export (re-read), atomic writes, helpers."""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+
+import ezdxf
+import numpy as np
+import pytest
+
+from ght_cad import GHTCurve
+from ght_cad.errors import GHTError
+from ght_cad.flat_pattern import DistortionReport, FlatPattern, clip_segments, romberg_length
+from ght_cad.ruled import CurvePairRuledSurface
+from ght_cad.unroll import unroll, unroll_composite
+
+
+def quarter(r: float, z: float, start: float = 0.0) -> GHTCurve:
+    c, s = math.cos(start), math.sin(start)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    P = np.array([(r, 0, z), (r, r, z), (0, r, z)]) @ R.T
+    return GHTCurve(P, gamma=-1)
+
+
+@pytest.fixture(scope="module")
+def pattern() -> FlatPattern:
+    return unroll(CurvePairRuledSurface(quarter(1.0, 0.0), quarter(2.0, 1.5)), rulings=7, units="mm")
+
+
+def test_errors_and_report(pattern: FlatPattern) -> None:
+    e = pattern.errors
+    assert set(e) == {"boundary_length", "ruling_length", "area", "angle_deg", "max"}
+    assert e["max"] == max(e["boundary_length"], e["ruling_length"], e["area"])
+    assert e["max"] < 1e-12
+    d = pattern.report.as_dict()
+    for k in ("boundary_length", "ruling_length", "area", "angle_deg", "stretch"):
+        assert d[k]["rms"] <= d[k]["max"] + 1e-300
+    assert len(pattern.report.boundary_names) == 4
+    text = pattern.summary()
+    for word in ("boundary length", "ruling length", "area", "angle", "max", "rms"):
+        assert word in text
+
+
+def test_dxf_reread(pattern: FlatPattern, tmp_path) -> None:
+    path = pattern.export_dxf(tmp_path / "p.dxf")
+    doc = ezdxf.readfile(path)
+    names = {layer.dxf.name for layer in doc.layers}
+    assert {"OUTLINE", "BEND", "LABELS"} <= names
+    assert doc.header["$INSUNITS"] == 4  # mm
+    msp = doc.modelspace()
+    outlines = msp.query('LWPOLYLINE[layer=="OUTLINE"]')
+    assert len(outlines) == 1 and outlines[0].closed
+    pts = np.array([p[:2] for p in outlines[0].get_points()])
+    np.testing.assert_allclose(pts, pattern.outlines[0], atol=1e-12)
+    bends = msp.query('LINE[layer=="BEND"]')
+    assert len(bends) == 7
+    assert all(b.dxf.linetype == "DASHED" for b in bends)
+    assert doc.layers.get("BEND").dxf.linetype == "DASHED"
+    assert "DASHED" in doc.linetypes
+    texts = [t.dxf.text for t in msp.query('TEXT[layer=="LABELS"]')]
+    assert "P1" in texts
+
+
+def test_dxf_units_and_spline(tmp_path) -> None:
+    pat = unroll(CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 2.0)), units="in", rulings=2)
+    doc = ezdxf.readfile(pat.export_dxf(tmp_path / "s.dxf", spline=True))
+    assert doc.header["$INSUNITS"] == 1
+    sp = doc.modelspace().query('SPLINE[layer=="OUTLINE"]')
+    assert len(sp) == 1 and sp[0].closed
+
+
+def test_svg_is_valid_xml_with_layers(pattern: FlatPattern, tmp_path) -> None:
+    path = pattern.export_svg(tmp_path / "p.svg")
+    root = ET.parse(path).getroot()
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    assert root.tag.endswith("svg")
+    assert root.get("width").endswith("mm")
+    groups = {g.get("id"): g for g in root.findall("s:g", ns)}
+    assert {"OUTLINE", "BEND", "LABELS"} <= set(groups)
+    assert len(groups["OUTLINE"].findall("s:polygon", ns)) == 1
+    assert len(groups["BEND"].findall("s:line", ns)) == 7
+    assert groups["BEND"].get("stroke-dasharray")
+    # polygon reproduces the outline up to the y flip and translation
+    poly = np.array([[float(c) for c in p.split(",")] for p in groups["OUTLINE"][0].get("points").split()])
+    out = pattern.outlines[0]
+    np.testing.assert_allclose(np.ptp(poly, axis=0), np.ptp(out, axis=0), rtol=1e-8)
+
+
+def test_png_preview(pattern: FlatPattern, tmp_path) -> None:
+    path = pattern.plot_png(tmp_path / "p.png")
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
+
+
+def test_failed_export_leaves_no_partial_file(pattern: FlatPattern, tmp_path, monkeypatch) -> None:
+    target = tmp_path / "keep.dxf"
+    target.write_text("old")
+
+    def boom(self, *a, **k):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(ezdxf.document.Drawing, "saveas", boom)
+    with pytest.raises(OSError):
+        pattern.export_dxf(target)
+    assert target.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.dxf"]
+
+
+def test_romberg_length_circle() -> None:
+    t = np.linspace(0.0, 2.0, 4 * 32 + 1)
+    pts = np.stack([np.cos(t), np.sin(t)], axis=1)
+    assert abs(romberg_length(pts) - 2.0) < 1e-11
+    assert abs(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)) - 2.0) > 1e-6  # plain chords are not
+    with pytest.raises(GHTError, match="4N\\+1"):
+        romberg_length(pts[:-1])
+
+
+def test_clip_segments_with_hole() -> None:
+    square = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
+    hole = np.array([[1, 1], [3, 1], [3, 3], [1, 3]], float)
+    segs = np.array([[[2, -1], [2, 5]], [[0.5, -1], [0.5, 5]]], float)
+    out = clip_segments(segs, [square, hole])
+    lengths = sorted(np.linalg.norm(s[1] - s[0]) for s in out)
+    np.testing.assert_allclose(lengths, [1.0, 1.0, 4.0], atol=1e-12)
+
+
+def test_bad_units() -> None:
+    with pytest.raises(GHTError, match="units='yd'"):
+        FlatPattern([], units="yd")
+
+
+def test_report_combine() -> None:
+    a = DistortionReport(np.array([1e-3]), ["x"], np.array([0.0]), np.array([1e-4]), np.array([0.1]), np.array([0.0]))
+    b = DistortionReport(np.array([2e-3]), ["y"], np.array([5e-3]), np.array([1e-5]), np.array([0.2]), np.array([0.0]))
+    c = DistortionReport.combine([a, b])
+    d = c.as_dict()
+    assert d["boundary_length"]["max"] == 2e-3
+    assert d["ruling_length"]["max"] == 5e-3
+    np.testing.assert_allclose(d["area"]["rms"], math.sqrt((1e-8 + 1e-10) / 2))
+    assert c.max_relative_error == 5e-3
+
+
+def test_composite_exports_all_panels(tmp_path) -> None:
+    s1 = CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 1.0))
+    s2 = CurvePairRuledSurface(quarter(1.0, 0.0, math.pi / 2), quarter(1.0, 1.0, math.pi / 2))
+    pat = unroll_composite([s1, s2], rulings=3)
+    doc = ezdxf.readfile(pat.export_dxf(tmp_path / "c.dxf"))
+    msp = doc.modelspace()
+    assert len(msp.query('LWPOLYLINE[layer=="OUTLINE"]')) == 2
+    texts = [t.dxf.text for t in msp.query("TEXT")]
+    assert {"P1", "P2"} <= set(texts) and texts.count("E1") == 2
+    assert len(msp.query('LINE[layer=="MARKS"]')) == 6
+    root = ET.parse(pat.export_svg(tmp_path / "c.svg")).getroot()
+    assert root.tag.endswith("svg")
