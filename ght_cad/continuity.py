@@ -171,7 +171,7 @@ def join_targets(
 ) -> list[np.ndarray]:
     r"""Targets ``T_r`` for ``R^(r)(0)``, r = 0..order, from segment A's end derivatives.
 
-    C: ``T_r = P^(r)(1)``. G: ``T_0 = P(1)``, ``T_1 = k P'``, ``T_2 = k² P'' + β2 P'``,
+    C: ``T_r = P^(r)(1)``, ``T_0 = P(1) = P_m`` (exactly). G: ``T_0 = P_m``, ``T_1 = k P'``, ``T_2 = k² P'' + β2 P'``,
     ``T_3 = k³ P''' + 3kβ2 P'' + β3 P'`` (all at t = 1).
 
     Args:
@@ -198,6 +198,7 @@ def join_targets(
     r = cont.order
     P = segment_a.control_points
     d = [row @ P for row in _end_rows(segment_a, 1, r)]
+    d[0] = np.array(P[-1], dtype=float)  # P(1) = P_m exactly (b_{i,m}(1) = δ_im, spec section 2)
     if not cont.geometric:
         return d
     out = [d[0]]
@@ -274,7 +275,8 @@ def join(
     targets = join_targets(segment_a, cont, k=k, beta2=beta2, beta3=beta3)
     rows = _end_rows(b, 0, r_max)
     pts = np.array(b.control_points, dtype=float)
-    for r in range(r_max + 1):
+    pts[0] = targets[0]  # R(0) = R_0 exactly (b_{i,n}(0) = δ_i0, c_0 = 1)
+    for r in range(1, r_max + 1):
         row = rows[r]
         c = float(row[r])
         if not abs(c) > _SINGULAR_REL * max(1.0, float(np.abs(row).sum())):
@@ -284,7 +286,7 @@ def join(
                 f"mu={b.mu:g}, nu={b.nu:g}, gamma={b.gamma:g}; order {r} cannot be imposed by moving "
                 f"R_{r}: change B's degree or shape parameters"
             )
-        known = row[:r] @ pts[:r] if r else 0.0
+        known = row[:r] @ pts[:r]
         pts[r] = (targets[r] - known) / c
     return GHTCurve(pts, seed=b.seed)
 
