@@ -116,9 +116,16 @@ class ViewProviderBase:
 
     icon_name = "GHT_Workbench"
     panel_factory: Callable[[Any], Any] | None = None
+    #: default colours (r, g, b in 0..1) and line width of new objects
+    shape_color: tuple | None = None
+    line_color: tuple | None = None
+    line_width: float | None = None
 
     def __init__(self, vobj: Any) -> None:
         vobj.Proxy = self
+        for prop, value in (("ShapeColor", self.shape_color), ("LineColor", self.line_color), ("LineWidth", self.line_width)):
+            if value is not None and hasattr(vobj, prop):
+                setattr(vobj, prop, value)
 
     def attach(self, vobj: Any) -> None:
         self.Object = vobj.Object

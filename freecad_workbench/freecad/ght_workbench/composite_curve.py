@@ -75,6 +75,8 @@ class CompositeCurveFeature(FeatureProxy):
 
 class ViewProviderCompositeCurve(ViewProviderBase):
     icon_name = "GHT_CompositeCurve"
+    line_color = (0.1, 0.45, 0.2)
+    line_width = 2.5
 
     def claimChildren(self) -> list:
         return list(getattr(self.Object, "Segments", []))

@@ -130,6 +130,7 @@ class DevelopableFeature(SurfaceOutputs, FeatureProxy):
 
 class ViewProviderDevelopable(ViewProviderBase):
     icon_name = "GHT_Developable"
+    shape_color = (0.5, 0.7, 0.9)
 
     def claimChildren(self) -> list:
         links = list(getattr(self.Object, "Planes", [])) + list(getattr(self.Object, "BoundaryPlanes", []))

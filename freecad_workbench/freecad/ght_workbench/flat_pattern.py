@@ -141,6 +141,8 @@ class FlatPatternFeature(FeatureProxy):
 
 class ViewProviderFlatPattern(ViewProviderBase):
     icon_name = "GHT_FlatPattern"
+    shape_color = (0.91, 0.85, 0.66)
+    line_color = (0.7, 0.1, 0.1)
 
 
 def make_flat_pattern(source: Any, sub: str = "", bend_lines: int = 8, *, doc: Any = None, name: str = "FlatPattern") -> Any:
@@ -149,6 +151,11 @@ def make_flat_pattern(source: Any, sub: str = "", bend_lines: int = 8, *, doc: A
     obj.Source = (source, [sub] if sub else [])
     obj.BendLines = int(bend_lines)
     obj.Document.recompute()
+    # lay the pattern beside its source (XY plane, to the +x side); later recomputes keep it
+    src, flat = source.Shape.BoundBox, obj.Shape.BoundBox
+    if src.isValid() and flat.isValid():
+        gap = 0.2 * max(src.DiagonalLength, flat.DiagonalLength)
+        obj.Placement = App.Placement(App.Vector(src.XMax + gap - flat.XMin, src.YMin - flat.YMin, 0), App.Rotation())
     return obj
 
 

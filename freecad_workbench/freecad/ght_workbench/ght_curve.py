@@ -96,6 +96,8 @@ class GHTCurveFeature(FeatureProxy):
 
 class ViewProviderGHTCurve(ViewProviderBase):
     icon_name = "GHT_Curve"
+    line_color = (0.1, 0.3, 0.55)
+    line_width = 2.0
 
     def claimChildren(self) -> list:
         return []

@@ -57,6 +57,7 @@ class SpineDevelopableFeature(SurfaceOutputs, FeatureProxy):
 
 class ViewProviderSpineDevelopable(ViewProviderBase):
     icon_name = "GHT_SpineDevelopable"
+    shape_color = (0.6, 0.83, 0.6)
 
     def claimChildren(self) -> list:
         c = getattr(self.Object, "Curve", None)

@@ -1,8 +1,7 @@
 """Reference numbers of the ght_cad core, computed identically in FreeCAD's Python (numpy 1.24)
 and in the project's environment (numpy 2); the pytest side compares the two to ~1e-12.
 
-Imports ght_cad only (no FreeCAD), so pytest can load this file directly. Parts of the core that
-are not present yet are skipped (the key is absent in both runs).
+Imports ght_cad only (no FreeCAD), so pytest can load this file directly.
 """
 
 from __future__ import annotations
@@ -75,11 +74,31 @@ def _unroll(out: dict[str, Any]) -> None:
 
     planes = [(-10.0, 1.0, 0.0, 0.0), (-10.0, 1.0, 1.0, 0.0), (-10.0, 0.0, 1.0, 0.0)]
     boundary = [(0.0, 0.0, 0.0, 1.0), (-20.0, 0.0, 0.0, 1.0)]
-    pat = unroll(developable_from_planes(planes, boundary, 0.0, 0.0, -1.0))
-    out["unroll/area"] = float(pat.area) if hasattr(pat, "area") else float("nan")
-    outline = pat.outline() if callable(getattr(pat, "outline", None)) else getattr(pat, "outline", None)
-    if outline is not None:
-        out["unroll/outline0"] = np.asarray(outline[0] if isinstance(outline, (list, tuple)) else outline, dtype=float)
+    pat = unroll(developable_from_planes(planes, boundary, 0.0, 0.0, -1.0), rulings=5, samples=33)
+    out["unroll/cylinder/area"] = float(pat.area)
+    out["unroll/cylinder/outline0"] = pat.outlines[0]
+    out["unroll/cylinder/bend_lines"] = pat.bend_lines
+    planes2 = [(-10.0, 1.0, 0.0, 0.2), (-10.0, 1.0, 1.0, 0.1), (-10.0, 0.0, 1.0, 0.2)]
+    pat2 = unroll(developable_from_planes(planes2, boundary, 0.1, -0.2, -0.6), rulings=5, samples=33)
+    out["unroll/general/area"] = float(pat2.area)
+    out["unroll/general/outline0"] = pat2.outlines[0]
+
+
+def _problems(out: dict[str, Any]) -> None:
+    from ght_cad import GHTCurve
+    from ght_cad.optimize.problems import CurveFairnessProblem, DualCurveFairnessProblem, StripProblem
+
+    X = np.array([[0.1, -0.4, 0.3], [-0.9, 0.8, -1.0], [0.5, 0.5, 0.9]])
+    c = GHTCurve(POINTS, 0.0, 0.0, 0.0)
+    p = CurveFairnessProblem(c, objective={"AL": 1.0, "En": 0.01, "CVEn": 1e-4})
+    out["problems/curve_fairness/measures"] = p.measures(X)
+    planes = [(-10.0, 1.0, 0.0, 0.2), (-10.0, 1.0, 1.0, 0.1), (-10.0, 0.0, 1.0, 0.2)]
+    q = DualCurveFairnessProblem(planes, objective="En")
+    out["problems/dual_fairness/values"] = q(X)
+    a = GHTCurve([(0, 0, 0), (10, 2, 0), (20, 0, 0)])
+    b = GHTCurve([(0, 0, 10), (8, 6, 10), (20, 3, 10)])
+    s = StripProblem(a, b)
+    out["problems/strip/values"] = s(np.hstack([X, X[::-1]]))
 
 
 SECTIONS: dict[str, Callable[[dict[str, Any]], None]] = {
@@ -89,19 +108,13 @@ SECTIONS: dict[str, Callable[[dict[str, Any]], None]] = {
     "join": _join,
     "developable": _developable,
     "unroll": _unroll,
+    "problems": _problems,
 }
 
 
 def compute() -> dict[str, Any]:
-    """All reference numbers as ``{key: list | float}`` (JSON-ready); missing core parts skipped."""
+    """All reference numbers as ``{key: list | float}`` (JSON-ready)."""
     out: dict[str, Any] = {}
-    for name, fn in SECTIONS.items():
-        part: dict[str, Any] = {}
-        try:
-            fn(part)
-        except ImportError:
-            continue
-        except AttributeError:
-            continue
-        out.update(part)
+    for fn in SECTIONS.values():
+        fn(out)
     return {k: (np.asarray(v, dtype=float).tolist() if not isinstance(v, float) else v) for k, v in out.items()}
