@@ -34,6 +34,7 @@ from .basis import _check_order
 from .continuity import Continuity, JointReport, join, measure_continuity, reverse_g_parameters
 from .curve import GHTCurve
 from .errors import GHTError, SingularJoinError
+from .seeds import make_seed, seed_names
 
 __all__ = ["CompositeCurve"]
 
@@ -213,10 +214,30 @@ class CompositeCurve:
         """
         i = self._check_index(index)
         old = self._free[i]
-        new = old.with_shape(mu, nu, gamma) if old.seed.name in ("ght", "gbt", "bernstein") else None
-        if new is None:
-            raise GHTError(f"segment {i} uses seed {old.seed.name!r}; set_shape supports registered seeds only")
-        self._replace(i, new)
+        name = old.seed.name
+        if name in ("gbt", "bernstein"):
+            name = "ght"  # GBT is GHT at γ = -1, Bernstein is GHT at γ = 1
+        if name not in seed_names():
+            raise GHTError(
+                f"segment {i} uses the unregistered seed {old.seed.name!r}; set_shape needs a registered "
+                "seed family (replace the segment with set_segment instead)"
+            )
+        seed = make_seed(
+            name,
+            old.mu if mu is None else mu,
+            old.nu if nu is None else nu,
+            old.gamma if gamma is None else gamma,
+        )
+        self._replace(i, GHTCurve(old.control_points, seed=seed))
+
+    def set_segment(self, index: int, segment: GHTCurve) -> None:
+        """Replace segment ``index`` (points, degree, seed and shape parameters); re-solve."""
+        i = self._check_index(index)
+        if not isinstance(segment, GHTCurve):
+            raise GHTError(f"segment must be a GHTCurve, got {type(segment).__name__}")
+        if segment.dim != self.dim:
+            raise GHTError(f"segment has dimension {segment.dim}; this chain has dimension {self.dim}")
+        self._replace(i, segment)
 
     def set_control_points(self, index: int, control_points: Any) -> None:
         """Replace segment ``index``'s control points (same or different count); re-solve.

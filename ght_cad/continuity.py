@@ -131,6 +131,8 @@ def _seed_for(curve: GHTCurve, mu: Any, nu: Any, gamma: Any):
     if mu is None and nu is None and gamma is None:
         return curve.seed
     name = curve.seed.name
+    if name in ("gbt", "bernstein"):
+        name = "ght"  # both are members of the GHT family (γ = -1 and γ = 1)
     if name not in seed_names():
         raise GHTError(
             f"segment_b uses the unregistered seed {name!r}; its shape parameters cannot be "
@@ -317,6 +319,7 @@ class JointReport:
         g_residuals: relative residuals of the G conditions with the fitted k, β2, β3.
         k, beta2, beta3: least-squares estimates (NaN when A's end tangent vanishes).
         tol: the relative tolerance used.
+        notes: human-readable remarks (vanishing or reversed end tangents).
     """
 
     c_order: int

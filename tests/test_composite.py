@@ -189,3 +189,22 @@ def test_errors_and_failed_edit_leaves_chain_unchanged():
         cc.set_shape(5, mu=0.1)
     with pytest.raises(GHTError, match="mu=3 is outside"):
         cc.set_shape(0, mu=3.0)
+
+
+def test_set_shape_and_set_segment_on_seed_families():
+    rng = np.random.default_rng(12)
+    gbt = GHTCurve(rng.normal(size=(5, 2)), 0.3, -0.2, seed="gbt")
+    bern = GHTCurve(rng.normal(size=(6, 2)), seed="bernstein")
+    cc = CompositeCurve([gbt, bern], "G2", k=1.2, beta2=0.1)
+    cc.set_shape(0, gamma=0.5)  # a GBT segment becomes a general GHT one (GBT = GHT at gamma=-1)
+    assert cc.segments[0].shape_parameters == (0.3, -0.2, 0.5)
+    cc.set_shape(1, mu=0.4)
+    assert cc.segments[1].shape_parameters == (0.4, 0.0, 1.0)
+    _assert_joints(cc)
+    new = GHTCurve(rng.normal(size=(8, 2)), -0.5, 0.5, -0.9)
+    cc.set_segment(1, new)
+    assert cc.segments[1].degree == 7
+    np.testing.assert_array_equal(cc.segments[1].control_points[3:], new.control_points[3:])
+    _assert_joints(cc)
+    with pytest.raises(GHTError, match="segment has dimension 3; this chain has dimension 2"):
+        cc.set_segment(0, GHTCurve(np.zeros((3, 3))))
