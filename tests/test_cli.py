@@ -1,0 +1,173 @@
+"""The ght-cad command line: help texts, exit codes, --json output, single-step commands."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ght_cad.cli import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, build_parser, main
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+COMMANDS = ["demo", "run", "curve", "surface", "optimize", "unroll", "export", "plot-basis"]
+
+# exact quarter cone (spec section 1), no optimization block: fast
+CONE = """
+name = "cone"
+[surface]
+planes = [[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]
+boundary_planes = [[0, 0, 0, 1], [-4, 0, 0, 1]]
+gamma = -1.0
+normalize = false
+"""
+
+
+def run_json(argv: list[str], capsys: pytest.CaptureFixture) -> tuple[int, dict, str]:
+    rc = main(argv + ["--json"])
+    cap = capsys.readouterr()
+    return rc, json.loads(cap.out), cap.err
+
+
+@pytest.fixture
+def cone(tmp_path: Path) -> Path:
+    p = tmp_path / "cone.toml"
+    p.write_text(CONE)
+    return p
+
+
+def test_help_of_every_command_is_fast_and_light() -> None:
+    """`--help` does not import matplotlib, scipy or a CAD kernel."""
+    code = (
+        "import sys\nfrom ght_cad.cli import main\n"
+        f"for c in {COMMANDS!r}:\n"
+        "    try:\n        main([c, '--help'])\n    except SystemExit as e:\n        assert e.code == 0, (c, e.code)\n"
+        "heavy = [m for m in ('matplotlib', 'scipy', 'OCP', 'build123d', 'cadquery') if m in sys.modules]\n"
+        "print('HEAVY', heavy)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "HEAVY []" in out.stdout
+    for c in COMMANDS:
+        assert f"usage: ght-cad {c}" in out.stdout
+    assert out.stdout.count("exit codes: 0 success, 1 internal failure, 2 bad input") == len(COMMANDS)
+
+
+def test_parser_lists_every_command() -> None:
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    assert set(sub.choices) == set(COMMANDS)
+
+
+@pytest.mark.parametrize("argv", [[], ["frobnicate"], ["curve", "--mu"], ["plot-basis"], ["run"], ["demo", "--bogus"]])
+def test_usage_errors_exit_2(argv: list[str], capsys) -> None:
+    with pytest.raises(SystemExit) as ei:
+        if main(argv) == EXIT_USAGE:  # no command: help on stderr, code 2
+            raise SystemExit(EXIT_USAGE)
+    assert ei.value.code == EXIT_USAGE
+    assert capsys.readouterr().err
+
+
+def test_curve_json_and_step(tmp_path: Path, capsys) -> None:
+    from ght_cad.cad.occ import is_valid, read_step
+
+    step = tmp_path / "c.step"
+    rc, res, _ = run_json(
+        ["curve", "--points", "1,0 1,1 0,1", "--gamma", "-1", "--step", str(step), "--plot", str(tmp_path / "c.png")], capsys
+    )
+    assert rc == EXIT_OK and res["ok"] and res["degree"] == 2
+    # γ = -1, μ = ν = 0 on (1,0), (1,1), (0,1) is the exact quarter unit circle
+    assert res["arc_length"] == pytest.approx(3.141592653589793 / 2, rel=1e-12)
+    assert res["curvature_max"] == pytest.approx(1.0, rel=1e-9)
+    assert is_valid(read_step(step)) and res["bspline"]["max_deviation"] <= 1e-6
+    assert (tmp_path / "c.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["curve", "--points", "0,0 1,1"], "at least 3"),
+        (["curve", "--points", "0,0 1,x 2,0"], "'1,x' is not a point"),
+        (["curve", "--points", "0,0 1,1 2,0", "--nu", "1.2"], "nu=1.2"),
+        (["plot-basis", "--degree", "1", "--out", "b.png"], "degree=1"),
+        (["plot-basis", "--params", "0,0", "--out", "b.png"], "three numbers"),
+    ],
+)
+def test_bad_values_one_line_exit_2(argv: list[str], needle: str, capsys, tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    rc, res, err = run_json(argv, capsys)
+    assert rc == EXIT_USAGE and res == {"ok": False, "error": res["error"], "exit_code": 2}
+    assert len(err.strip().splitlines()) == 1 and needle in err
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_plot_basis(tmp_path: Path, capsys) -> None:
+    from test_plotting import png_size
+
+    rc, res, _ = run_json(["plot-basis", "--degree", "5", "--params", "0,0,-1", "--params", "0.5,-0.5,0.3",
+                           "--derivative", "1", "--out", str(tmp_path / "b.png")], capsys)
+    assert rc == 0 and res["params"] == [[0, 0, -1], [0.5, -0.5, 0.3]]
+    assert png_size(tmp_path / "b.png") == tuple(res["pixels"]) == (1200, 800)
+
+
+def test_surface_unroll_export_on_a_design(cone: Path, tmp_path: Path, capsys) -> None:
+    import math
+
+    import ezdxf
+
+    from ght_cad.cad.occ import is_valid, read_step
+
+    rc, res, _ = run_json(["surface", str(cone), "--step", str(tmp_path / "s.step")], capsys)
+    assert rc == 0 and res["developability"]["dd"] == pytest.approx(1.0, abs=1e-12)
+    assert is_valid(read_step(tmp_path / "s.step"))
+    rc, res, _ = run_json(["unroll", str(cone), "--dxf", str(tmp_path / "p.dxf"), "--svg", str(tmp_path / "p.svg")], capsys)
+    assert rc == 0 and res["errors"]["max"] < 1e-12
+    ezdxf.readfile(tmp_path / "p.dxf")
+    files = [str(tmp_path / n) for n in ("e.step", "e.dxf", "e.svg", "e.json", "e.png")]
+    rc, res, _ = run_json(["export", str(cone), *files], capsys)
+    assert rc == 0 and sorted(res["outputs"].values()) == sorted(files)
+    summary = json.loads((tmp_path / "e.json").read_text())
+    # quarter frustum area: (pi/2) * (r1 + r2)/2 * slant, r = 4 and 2, slant = hypot(2, 4)
+    assert summary["surface"]["area_3d"] == pytest.approx(math.pi / 2 * 3 * math.hypot(2, 4), rel=1e-12)
+
+
+def test_export_unknown_suffix(cone: Path, tmp_path: Path, capsys) -> None:
+    rc, res, err = run_json(["export", str(cone), str(tmp_path / "x.stl")], capsys)
+    assert rc == EXIT_USAGE and ".stl" in err and ".step" in err and not (tmp_path / "x.stl").exists()
+
+
+def test_optimize_command(tmp_path: Path, capsys) -> None:
+    rc, res, _ = run_json(["optimize", str(EXAMPLES / "design_hull_plate.toml"), "--iterations", "4",
+                           "--population", "8", "--method", "gwo", "--plot", str(tmp_path / "cv.png")], capsys)
+    assert rc == 0 and res["method"] == "gwo" and res["objective"] == "R"
+    assert res["best_value"] <= res["initial_value"]
+    assert len(res["history"]) == 5 and (tmp_path / "cv.png").exists()
+    rc, res, err = run_json(["optimize", str(EXAMPLES / "design_hull_plate.toml"), "--objective", "AL"], capsys)
+    assert rc == EXIT_USAGE and "'optimize.objective'" in err and "allowed: R" in err
+
+
+def test_optimize_needs_a_surface(tmp_path: Path, capsys) -> None:
+    p = tmp_path / "c.toml"
+    p.write_text('[[curves]]\ncontrol_points = [[0, 0], [1, 1], [2, 0]]\n')
+    rc, res, err = run_json(["optimize", str(p)], capsys)
+    assert rc == EXIT_USAGE and "'surface'" in err
+
+
+def test_internal_failure_exit_1(cone: Path, tmp_path: Path, capsys, monkeypatch) -> None:
+    import ght_cad.design as D
+
+    def boom(*a, **k):
+        raise RuntimeError("kernel exploded")
+
+    monkeypatch.setattr(D, "surface_summary", boom)
+    rc, res, err = run_json(["surface", str(cone)], capsys)
+    assert rc == EXIT_FAILURE and res["exit_code"] == 1
+    assert "internal failure: RuntimeError: kernel exploded" in err and len(err.strip().splitlines()) == 1
+
+
+def test_console_script_is_installed() -> None:
+    exe = Path(sys.executable).with_name("ght-cad")
+    if not exe.exists():
+        pytest.skip("ght-cad console script not installed next to this interpreter")
+    out = subprocess.run([str(exe), "--version"], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.startswith("ght-cad ")
