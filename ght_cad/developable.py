@@ -281,6 +281,13 @@ class EnvelopeDevelopable(RuledSurface):
         r = _check_derivative(derivative)
         return _jcartesian(self._boundary_h(u, 1, r))[r]
 
+    def boundary_values(self, u: Any) -> np.ndarray:
+        """``(a(u), b(u))`` side by side, shape (len(u), 6), sharing one evaluation of ``U, U'``."""
+        U = self._U(u, 1)
+        X = meet(U[0][:, None, :], U[1][:, None, :], self.boundary_planes[None, :, :])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return (X[:, :, 1:] / X[:, :, :1]).reshape(-1, 6)
+
     # -- geometry -------------------------------------------------------------------------------
     def ruling_direction(self, u: Any) -> np.ndarray:
         r"""Unit direction of the ruling ``U ∩ U'``: ``n(U) × n(U') / |..|`` (sign arbitrary)."""
@@ -402,12 +409,15 @@ class EnvelopeDevelopable(RuledSurface):
 
         h, R0 = self._regression_hr(u)
         phi = h * (R0 - h)
-        cand = [int(np.argmax(phi))]
-        # refine around the largest local maxima (the edge may enter between samples)
+        best_u, best_phi = float(u[int(np.argmax(phi))]), float(np.max(phi))
+        # refine around local maxima that the neighbouring variation could lift above 0 (the edge
+        # may enter the strip between two samples)
         interior = np.nonzero((phi[1:-1] >= phi[:-2]) & (phi[1:-1] >= phi[2:]))[0] + 1
-        cand += [int(i) for i in interior[np.argsort(phi[interior])[::-1][:4]]]
-        best_u, best_phi = float(u[cand[0]]), float(phi[cand[0]])
-        for i in cand:
+        ends = [i for i in (0, phi.size - 1) if phi[i] >= phi[1 if i == 0 else -2]]
+        cand = [int(i) for i in list(interior) + ends]
+        jump = np.abs(np.diff(phi))
+        near = [i for i in cand if phi[i] + 2.0 * max(jump[max(i - 1, 0)], jump[min(i, jump.size - 1)]) >= 0.0]
+        for i in sorted(near, key=lambda j: -phi[j])[:8]:
             lo, hi = u[max(i - 1, 0)], u[min(i + 1, u.size - 1)]
 
             def f(x: float) -> float:

@@ -199,19 +199,14 @@ def signed_distance(U: Any, points: Any) -> np.ndarray:
     return (u[0] + x @ u[1:]) / np.linalg.norm(u[1:])
 
 
-def _triple(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    return np.einsum("...i,...i->...", a, np.cross(b, c))
-
-
-_MINOR_COLS = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
-
-
 def meet(A: Any, B: Any, C: Any) -> np.ndarray:
     r"""Homogeneous meet point of three planes, ``X_j = (-1)^j det([A; B; C] without column j)``.
 
     Vectorized: ``A, B, C`` broadcast over leading dimensions, last dimension 4. The map is
     trilinear and alternating, so derivatives follow by the product rule (used by
-    :mod:`ght_cad.developable`). ``X`` satisfies ``A·X = B·X = C·X = 0``.
+    :mod:`ght_cad.developable`). ``X`` satisfies ``A·X = B·X = C·X = 0``. Computed from the
+    Plücker coordinates ``p_ij = A_i B_j - A_j B_i`` of ``A ∧ B`` by expanding each 3×3 minor along
+    the row of ``C``: ``det(cols i<j<k) = C_k p_ij - C_j p_ik + C_i p_jk``.
 
     Returns:
         Array of shape (..., 4); ``X0 = 0`` for a point at infinity, ``X = 0`` when the three
@@ -220,12 +215,20 @@ def meet(A: Any, B: Any, C: Any) -> np.ndarray:
     A = np.asarray(A, dtype=float)
     B = np.asarray(B, dtype=float)
     C = np.asarray(C, dtype=float)
-    A, B, C = np.broadcast_arrays(A, B, C)
-    out = np.empty(A.shape)
-    for j, cols in enumerate(_MINOR_COLS):
-        c = list(cols)
-        out[..., j] = (-1.0) ** j * _triple(A[..., c], B[..., c], C[..., c])
-    return out
+    a0, a1, a2, a3 = (A[..., i] for i in range(4))
+    b0, b1, b2, b3 = (B[..., i] for i in range(4))
+    c0, c1, c2, c3 = (C[..., i] for i in range(4))
+    p01 = a0 * b1 - a1 * b0
+    p02 = a0 * b2 - a2 * b0
+    p03 = a0 * b3 - a3 * b0
+    p12 = a1 * b2 - a2 * b1
+    p13 = a1 * b3 - a3 * b1
+    p23 = a2 * b3 - a3 * b2
+    x0 = c3 * p12 - c2 * p13 + c1 * p23
+    x1 = -(c3 * p02 - c2 * p03 + c0 * p23)
+    x2 = c3 * p01 - c1 * p03 + c0 * p13
+    x3 = -(c2 * p01 - c1 * p02 + c0 * p12)
+    return np.stack(np.broadcast_arrays(x0, x1, x2, x3), axis=-1)
 
 
 def meet_point(A: Any, B: Any, C: Any, *, names: Sequence[str] = ("A", "B", "C")) -> np.ndarray:

@@ -115,8 +115,10 @@ def developable_surface_data(
     if not (math.isfinite(tol) and tol > 0):
         raise GHTError(f"tol={tol!r} must be a positive finite number")
 
+    fast = getattr(surface, "boundary_values", None)
+
     def f(u: np.ndarray) -> np.ndarray:
-        return np.hstack([surface.a(u), surface.b(u)])
+        return fast(u) if fast is not None else np.hstack([surface.a(u), surface.b(u)])
 
     ends = tuple(
         [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(min(end_order, degree - 1) + 1)]
