@@ -17,6 +17,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 from pathlib import Path
 
@@ -47,12 +48,21 @@ def _env(tmp_path: Path, pythonpath: bool = True) -> dict[str, str]:
     return env
 
 
+def _run(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
+    """Run in a new session; on timeout kill the whole process group (FreeCAD, Xvfb) and fail."""
+    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        pytest.fail(f"{cmd[0]} timed out after {timeout} s:\n{(out + err)[-4000:]}")
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
 def _run_unittest(module: str, tmp_path: Path, timeout: float = 240) -> subprocess.CompletedProcess:
     exe = freecadcmd_or_skip()
-    proc = subprocess.run(
-        [exe, "-t", module], env=_env(tmp_path), cwd=tmp_path, capture_output=True, text=True, timeout=timeout
-    )
-    return proc
+    return _run([exe, "-t", module], _env(tmp_path), tmp_path, timeout)
 
 
 def _summary(proc: subprocess.CompletedProcess) -> str:
@@ -125,10 +135,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     (mod / "ght_workbench").symlink_to(WB, target_is_directory=True)
     env["QTWEBENGINE_DISABLE_SANDBOX"] = "1"  # Qt WebEngine refuses to start as root otherwise
     env["QT_QPA_PLATFORM"] = "xcb"
-    proc = subprocess.run(
-        ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(WB_TESTS / "gui_check.py")],
-        env=env, cwd=tmp_path, capture_output=True, text=True, timeout=240,
-    )
+    proc = _run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(WB_TESTS / "gui_check.py")], env, tmp_path, 240)
     result_file = tmp_path / "gui_result.json"
     assert result_file.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{_summary(proc)}"
     res = json.loads(result_file.read_text())
@@ -167,3 +174,19 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert img.shape == (768, 1024, 3), img.shape
     drawn = float(np.mean(np.any(np.abs(img - img[0, 0]) > 30, axis=-1)))
     assert drawn > 0.002, f"screenshot is (nearly) blank: {drawn:.4%} drawn pixels"
+
+
+def test_example_macro_in_freecadcmd(tmp_path: Path) -> None:
+    exe = freecadcmd_or_skip()
+    env = _env(tmp_path, pythonpath=False)  # the macro finds the workbench next to itself
+    env["GHT_MACRO_OUT"] = str(tmp_path / "out")
+    proc = _run([exe, str(REPO / "examples" / "freecad_macro.FCMacro")], env, tmp_path, 180)
+    out = proc.stdout + proc.stderr
+    m = re.search(r"quarter cylinder pattern ([\d.]+) x ([\d.]+)", out)
+    assert m, _summary(proc)
+    # r = 40, H = 60: the pattern is the exact r·π/2 × H rectangle (printed to 1e-9)
+    assert abs(float(m.group(1)) - 20 * np.pi) < 2e-9 and abs(float(m.group(2)) - 60.0) < 2e-9, m.group(0)
+    fair = re.search(r"fairness En: ([\deE.+-]+) -> ([\deE.+-]+)", out)
+    assert fair and float(fair.group(2)) < float(fair.group(1)), _summary(proc)
+    for name in ("ght_example.step", "ght_example_pattern.dxf", "ght_example_pattern.svg", "ght_example.FCStd"):
+        assert (tmp_path / "out" / name).stat().st_size > 0, name
