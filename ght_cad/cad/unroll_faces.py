@@ -258,6 +258,13 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     def xyz(t: np.ndarray) -> np.ndarray:
         return np.array([c3.Value(q0 + x * (q1 - q0)).Coord() for x in t.tolist()]).reshape(-1, 3)
 
+    tbreaks = np.zeros(0)
+    if c2.GetType() == GeomAbs_BSplineCurve:
+        b = c2.BSpline()
+        ks = np.array([b.Knot(i) for i in range(1, b.NbKnots() + 1)])
+        tb = (ks - p0) / (p1 - p0)
+        tbreaks = np.sort(tb[(tb > 1e-12) & (tb < 1 - 1e-12)])
+
     def duv(t: np.ndarray) -> np.ndarray:
         out = np.empty((t.size, 2))
         p, vec = gp_Pnt2d(), gp_Vec2d()
@@ -267,6 +274,7 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
         return out * (p1 - p0)
 
     length = 0.0 if BRep_Tool.Degenerated_s(edge) else GCPnts_AbscissaPoint.Length_s(c3, 1e-13)
+    duv.breaks = tbreaks  # type: ignore[attr-defined]
     return uv, xyz, float(length), duv
 
 
@@ -274,17 +282,17 @@ def face_area(ev: _SurfEval, edges_uv: list[list[tuple[Callable, Callable]]], u_
     r"""3-D area ``∬_Ω |S_u × S_v| du dv`` of a trimmed face by Green's theorem in (u, v).
 
     ``∬_Ω f du dv = ∮_{∂Ω} P dv`` with ``P(u, v) = ∫_{u_lo}^{u} f(s, v) ds``: the outer integral by
-    16 × 12-point Gauss–Legendre panels along each pcurve, the inner one by 2 × 12-point panels per
+    16 × 12-point Gauss–Legendre panels along each pcurve (split at the pcurve's knots), the inner one by 2 × 12-point panels per
     interval between ``u_breaks`` (the surface's knots), i.e. exact up to the smoothness of ``f``.
     The absolute value of the signed total over all loops is returned (orientation-free).
     """
     xg, wg = np.polynomial.legendre.leggauss(12)
-    te = np.linspace(0.0, 1.0, 17)
-    tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
-    tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
     total = 0.0
     for loop in edges_uv:
         for uvf, duv in loop:
+            te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
+            tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
+            tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
             dv = duv(tn)[:, 1]
             if np.max(np.abs(dv)) == 0.0:
                 continue
