@@ -409,13 +409,20 @@ class EnvelopeDevelopable(RuledSurface):
 
         h, R0 = self._regression_hr(u)
         phi = h * (R0 - h)
+        # where U, U', U'' are dependent (an inflection of the dual curve) R vanishes and the edge
+        # of regression is undefined at that single t: not a point of the strip
+        U = self._U(u, 2)
+        Rn = np.linalg.norm(meet(U[0], U[1], U[2]), axis=1)
+        ref = np.prod([np.linalg.norm(x, axis=1) for x in U], axis=0)
+        phi = np.where(Rn > 1e-12 * ref, phi, -np.inf)
         best_u, best_phi = float(u[int(np.argmax(phi))]), float(np.max(phi))
         # refine around local maxima that the neighbouring variation could lift above 0 (the edge
         # may enter the strip between two samples)
         interior = np.nonzero((phi[1:-1] >= phi[:-2]) & (phi[1:-1] >= phi[2:]))[0] + 1
         ends = [i for i in (0, phi.size - 1) if phi[i] >= phi[1 if i == 0 else -2]]
         cand = [int(i) for i in list(interior) + ends]
-        jump = np.abs(np.diff(phi))
+        with np.errstate(invalid="ignore"):
+            jump = np.nan_to_num(np.abs(np.diff(phi)), nan=0.0, posinf=0.0)
         near = [i for i in cand if phi[i] + 2.0 * max(jump[max(i - 1, 0)], jump[min(i, jump.size - 1)]) >= 0.0]
         for i in sorted(near, key=lambda j: -phi[j])[:8]:
             lo, hi = u[max(i - 1, 0)], u[min(i + 1, u.size - 1)]
@@ -431,9 +438,15 @@ class EnvelopeDevelopable(RuledSurface):
             vR = float(self.regression_parameter(np.array([best_u]))[0])
             t = float(self.dual_parameter(best_u)[0])
             R = self.edge_of_regression(np.array([best_u]))[0]
+            inside = np.nonzero(phi >= 0.0)[0]
+            if inside.size:
+                t_lo, t_hi = (float(x) for x in self.dual_parameter(u[[inside[0], inside[-1]]]))
+                where = f" (sampled: for t in [{t_lo:.4g}, {t_hi:.4g}])"
+            else:
+                where = ""
             raise EdgeOfRegressionError(
                 f"the strip contains its edge of regression at u={best_u:.6g} (t={t:.6g}), v={vR:.6g} "
-                f"(point {_fmt(R)}); the surface is singular there. Move the boundary planes "
+                f"(point {_fmt(R)}){where}; the surface is singular there. Move the boundary planes "
                 f"E_a={_fmt(self.boundary_planes[0])}, E_b={_fmt(self.boundary_planes[1])} so that the "
                 "edge of regression stays outside 0 <= v <= 1, or trim t_range"
             )

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ght_cad
+import ght_cad.ruled
 from ght_cad import GHTCurve
 from ght_cad.developable import (
     CanalSurface,
@@ -216,6 +217,28 @@ def test_strip_containing_its_edge_of_regression():
     # a trimmed range avoids nothing here, the error names the t of the trimmed surface
     with pytest.raises(EdgeOfRegressionError, match=r"v=0.666667"):
         developable_from_planes([(-1, 1, 0, 0.5), (-1, 1, 1, 0.5), (-1, 0, 1, 0.5)], [(0, 0, 0, 1), (-3, 0, 0, 1)], gamma=-1, t_range=(0.25, 0.5))
+
+
+def test_edge_of_regression_in_part_of_the_range_and_trimming_it_away():
+    """With E_b at x = 30 the edge of regression enters the ship strip for t >~ 0.72 only."""
+    far = [(0, 1, 0, 0), (-30, 1, 0, 0)]
+    with pytest.raises(EdgeOfRegressionError, match=r"at u=1 \(t=1\), v=0.765333.*sampled: for t in \[0.71\d*, 1\]"):
+        developable_from_planes(SHIP, far, 0.3, -0.2, 0.1)
+    s = developable_from_planes(SHIP, far, 0.3, -0.2, 0.1, t_range=(0.0, 0.5))
+    vR = s.regression_parameter(np.linspace(0, 1, 101))
+    assert np.all((vR < 0) | (vR > 1))
+    assert s.developability().theta_max <= ROUND_OFF_DEG
+
+
+def test_sampled_gaussian_curvature_is_an_independent_check():
+    """K = -det(a', g, g')² / |X_u × g|⁴ vanishes (scale-free, K L²) on the exact developables."""
+    u = np.repeat(np.linspace(0, 1, 21), 3)
+    v = np.tile([0.0, 0.5, 1.0], 21)
+    for s in (ship(), cone(0.5, 2.0, 1.0), TangentDevelopable(SPACE, 0.2, 1.0), RectifyingDevelopable(SPACE, -0.1, 0.2)):
+        L = np.ptp(s.grid(9, 3).reshape(-1, 3), axis=0).max()
+        assert np.abs(s.gaussian_curvature(u, v)).max() * L**2 <= 1e-18
+    twisted = ght_cad.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
+    assert np.abs(twisted.gaussian_curvature(u, v)).max() > 1e-2
 
 
 def test_boundary_planes_crossing_inside_the_strip():
