@@ -85,6 +85,26 @@ def test_features_inside_freecadcmd(tmp_path: Path) -> None:
     assert re.search(r"\nOK\s*$", out) and "skipped=" not in out, _summary(proc)
     for f in ("curve.step", "composite.step", "developable.step", "flat.step", "flat.dxf", "flat.svg"):
         assert (tmp_path / f).stat().st_size > 0, f
+    # the files FreeCAD wrote are read by the project's other tools: ezdxf (DXF) and OCP 7.9 (STEP)
+    from ezdxf import recover
+
+    dxf, auditor = recover.readfile(str(tmp_path / "flat.dxf"))
+    assert not auditor.has_errors, [str(e) for e in auditor.errors]
+    msp = dxf.modelspace()
+    assert len(msp.query('LINE[layer=="BEND"]')) == 6
+    assert len(msp.query('*[layer=="OUTLINE"]')) >= 4
+    assert {"OUTLINE", "BEND"} <= {layer.dxf.name for layer in dxf.layers}
+    from ght_cad.cad.occ import is_valid, read_step
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    shape = read_step(tmp_path / "developable.step")
+    assert is_valid(shape)
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props)
+    area = float(props.Mass())
+    fc_area = float((tmp_path / "developable_area.txt").read_text())
+    assert abs(area - fc_area) <= 1e-7 * fc_area, (area, fc_area)
 
 
 def _load_core_numbers():
@@ -160,6 +180,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     c = steps["GHT_Curve"]["value"]
     assert c["dialog_open"] and c["live_changed"] and c["slider_gamma"] == -1.0, c
     assert c["restored"] == [0.0, 0.0] and c["length_restored"], c
+    v = steps["GHT_Curve from vertices"]["value"]
+    assert v["degree"] == 3 and v["source"] == ["Vertex1", "Vertex2", "Vertex3", "Vertex4"], v
     opt = steps["GHT_RunOptimization"]["value"]
     assert opt["best"] <= opt["initial"] and not opt["status"].startswith("cancelled"), opt
     for name in ("GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"):

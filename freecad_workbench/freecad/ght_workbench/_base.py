@@ -22,6 +22,7 @@ __all__ = [
     "ShapeParameterPanel",
     "BaseCommand",
     "add_shape_parameters",
+    "check_shape",
     "restore_constraints",
     "set_read_only",
     "new_feature",
@@ -45,6 +46,14 @@ def add_shape_parameters(obj: Any, group: str = "Shape", values: Sequence[float]
         if pname not in obj.PropertiesList:
             obj.addProperty("App::PropertyFloatConstraint", pname, group, tip)
         setattr(obj, pname, (float(value), -1.0, 1.0, _STEP))
+
+
+def check_shape(mu: float, nu: float, gamma: float) -> None:
+    """Raise :class:`ght_cad.errors.ShapeParameterError` if μ, ν or γ is outside [-1, 1] (no clamping)."""
+    from ght_cad._validate import check_shape_parameter
+
+    for n, v in (("mu", mu), ("nu", nu), ("gamma", gamma)):
+        check_shape_parameter(n, v)
 
 
 def restore_constraints(obj: Any) -> None:

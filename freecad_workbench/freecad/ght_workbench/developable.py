@@ -17,7 +17,17 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, add_shape_parameters, new_feature, register_command, set_read_only
+from ._base import (
+    BaseCommand,
+    FeatureProxy,
+    ShapeParameterPanel,
+    ViewProviderBase,
+    add_shape_parameters,
+    check_shape,
+    new_feature,
+    register_command,
+    set_read_only,
+)
 from .convert import ruled_face
 
 __all__ = ["DevelopableFeature", "make_developable", "plane_from_link", "SurfaceOutputs"]
@@ -162,6 +172,7 @@ def make_developable(
     Returns:
         The recomputed feature (``ThetaMax``/``DD`` report its developability).
     """
+    check_shape(mu, nu, gamma)
     obj = new_feature(doc, name, DevelopableFeature, ViewProviderDevelopable)
     planes = DEFAULT_PLANES if planes is None else planes
     boundary_planes = DEFAULT_BOUNDARY if boundary_planes is None else boundary_planes

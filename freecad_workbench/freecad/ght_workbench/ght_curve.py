@@ -21,6 +21,7 @@ from ._base import (
     ShapeParameterPanel,
     ViewProviderBase,
     add_shape_parameters,
+    check_shape,
     new_feature,
     register_command,
     set_read_only,
@@ -131,10 +132,7 @@ def make_ght_curve(
     Returns:
         The recomputed ``Part::FeaturePython`` object.
     """
-    from ght_cad._validate import check_shape_parameter
-
-    for n, v in (("mu", mu), ("nu", nu), ("gamma", gamma)):
-        check_shape_parameter(n, v)
+    check_shape(mu, nu, gamma)
     obj = new_feature(doc, name, GHTCurveFeature, ViewProviderGHTCurve)
     if control_points is not None:
         pts = np.asarray(control_points, dtype=float)

@@ -81,6 +81,13 @@ class GHTCurveTest(unittest.TestCase):
         self.assertLess(np.max(np.linalg.norm(fc - curve.evaluate(t), axis=1)), 10 * obj.Tolerance)
         obj.Mu = 5.0  # App::PropertyFloatConstraint clamps to [-1, 1]
         self.assertEqual(obj.Mu, 1.0)
+        # the scripting API refuses out-of-range values instead of clamping them (spec section 1)
+        from ght_cad.errors import ShapeParameterError
+
+        with self.assertRaisesRegex(ShapeParameterError, "gamma"):
+            ght_curve.make_ght_curve(QUARTER, gamma=1.5, doc=self.doc)
+        with self.assertRaisesRegex(ShapeParameterError, "mu"):
+            developable.make_developable(mu=-1.01, doc=self.doc)
 
     def test_from_vertices_and_sketch(self):
         pts = [App.Vector(0, 0, 0), App.Vector(5, 8, 0), App.Vector(12, 8, 0), App.Vector(16, 0, 0)]
@@ -228,12 +235,15 @@ class DevelopableTest(unittest.TestCase):
         p0 = plane((1, 0, 0), (10, 0, 0), "P0")
         p1 = plane((s, s, 0), (5, 5, 0), "P1")  # x + y = r: the chord plane
         p2 = plane((0, 1, 0), (0, 10, 0), "P2")
-        ea = plane((0, 0, 1), (0, 0, 0), "Ea")
-        eb = plane((0, 0, 1), (0, 0, 20), "Eb")
+        box = self.doc.addObject("Part::Box", "Box")  # boundary planes from faces: bottom z=0, top z=20
+        box.Length, box.Width, box.Height = 3, 3, 20
         self.doc.recompute()
+        bottom, top = (f"Face{i + 1}" for z in (0.0, 20.0) for i, f in enumerate(box.Shape.Faces)
+                       if abs(f.CenterOfMass.z - z) < 1e-9 and abs(abs(f.normalAt(0, 0).z) - 1) < 1e-12)
         obj = developable.make_developable(
-            [(p0, ""), (p1, ""), (p2, "")], [(ea, ""), (eb, "")], gamma=-1.0, weights=[1.0, math.sqrt(2), 1.0], doc=self.doc
+            [(p0, ""), (p1, ""), (p2, "")], [(box, [bottom]), (box, [top])], gamma=-1.0, weights=[1.0, math.sqrt(2), 1.0], doc=self.doc
         )
+        self.assertAlmostEqual(obj.Shape.BoundBox.ZLength, 20.0, delta=1e-9)
         self.assertTrue(obj.Shape.isValid())
         self.assertLess(_radial_error(obj.Shape.Faces[0], 10.0), 1e-5)
         # moving a control plane reshapes the surface
@@ -254,6 +264,8 @@ class DevelopableTest(unittest.TestCase):
         self.assertNotAlmostEqual(obj2.Shape.Area, area, delta=1e-3)
         path = os.path.join(OUT, "developable.step")
         export.export_step([obj2], path)
+        with open(os.path.join(OUT, "developable_area.txt"), "w") as fh:  # checked with OCP by pytest
+            fh.write(repr(obj2.Shape.Area))
         back = export.read_step(path)
         self.assertEqual(len(back.Faces), 1)
         self.assertAlmostEqual(back.Area, obj2.Shape.Area, delta=1e-6 * area)

@@ -88,6 +88,23 @@ def main():
         return {"created": len(created), "valid": ok, "joints": list(comp.JointOrders)}
 
     step("GHT_Curve", curve)
+
+    def curve_from_vertices():
+        import Part
+
+        poly = doc.addObject("Part::Feature", "Polygon")
+        poly.Shape = Part.makePolygon([App.Vector(0, -30, 0), App.Vector(8, -20, 6), App.Vector(20, -24, 6), App.Vector(28, -30, 0)])
+        doc.recompute()
+        before = {o.Name for o in doc.Objects}
+        Gui.Selection.clearSelection()
+        for i in range(1, 5):  # selection order = control point order
+            Gui.Selection.addSelection(poly, f"Vertex{i}")
+        Gui.runCommand("GHT_Curve", 0)
+        doc.recompute()
+        obj = new_objects(doc, before)[0]
+        return {"degree": obj.Degree, "source": [s for _, subs in obj.Source for s in subs], "valid": obj.Shape.isValid(), "created": 1}
+
+    step("GHT_Curve from vertices", curve_from_vertices)
     step("GHT_CompositeCurve", composite)
 
     def generic(name, select_key=None, kind=None, store=None):
