@@ -1,0 +1,212 @@
+"""Unrolling build123d/OCP faces: closed forms, B-spline developables, holes, refusals, flatmesh."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import build123d as bd
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from conftest import freecadcmd_or_skip
+from ght_cad.bspline import BSplineSurfaceData
+from ght_cad.cad.occ import make_face
+from ght_cad.cad.unroll_faces import face_ruling_direction, unroll_face
+from ght_cad.errors import GHTError, NotDevelopableError
+from ght_cad.unroll import unroll, unroll_composite
+
+RTOL = 1e-9
+
+
+def _face(shape, kind):
+    return next(f for f in shape.faces() if f.geom_type == kind)
+
+
+def _edge_lengths(pat):
+    return [(e.length_3d, e.length_flat) for lp in pat.panels[0].loops for e in lp]
+
+
+@pytest.mark.parametrize("R, H, arc", [(2.0, 5.0, 360), (7.5, 3.0, 90), (0.3, 11.0, 200)])
+def test_cylinder_face_is_rectangle(R: float, H: float, arc: float) -> None:
+    f = _face(bd.Cylinder(R, H, arc_size=arc), bd.GeomType.CYLINDER)
+    pat = unroll(f, rulings=5)
+    out = pat.outlines[0]
+    w = R * math.radians(arc)
+    np.testing.assert_allclose(np.ptp(out, axis=0), [w, H], rtol=RTOL)
+    np.testing.assert_allclose(pat.area, w * H, rtol=RTOL)
+    # every outline point lies on the rectangle's border
+    x, y = out[:, 0] - out[:, 0].min(), out[:, 1] - out[:, 1].min()
+    border = np.minimum.reduce([np.abs(x), np.abs(x - w), np.abs(y), np.abs(y - H)])
+    assert border.max() < RTOL * max(w, H)
+    assert pat.errors["max"] < 1e-12
+    assert len(pat.bend_lines) == 5
+
+
+@pytest.mark.parametrize("r1, r2, h, arc", [(1.0, 2.0, 1.5, 90), (4.0, 1.0, 2.0, 360), (2.0, 3.0, 0.5, 120)])
+def test_cone_face_is_annular_sector(r1: float, r2: float, h: float, arc: float) -> None:
+    """Sector radii ρ = slant · r / |r2 - r1| and angle θ r_big / ρ_big (2π r/ρ for a full cone)."""
+    f = _face(bd.Solid.make_cone(r1, r2, h, angle=arc), bd.GeomType.CONE)
+    pat = unroll(f, rulings=3)
+    slant = math.hypot(r2 - r1, h)
+    rho = {r: slant * r / abs(r2 - r1) for r in (r1, r2)}
+    angle = math.radians(arc) * r2 / rho[r2]
+    panel = pat.panels[0]
+    # apex image: the closed-form map F = ρ (cos su, sin su) sends the apex (ρ = 0) to the origin,
+    # which placement moves to the panel offset
+    C = panel.offset
+    pts = np.concatenate([e.flat for e in panel.loops[0]]) + panel.offset
+    d = np.linalg.norm(pts - C, axis=1)
+    lo, hi = sorted(rho.values())
+    assert d.min() == pytest.approx(lo, rel=RTOL)
+    assert d.max() == pytest.approx(hi, rel=RTOL)
+    on_arc = np.minimum(np.abs(d - lo), np.abs(d - hi)) < RTOL * hi
+    radial = ~on_arc
+    assert on_arc.sum() > 100 and radial.sum() > 10
+    ang = np.unwrap(np.arctan2(pts[:, 1] - C[1], pts[:, 0] - C[0]))
+    assert np.ptp(ang) == pytest.approx(angle, rel=RTOL)
+    assert pat.area == pytest.approx(0.5 * angle * (hi**2 - lo**2), rel=RTOL)
+    assert pat.errors["max"] < 1e-12
+
+
+def test_extrusion_face_is_rectangle() -> None:
+    edge = bd.Edge.make_spline([(0, 0, 0), (1, 0.5, 0), (2, -0.3, 0), (3, 0, 0)])
+    f = bd.Face.extrude(edge, (0, 0, 2.5))
+    assert f.geom_type == bd.GeomType.EXTRUSION
+    pat = unroll(f, rulings=4)
+    L = edge.length
+    np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [L, 2.5], rtol=RTOL)
+    assert pat.area == pytest.approx(2.5 * L, rel=RTOL)
+    assert pat.panels[0].info["method"].startswith("quadrature")
+
+
+def test_oblique_extrusion_preserves_lengths_and_area() -> None:
+    edge = bd.Edge.make_spline([(0, 0, 0), (1, 0.5, 0), (2, -0.3, 0), (3, 0, 0)])
+    pat = unroll(bd.Face.extrude(edge, (0.3, 0, 2)))
+    assert pat.errors["max"] < 1e-12
+    # parallel rulings: every bend line has the extrusion length |(0.3, 0, 2)|
+    lens = np.linalg.norm(pat.bend_lines[:, 1] - pat.bend_lines[:, 0], axis=1)
+    np.testing.assert_allclose(lens, math.hypot(0.3, 2.0), rtol=1e-12)
+
+
+def _tangent_developable_face(v0: float = 0.3, v1: float = 1.0, transpose: bool = False):
+    """Tangent developable of c(t) = (t, t², t³): a = c + v0 c', b = c + v1 c' as an exact cubic ×
+    linear Bézier B-spline face (exactly developable)."""
+    M = np.array([[1, 0, 0, 0], [1, 1 / 3, 0, 0], [1, 2 / 3, 1 / 3, 0], [1, 1, 1, 1]])
+    c = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    cp = np.array([[1, 0, 0], [0, 2, 0], [0, 0, 3], [0, 0, 0]], float)
+    net = np.stack([M @ (c + v0 * cp), M @ (c + v1 * cp)], axis=1)
+    if transpose:
+        return make_face(BSplineSurfaceData(net.transpose(1, 0, 2), [0, 0, 1, 1], [0] * 4 + [1] * 4, 1, 3))
+    return make_face(BSplineSurfaceData(net, [0] * 4 + [1] * 4, [0, 0, 1, 1], 3, 1))
+
+
+@pytest.mark.parametrize("transpose", [False, True])
+def test_bspline_developable_face_preserves_lengths_and_area(transpose: bool) -> None:
+    f = _tangent_developable_face(transpose=transpose)
+    assert face_ruling_direction(f)[0] == ("u" if transpose else "v")
+    pat = unroll(f)
+    e = pat.errors
+    assert e["boundary_length"] < 1e-10 and e["ruling_length"] < 1e-10 and e["area"] < 1e-10
+    for L3, L2 in _edge_lengths(pat):
+        assert L2 == pytest.approx(L3, rel=1e-10)
+
+
+def test_project_developable_face_matches_ruled_unroll() -> None:
+    """developable_from_planes(...).to_face() (B-spline, degree 1 across): 1e-7 or better, and
+    the same area as unrolling the exact surface (up to the face's fit tolerance)."""
+    from ght_cad import developable_from_planes
+
+    planes = [(-10.0, 1.0, 0.0, 0.2), (-10.0, 1.0, 1.0, 0.1), (-10.0, 0.0, 1.0, 0.2)]
+    boundary = [(0.0, 0.0, 0.0, 1.0), (-20.0, 0.0, 0.0, 1.0)]
+    surf = developable_from_planes(planes, boundary, 0.1, -0.2, -0.6)
+    face = surf.to_face()
+    pf = unroll(face)
+    ps = unroll(surf)
+    assert pf.errors["max"] < 1e-9
+    assert ps.errors["max"] < 1e-12
+    assert pf.area == pytest.approx(ps.area, rel=1e-6)
+
+
+def test_holes_and_planar_face_output() -> None:
+    """Half cylinder (R=20) pierced by a cylinder (r=5): the hole is kept; areas match the exact
+    integral; the planar build123d face has the hole as inner wire."""
+    part = bd.Cylinder(20.0, 50.0, arc_size=180) - bd.Cylinder(5.0, 100.0, rotation=(90, 0, 0))
+    f = _face(part, bd.GeomType.CYLINDER)
+    pat = unroll(f, rulings=20)
+    assert len(pat.outlines) == 2
+    th0 = math.acos(0.25)
+    hole, _ = quad(lambda t: 2 * math.sqrt(max(25 - 400 * math.cos(t) ** 2, 0.0)) * 20, th0, math.pi - th0,
+                   epsabs=0, epsrel=1e-13, limit=200)
+    exact = math.pi * 20 * 50 - hole
+    assert pat.area == pytest.approx(exact, rel=1e-9)
+    assert pat.errors["max"] < 1e-10
+    # bend lines are clipped by the hole: some rulings are split in two
+    assert len(pat.bend_lines) > 20
+    flat = pat.to_face()
+    assert isinstance(flat, bd.Face) and len(flat.inner_wires()) == 1
+    assert flat.area == pytest.approx(pat.area, rel=1e-7)
+    assert flat.geom_type == bd.GeomType.PLANE
+    assert abs(abs(flat.normal_at().Z) - 1.0) < 1e-12
+    assert max(abs(v.Z) for v in flat.vertices()) < 1e-12
+
+
+def test_non_ruled_face_is_refused_with_deviation() -> None:
+    sphere = bd.Sphere(3.0).faces()[0]
+    with pytest.raises(NotDevelopableError, match="not ruled") as exc:
+        unroll(sphere)
+    assert "u-isolines" in str(exc.value) and "best_effort" in str(exc.value)
+    pat = unroll(sphere, best_effort=True)
+    assert pat.errors["max"] > 1e-2  # the report shows the distortion
+
+
+def test_twisted_bilinear_face_is_refused_with_theta() -> None:
+    net = np.array([[[0, 0, 0], [0, 1, 1]], [[1, 0, 0], [1, 1, 0]]], float)
+    f = make_face(BSplineSurfaceData(net, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1))
+    with pytest.raises(NotDevelopableError, match=r"theta_max=45 deg.*DD=0\.75"):
+        unroll(f)
+    pat = unroll(f, best_effort=True)
+    assert pat.errors["area"] > 1e-3
+
+
+def test_face_input_errors() -> None:
+    with pytest.raises(GHTError, match="6 faces.*unroll_composite"):
+        unroll_face(bd.Box(1, 2, 3))
+    with pytest.raises(GHTError, match="cannot unroll"):
+        unroll_face(42)
+
+
+def test_composite_of_cylinder_faces_marks_shared_edges() -> None:
+    faces = bd.Cylinder(2.0, 5.0).faces()
+    pat = unroll_composite(list(faces), rulings=4)
+    assert len(pat.panels) == 3
+    marks = [t[2] for t in pat.labels if t[2].startswith("E")]
+    # the two circles (side/top, side/bottom) and the seam (two sides of the rectangle)
+    assert sorted(set(marks)) == ["E1", "E2", "E3"] and len(marks) == 6
+    assert pat.errors["max"] < 1e-12
+
+
+def _load_bench():
+    path = Path(__file__).resolve().parents[1] / "bench" / "flatmesh_compare.py"
+    spec = importlib.util.spec_from_file_location("flatmesh_compare", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.freecad
+def test_error_is_100x_smaller_than_freecad_flatmesh() -> None:
+    exe = freecadcmd_or_skip()
+    bench = _load_bench()
+    faces = {
+        "cone": _face(bd.Solid.make_cone(20.0, 40.0, 30.0, angle=90), bd.GeomType.CONE),
+        "tangent_dev": _tangent_developable_face(),
+    }
+    rows = bench.compare(faces, rel_deflection=1e-3, freecadcmd=exe)
+    for r in rows:
+        assert r["fm_nodes"] > 20
+        assert r["ours_err"] * 100 <= r["fm_err"], r
+    cone = rows[0]
+    assert cone["ours_err"] * 100 <= cone["fm_err_intrinsic"], cone  # also vs flatmesh's own mesh
