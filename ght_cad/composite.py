@@ -142,14 +142,32 @@ class CompositeCurve:
         k, b2, b3 = self._g[j]
         return {"k": k, "beta2": b2, "beta3": b3}
 
-    def _resolve(self) -> None:
-        segs = list(self._free)
-        n = len(segs)
-        for j in range(n - 1):
+    def _resolve(self, start: int = 0) -> None:
+        """Solve the dependent points of segments ``start..`` (all when start = 0 or unsolved).
+
+        Segments before ``start`` keep their solved points. The forward pass stops early at the
+        first segment after ``start`` that comes out bit-identical to its previous solution: the
+        joins are deterministic functions of the predecessor and the user's points, so nothing
+        downstream can change. The wrap joint of a closed chain is always re-solved. The result
+        is bit-identical to a full solve.
+        """
+        n = len(self._free)
+        old = self._segments if (start > 0 and len(self._segments) == n) else None
+        segs = list(old) if old is not None else list(self._free)
+        segs[0] = self._free[0] if old is None or start == 0 else segs[0]
+        for j in range(max(start, 1), n):
             try:
-                segs[j + 1] = join(segs[j], self._continuity[j], segs[j + 1], **self._gkw(j))
+                new = join(segs[j - 1], self._continuity[j - 1], self._free[j], **self._gkw(j - 1))
             except SingularJoinError as exc:
-                raise SingularJoinError(f"joint {j} (segment {j} -> {j + 1}): {exc}") from None
+                raise SingularJoinError(f"joint {j - 1} (segment {j - 1} -> {j}): {exc}") from None
+            if (
+                old is not None
+                and j > start
+                and not (self._closed and j == n - 1)
+                and np.array_equal(new.control_points, old[j].control_points)
+            ):
+                break
+            segs[j] = new
         if self._closed:
             j = n - 1
             c = self._continuity[j]
@@ -271,13 +289,12 @@ class CompositeCurve:
         self.set_control_points(j, pts)
 
     def _replace(self, i: int, curve: GHTCurve) -> None:
-        old = self._free[i]
+        old, old_segments = self._free[i], list(self._segments)
         self._free[i] = curve
         try:
-            self._resolve()
+            self._resolve(start=i)
         except GHTError:
-            self._free[i] = old
-            self._resolve()
+            self._free[i], self._segments = old, old_segments
             raise
 
     # -- attributes -------------------------------------------------------------------------

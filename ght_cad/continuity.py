@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import enum
 import math
+from math import comb
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -36,7 +37,7 @@ import numpy as np
 
 from .curve import GHTCurve
 from .errors import GHTError, SingularJoinError
-from .seeds import MAX_DERIVATIVE, make_seed, seed_names
+from .seeds import MAX_DERIVATIVE, BernsteinSeed, GBTSeed, GHTSeed, make_seed, seed_names
 
 __all__ = [
     "Continuity",
@@ -158,9 +159,62 @@ def _as_segment_b(segment_b: Any, mu: Any, nu: Any, gamma: Any) -> GHTCurve:
 
 
 def _end_rows(curve: GHTCurve, end: int, max_order: int) -> list[np.ndarray]:
-    """Rows ``b^{(r)}_{i}(end)`` of the basis, r = 0..max_order."""
+    """Rows ``b^{(r)}_{i}(end)`` of the basis, r = 0..max_order, by full basis evaluation.
+
+    Used by :func:`measure_continuity` (the independent path).
+    """
     t = np.array([float(end)])
     return [curve.basis(t, r)[0] for r in range(max_order + 1)]
+
+
+_JET_CACHE: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+_BUILTIN_SEEDS = (GHTSeed, GBTSeed, BernsteinSeed)
+
+
+def _seed_end_jets(seed) -> tuple[np.ndarray, np.ndarray]:
+    """``seed.end_jets()``, cached for the built-in seed classes (keyed by class and μ, ν, γ)."""
+    if type(seed) not in _BUILTIN_SEEDS:
+        return seed.end_jets()
+    key = (type(seed), seed.mu, seed.nu, seed.gamma)
+    hit = _JET_CACHE.get(key)
+    if hit is None:
+        if len(_JET_CACHE) > 4096:
+            _JET_CACHE.clear()
+        hit = _JET_CACHE[key] = seed.end_jets()
+    return hit
+
+
+def _end_rows_fast(curve: GHTCurve, end: int, max_order: int) -> list[np.ndarray]:
+    r"""Rows ``b^{(r)}_{i,m}(end)`` from the seed's end jets (used by :func:`join`).
+
+    ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}`` (n = m-2) with the Bernstein end
+    values ``B^{(j)}_{l,n}(0) = n!/(n-j)! (-1)^{j-l} C(j,l)`` and
+    ``B^{(j)}_{l,n}(1) = n!/(n-j)! (-1)^{n-l} C(j, l-n+j)``.
+    """
+    a, e = _seed_end_jets(curve.seed)
+    jets = a if end == 0 else e
+    m = curve.degree
+    n = m - 2
+    rows = []
+    for r in range(max_order + 1):
+        row = np.zeros(m + 1)
+        for s_ in range(r + 1):
+            j = r - s_
+            if j > n:
+                continue
+            ff = float(np.prod(np.arange(n - j + 1, n + 1))) if j else 1.0
+            Bj = np.zeros(n + 1)
+            if end == 0:
+                for l_ in range(j + 1):
+                    Bj[l_] = ff * (-1) ** (j - l_) * comb(j, l_)
+            else:
+                for l_ in range(n - j, n + 1):
+                    Bj[l_] = ff * (-1) ** (n - l_) * comb(j, l_ - n + j)
+            c = comb(r, s_)
+            for k in range(3):
+                row[k : k + n + 1] += c * jets[s_, k] * Bj
+        rows.append(row)
+    return rows
 
 
 def join_targets(
@@ -199,7 +253,7 @@ def join_targets(
         )
     r = cont.order
     P = segment_a.control_points
-    d = [row @ P for row in _end_rows(segment_a, 1, r)]
+    d = [row @ P for row in _end_rows_fast(segment_a, 1, r)]
     d[0] = np.array(P[-1], dtype=float)  # P(1) = P_m exactly (b_{i,m}(1) = δ_im, spec section 2)
     if not cont.geometric:
         return d
@@ -275,7 +329,7 @@ def join(
             f"segment B has degree {b.degree} ({b.degree + 1} points); {cont.value} needs degree >= {r_max}"
         )
     targets = join_targets(segment_a, cont, k=k, beta2=beta2, beta3=beta3)
-    rows = _end_rows(b, 0, r_max)
+    rows = _end_rows_fast(b, 0, r_max)
     pts = np.array(b.control_points, dtype=float)
     pts[0] = targets[0]  # R(0) = R_0 exactly (b_{i,n}(0) = δ_i0, c_0 = 1)
     for r in range(1, r_max + 1):

@@ -86,6 +86,12 @@ def test_joints_hold_after_construction_and_set_shape(n, closed, conts, degrees,
     assert cc.segments[idx].shape_parameters == (mu, nu, gamma)
     _assert_joints(cc)
     _assert_free_points_kept(cc, user)
+    # the incremental re-solve equals a fresh solve bit for bit
+    fresh_segs = list(segs)
+    fresh_segs[idx] = segs[idx].with_shape(mu, nu, gamma)
+    fresh = CompositeCurve(fresh_segs, conts, closed=closed, k=k, beta2=b2, beta3=b3)
+    for x, y in zip(cc.segments, fresh.segments):
+        np.testing.assert_array_equal(x.control_points, y.control_points)
     # upstream segments (before idx, except a closed chain's last one) are untouched
     for i in range(idx):
         np.testing.assert_array_equal(cc.segments[i].control_points, before[i])
@@ -189,6 +195,28 @@ def test_errors_and_failed_edit_leaves_chain_unchanged():
         cc.set_shape(5, mu=0.1)
     with pytest.raises(GHTError, match="mu=3 is outside"):
         cc.set_shape(0, mu=3.0)
+
+
+def test_incremental_resolve_stops_early_but_matches_full_solve():
+    rng = np.random.default_rng(13)
+    segs = [GHTCurve(rng.normal(size=(7, 2)), 0.1, 0.2, -0.3) for _ in range(6)]
+    cc = CompositeCurve(segs, "G2", k=1.1, beta2=0.1)
+    before = [s.control_points.copy() for s in cc.segments]
+    cc.set_shape(2, mu=-0.5)
+    # segment 2 changes, 3 re-solves (its start depends on 2's end), 4.. are unchanged
+    assert not np.array_equal(cc.segments[3].control_points, before[3])
+    for i in (0, 1, 4, 5):
+        np.testing.assert_array_equal(cc.segments[i].control_points, before[i])
+    fresh = CompositeCurve([s if i != 2 else s.with_shape(mu=-0.5) for i, s in enumerate(segs)], "G2", k=1.1, beta2=0.1)
+    for x, y in zip(cc.segments, fresh.segments):
+        np.testing.assert_array_equal(x.control_points, y.control_points)
+    # degree 2 + C2 everywhere: every point is dependent, a change runs to the end of the chain
+    low = [GHTCurve(rng.normal(size=(3, 2)), 0.1, 0.2, -0.3) for _ in range(4)]
+    cl = CompositeCurve(low, "C2")
+    old_last = cl.segments[3].control_points.copy()
+    cl.set_shape(1, gamma=0.5)
+    assert not np.array_equal(cl.segments[3].control_points, old_last)
+    _assert_joints(cl)
 
 
 def test_set_shape_and_set_segment_on_seed_families():

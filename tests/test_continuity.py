@@ -220,3 +220,21 @@ def test_singular_cases_raise_clear_errors():
         join(a, "C1", [(0, 0), (1, 0), (2, 0)], mu=2.0)
     with pytest.raises(GHTError, match="measure_continuity needs two GHTCurve"):
         measure_continuity(a, [(0, 0), (1, 0), (2, 0)])
+
+
+def test_join_end_rows_match_full_basis_evaluation():
+    # join uses closed-form end rows from the seed's end jets; measure_continuity evaluates the
+    # full basis. Both must agree (reversed seeds go through the uncached generic path).
+    from ght_cad.continuity import _end_rows, _end_rows_fast
+
+    rng = np.random.default_rng(17)
+    for m in range(2, 11):
+        for curve in (
+            GHTCurve(rng.normal(size=(m + 1, 2)), *rng.uniform(-1, 1, 3)),
+            GHTCurve(rng.normal(size=(m + 1, 2)), *rng.uniform(-1, 1, 3)).reversed(),
+            GHTCurve(rng.normal(size=(m + 1, 2)), 0.4, -0.6, seed="gbt"),
+            GHTCurve(rng.normal(size=(m + 1, 2)), seed="bernstein"),
+        ):
+            for end in (0, 1):
+                for x, y in zip(_end_rows(curve, end, 3), _end_rows_fast(curve, end, 3)):
+                    np.testing.assert_allclose(y, x, rtol=1e-13, atol=1e-13 * max(1.0, np.abs(x).max()))
