@@ -227,6 +227,12 @@ class EnvelopeDevelopable(RuledSurface):
         if isinstance(planes, GHTCurve):
             if planes.dim != 4:
                 raise GHTError(f"a dual curve of planes must be 4-D; got a curve of dimension {planes.dim}")
+            if (mu, nu, gamma) != (0.0, 0.0, 0.0) or normalize:
+                raise GHTError(
+                    f"mu={mu!r}, nu={nu!r}, gamma={gamma!r}, normalize={normalize!r} were given with a "
+                    "GHTCurve of planes; its shape parameters and plane scales are its own (pass an array "
+                    "of planes to set them)"
+                )
             check_control_planes(planes.control_points, "planes")
             curve = planes
         else:
@@ -360,7 +366,7 @@ class EnvelopeDevelopable(RuledSurface):
             raise DegenerateGeometryError(
                 f"at u={u[i]:.6g} (t={t:.6g}) the dual curve's plane U={_fmt(U[0][i])} and its derivative "
                 f"U'={_fmt(U[1][i])} have parallel normals, so the ruling U ∩ U' is at infinity; "
-                "the control planes must turn (neighbouring planes must not be parallel)"
+                "the control planes must turn (neighbouring planes must not be parallel)" + self._orientation_hint()
             )
         dunit = d / dn[:, None]
         names = ("E_a", "E_b")
@@ -382,7 +388,7 @@ class EnvelopeDevelopable(RuledSurface):
                 raise DegenerateGeometryError(
                     f"boundary plane {names[which]}={_fmt(E)} {what} the ruling at u={x:.6g} (t={t:.6g}) "
                     f"(the line through {_fmt(p)} with direction {_fmt(self.ruling_direction(x)[0])}); "
-                    "boundary planes must cut every ruling of the strip in one point"
+                    "boundary planes must cut every ruling of the strip in one point" + self._orientation_hint()
                 )
         # strip width: E_a and E_b must not cross on a ruling
         A = self.a(u)
@@ -400,6 +406,7 @@ class EnvelopeDevelopable(RuledSurface):
                 f"boundary planes E_a={_fmt(self.boundary_planes[0])} and E_b={_fmt(self.boundary_planes[1])} "
                 f"cut the ruling at u={x:.6g} (t={t:.6g}) in the same point {_fmt(self.a(x)[0])}; "
                 "the strip has zero width there (the boundary planes must not cross inside the strip)"
+                + self._orientation_hint()
             )
         # edge of regression inside the strip: phi = h (R0 - h) >= 0  <=>  0 <= v_R <= 1
         self._check_regression(u)
@@ -448,11 +455,24 @@ class EnvelopeDevelopable(RuledSurface):
                 f"the strip contains its edge of regression at u={best_u:.6g} (t={t:.6g}), v={vR:.6g} "
                 f"(point {_fmt(R)}){where}; the surface is singular there. Move the boundary planes "
                 f"E_a={_fmt(self.boundary_planes[0])}, E_b={_fmt(self.boundary_planes[1])} so that the "
-                "edge of regression stays outside 0 <= v <= 1, or trim t_range"
+                "edge of regression stays outside 0 <= v <= 1, or trim t_range" + self._orientation_hint()
             )
 
+    def _orientation_hint(self) -> str:
+        """A note when neighbouring control planes have opposite normal orientations."""
+        P = self.planes
+        n = P[:, 1:] / np.linalg.norm(P[:, 1:], axis=1, keepdims=True)
+        dots = np.sum(n[:-1] * n[1:], axis=1)
+        if np.all(dots >= 0.0):
+            return ""
+        i = int(np.argmin(dots))
+        return (
+            f". Note: control planes planes[{i}] and planes[{i + 1}] have opposite normal orientations "
+            f"(n·n = {dots[i]:.3g}); U and -U are the same plane but blend differently: flip the sign of one"
+        )
+
     # -- CAD ------------------------------------------------------------------------------------
-    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+    def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face (degree 1 across the rulings); see :func:`ght_cad.cad.developable_faces.developable_face`."""
         from .cad.developable_faces import developable_face
 
@@ -627,7 +647,7 @@ class TangentDevelopable(RuledSurface):
         """The spine ``C(t)``."""
         return self.curve.evaluate(as_parameter_array(u, "u")[0])
 
-    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+    def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
         from .cad.developable_faces import developable_face
 
@@ -692,7 +712,7 @@ class RectifyingDevelopable(RuledSurface):
         r = _check_derivative(derivative)
         return curve_derivatives(self.curve, u, r)[r] + self.v1 * self._D(u, r)[r]
 
-    def to_face(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+    def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
         from .cad.developable_faces import developable_face
 
@@ -1106,7 +1126,7 @@ class CompositeDevelopable:
         """:func:`measure_developable_joint` at every joint (enveloping segments only)."""
         return [measure_developable_joint(self.segments[i], self.segments[i + 1], tol=tol) for i in range(len(self.segments) - 1)]
 
-    def to_shell(self, tol: float = 1e-7, **kwargs: Any) -> Any:
+    def to_shell(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A shell of one B-spline face per segment with shared joint edges; see
         :func:`ght_cad.cad.developable_faces.composite_shell`."""
         from .cad.developable_faces import composite_shell

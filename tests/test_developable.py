@@ -247,6 +247,13 @@ def test_boundary_planes_crossing_inside_the_strip():
         developable_from_planes([(-1, 1, 0, 0), (-1, 1, 1, 0), (-1, 0, 1, 0)], [(0, 0, 0, 1), (1, 0, -2, 1)], gamma=-1)
 
 
+def test_flipped_control_plane_gets_a_hint():
+    P = np.array(SHIP)
+    P[1] *= -1  # the same plane, opposite orientation: the dual curve no longer follows the hull
+    with pytest.raises(DegenerateGeometryError, match=r"planes\[0\] and planes\[1\] have opposite normal orientations.*flip the sign"):
+        developable_from_planes(P, FRAMES, 0.3, -0.2, 0.1)
+
+
 def test_other_bad_arguments():
     with pytest.raises(ShapeParameterError, match=r"mu=1.5 is outside the allowed range \[-1, 1\]"):
         developable_from_planes(SHIP, FRAMES, mu=1.5)
@@ -256,6 +263,8 @@ def test_other_bad_arguments():
         developable_from_planes(SHIP, [(0, 1, 0, 0)])
     with pytest.raises(DegenerateGeometryError, match=r"E_b=.*zero normal"):
         developable_from_planes(SHIP, [(0, 1, 0, 0), (1, 0, 0, 0)])
+    with pytest.raises(GHTError, match=r"gamma=0.5.*were given with a GHTCurve of planes"):
+        EnvelopeDevelopable(GHTCurve(SHIP), FRAMES, gamma=0.5)
     with pytest.raises(GHTError, match=r"derivative=3 is not allowed; .*0..2"):
         ship().a(0.5, 3)
 
@@ -409,3 +418,19 @@ def test_join_errors():
         join_developable(a.trimmed((0.0, 0.5)), "G1", NEXT)
     with pytest.raises(DegenerateGeometryError, match=r"segments 0 and 1 do not share their joint ruling.*relative gap"):
         CompositeDevelopable([a, developable_from_planes(NEXT, FRAMES)])
+
+
+@given(st.floats(0.5, 2.0), st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), shape, shape, shape)
+@settings(max_examples=12)
+def test_g3_join_over_parameter_box(k, beta2, beta3, mu, nu, gamma):
+    """A G3 join of the dual curves measures G3 for any k > 0, β2, β3 and shape of the second surface."""
+    a = _first()
+    try:
+        b = join_developable(a, "G3", NEXT, mu=mu, nu=nu, gamma=gamma, k=k, beta2=beta2, beta3=beta3)
+    except (SingularJoinError, DegenerateGeometryError):
+        # a zero newest-point coefficient, or solved planes that give an unusable strip: both are
+        # reported with their own error; nothing to measure
+        return
+    rep = measure_developable_joint(a, b)
+    assert rep.order == 3, rep
+    assert rep.dual.g_order == 3
