@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import ght_cad
@@ -429,8 +429,8 @@ def test_g3_join_over_parameter_box(k, beta2, beta3, mu, nu, gamma):
         b = join_developable(a, "G3", NEXT, mu=mu, nu=nu, gamma=gamma, k=k, beta2=beta2, beta3=beta3)
     except (SingularJoinError, DegenerateGeometryError):
         # a zero newest-point coefficient, or solved planes that give an unusable strip: both are
-        # reported with their own error; nothing to measure
-        return
+        # reported with their own error; nothing to measure (hypothesis fails if this is common)
+        assume(False)
     rep = measure_developable_joint(a, b)
     assert rep.order == 3, rep
     assert rep.dual.g_order == 3
