@@ -42,7 +42,11 @@ def _env(tmp_path: Path, pythonpath: bool = True) -> dict[str, str]:
     env.pop("PYTHONHOME", None)
     env.pop("VIRTUAL_ENV", None)
     if pythonpath:
-        env["PYTHONPATH"] = os.pathsep.join([str(WB), str(REPO)])
+        # the very ght_cad this pytest process imports, so both sides run the same core code
+        import ght_cad
+
+        core = Path(ght_cad.__file__).resolve().parents[1]
+        env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys([str(WB), str(core), str(REPO)]))
     else:
         env.pop("PYTHONPATH", None)
     return env
@@ -182,6 +186,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert c["restored"] == [0.0, 0.0] and c["length_restored"], c
     v = steps["GHT_Curve from vertices"]["value"]
     assert v["degree"] == 3 and v["source"] == ["Vertex1", "Vertex2", "Vertex3", "Vertex4"], v
+    r = steps["reopen"]["value"]
+    assert r["objects"] == 9 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]
     assert opt["best"] <= opt["initial"] and not opt["status"].startswith("cancelled"), opt
     for name in ("GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"):

@@ -139,6 +139,11 @@ class ViewProviderBase:
     def attach(self, vobj: Any) -> None:
         self.Object = vobj.Object
 
+    @property
+    def obj(self) -> Any:
+        """The feature (None before ``attach``)."""
+        return getattr(self, "Object", None)
+
     def getIcon(self) -> str:
         return icon(self.icon_name)
 

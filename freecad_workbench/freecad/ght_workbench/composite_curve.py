@@ -79,7 +79,7 @@ class ViewProviderCompositeCurve(ViewProviderBase):
     line_width = 2.5
 
     def claimChildren(self) -> list:
-        return list(getattr(self.Object, "Segments", []))
+        return list(getattr(self.obj, "Segments", []))
 
 
 def _panel(obj: Any) -> ShapeParameterPanel:

@@ -143,7 +143,7 @@ class ViewProviderDevelopable(ViewProviderBase):
     shape_color = (0.5, 0.7, 0.9)
 
     def claimChildren(self) -> list:
-        links = list(getattr(self.Object, "Planes", [])) + list(getattr(self.Object, "BoundaryPlanes", []))
+        links = list(getattr(self.obj, "Planes", [])) + list(getattr(self.obj, "BoundaryPlanes", []))
         return [o for o, _ in links]
 
 

@@ -60,7 +60,7 @@ class ViewProviderSpineDevelopable(ViewProviderBase):
     shape_color = (0.6, 0.83, 0.6)
 
     def claimChildren(self) -> list:
-        c = getattr(self.Object, "Curve", None)
+        c = getattr(self.obj, "Curve", None)
         return [c] if c is not None else []
 
 

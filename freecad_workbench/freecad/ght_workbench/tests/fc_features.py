@@ -115,6 +115,7 @@ class GHTCurveTest(unittest.TestCase):
         doc2 = _reopen(self.doc)
         obj2 = doc2.getObject(name)
         self.assertEqual(obj2.Proxy.Type, "GHT::Curve")
+        self.assertEqual(obj2.getEditorMode("Degree"), ["ReadOnly"])
         self.assertAlmostEqual(obj2.Shape.Length, length, delta=1e-9)
         self.assertEqual((obj2.Mu, obj2.Nu, obj2.Gamma), (0.3, -0.4, 0.2))
         obj2.Mu = 7.0  # the [-1, 1] constraint survives the reload

@@ -164,7 +164,26 @@ def main():
         return {"path": path, "size": os.path.getsize(path)}
 
     step("screenshot", screenshot)
-    doc.saveAs(os.path.join(OUT, "gui_check.FCStd"))
+
+    def reopen():
+        path = os.path.join(OUT, "gui_check.FCStd")
+        names = {o.Name: o.Proxy.Type for o in doc.Objects if hasattr(o, "Proxy")}
+        doc.saveAs(path)
+        App.closeDocument(doc.Name)
+        doc2 = App.openDocument(path)
+        for o in doc2.Objects:
+            o.touch()
+        doc2.recompute()
+        objs = [doc2.getObject(n) for n in names]
+        bad = [o.Name for o in objs if "Invalid" in o.State or "Error" in o.State]
+        icons = all(os.path.isfile(o.ViewObject.Proxy.getIcon()) for o in objs)
+        dev = [o for o in objs if o.Proxy.Type == "GHT::Developable"][0]
+        Gui.ActiveDocument.setEdit(dev.Name, 0)  # double-click: task panel again
+        panel_open = bool(Gui.Control.activeDialog())
+        return {"objects": len(objs), "bad": bad, "icons": icons, "panel_open": panel_open,
+                "children": [c.Name for c in dev.ViewObject.Proxy.claimChildren()]}
+
+    step("reopen", reopen)
 
 
 def finish():
