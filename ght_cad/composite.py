@@ -411,6 +411,84 @@ class CompositeCurve:
         """All control points, segment after segment (shared joint points repeated)."""
         return np.vstack([seg.control_points for seg in self._segments])
 
+    # -- construction helpers -------------------------------------------------------------------
+    @classmethod
+    def through_points(
+        cls,
+        points: Any,
+        *,
+        degree: int = 5,
+        continuity: Any = "G2",
+        closed: bool = False,
+        mu: float = 0.0,
+        nu: float = 0.0,
+        gamma: float = 0.0,
+    ) -> "CompositeCurve":
+        r"""A chain whose joints pass through ``points``: segment j runs from ``Q_j`` to ``Q_{j+1}``.
+
+        Initial segments are the cubic Hermite (Catmull–Rom, chord-scaled tangents) pieces
+        sampled at ``i/degree`` as control points; then every joint is solved with
+        ``continuity``. At G joints ``k_j = |Q_{j+2} - Q_{j+1}| / |Q_{j+1} - Q_j|`` (chord-length
+        ratio, so the parameter speed follows the spacing) and ``β2 = β3 = 0``. Segment ends
+        ``Q_{j+1}`` are kept because a segment's last point is free when ``degree > r`` (open)
+        or solved to ``Q_0`` by the wrap joint (closed).
+
+        Args:
+            points: (count, dim) points, count >= 2 (>= 3 when closed); no two consecutive equal.
+            degree: degree of every segment (>= the continuity order + 1; closed chains need
+                ``2 r + 1``).
+            continuity: one value or one per joint.
+            closed: close the chain through ``Q_0`` (``count`` segments instead of ``count - 1``).
+            mu, nu, gamma: shape parameters of every segment.
+
+        Raises:
+            GHTError: too few points, repeated consecutive points, too low a degree.
+        """
+        from ._validate import check_degree
+
+        Q = check_points("points", points, min_count=3 if closed else 2)
+        m = check_degree(degree)
+        P = np.vstack([Q, Q[:1]]) if closed else Q
+        n = len(P) - 1
+        chords = np.linalg.norm(np.diff(P, axis=0), axis=1)
+        if np.any(chords <= 1e-12 * max(1.0, float(np.abs(P).max()))):
+            j = int(np.argmin(chords))
+            raise GHTError(f"points {j} and {(j + 1) % len(Q)} coincide; consecutive points must differ")
+        conts = _per_joint("continuity", continuity, n if closed else n - 1, Continuity.parse)
+        need = max([c.order for c in conts] + [0]) + 1
+        if closed:
+            need = max(need, 2 * max(c.order for c in conts) + 1)
+        if m < need:
+            raise GHTError(
+                f"degree={m} is too low for continuity {', '.join(sorted({c.value for c in conts}))} "
+                f"{'(closed)' if closed else ''} through points; it needs degree >= {need}"
+            )
+        # Catmull-Rom tangents (per unit parameter of each segment), chord-scaled
+        tangents = np.empty_like(P)
+        for i in range(n + 1):
+            if closed:
+                prev, nxt = P[(i - 1) % n], P[(i + 1) % n] if i < n else P[1]
+                lp, ln = chords[(i - 1) % n], chords[i % n]
+            else:
+                prev, nxt = P[max(i - 1, 0)], P[min(i + 1, n)]
+                lp, ln = chords[max(i - 1, 0)], chords[min(i, n - 1)]
+            d = (nxt - prev) / (lp + ln if 0 < i < n or closed else max(lp, ln))
+            tangents[i] = d
+        t = np.linspace(0.0, 1.0, m + 1)[:, None]
+        h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
+        h01, h11 = -2 * t**3 + 3 * t**2, t**3 - t**2
+        segs = []
+        for j in range(n):
+            L = chords[j]
+            pts = h00 * P[j] + h10 * L * tangents[j] + h01 * P[j + 1] + h11 * L * tangents[j + 1]
+            segs.append(GHTCurve(pts, mu, nu, gamma))
+        nj = len(conts)
+        k = [float(chords[(j + 1) % n] / chords[j]) for j in range(nj)]
+        for j, c in enumerate(conts):
+            if not c.geometric:
+                k[j] = 1.0
+        return cls(segs, conts, closed=closed, k=k, beta2=0.0, beta3=0.0)
+
     # -- (de)serialization ----------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """Plain data: ``{"type", "segments": [GHTCurve.to_dict()], "continuity", "closed", "k", "beta2", "beta3"}``.

@@ -236,3 +236,28 @@ def test_set_shape_and_set_segment_on_seed_families():
     _assert_joints(cc)
     with pytest.raises(GHTError, match="segment has dimension 3; this chain has dimension 2"):
         cc.set_segment(0, GHTCurve(np.zeros((3, 3))))
+
+
+@pytest.mark.parametrize(
+    "closed,degree,cont", [(False, 5, "G2"), (False, 4, "C2"), (True, 5, "G2"), (True, 7, "G3"), (False, 3, "G1")]
+)
+def test_through_points(closed, degree, cont):
+    Q = np.array([(0, 0, 0), (1, 1, 0.5), (3, 1.2, 1), (4, 0, 0.2), (6, -1, 0)], dtype=float)
+    cc = CompositeCurve.through_points(Q, degree=degree, continuity=cont, closed=closed, mu=0.2, nu=-0.3, gamma=-0.5)
+    assert cc.n_segments == (5 if closed else 4) and cc.closed == closed
+    s = np.arange(cc.n_segments + 1, dtype=float)
+    expected = np.vstack([Q, Q[:1]]) if closed else Q
+    np.testing.assert_allclose(cc.evaluate(s), expected, rtol=0, atol=1e-13)
+    _assert_joints(cc)
+    chords = np.linalg.norm(np.diff(expected, axis=0), axis=1)
+    if cont.startswith("G"):
+        assert cc.g_parameters[0][0] == pytest.approx(chords[1] / chords[0], rel=1e-14)
+
+
+def test_through_points_errors():
+    with pytest.raises(GHTError, match="points 1 and 2 coincide"):
+        CompositeCurve.through_points([(0, 0), (1, 1), (1, 1), (2, 0)])
+    with pytest.raises(GHTError, match=r"degree=4 is too low for continuity G2 \(closed\) through points; it needs degree >= 5"):
+        CompositeCurve.through_points([(0, 0), (1, 1), (2, 0)], degree=4, closed=True)
+    with pytest.raises(GHTError, match="points has 2 points; at least 3 are required"):
+        CompositeCurve.through_points([(0, 0), (1, 1)], closed=True)
