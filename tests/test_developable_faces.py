@@ -124,6 +124,21 @@ def test_cylinder_face_keeps_radius():
     assert face_developability(face).theta_max <= 1e-9
 
 
+def test_cone_face_keeps_apex_and_axis():
+    k, h = 0.5, 2.0
+    P = [(-k * h, 1, 0, k), (-k * h, 1, 1, k), (-k * h, 0, 1, k)]
+    s = developable_from_planes(P, [(0, 0, 0, 1), (-1.2, 0, 0, 1)], gamma=-1)
+    g = _surface(s.to_face(tol=1e-10))
+    for u in np.linspace(0, 1, 17):
+        pts = [g.Value(float(u), v) for v in (0.0, 1.0)]
+        X = np.array([[p.X(), p.Y(), p.Z()] for p in pts])
+        # on the cone sqrt(x² + y²) = k (h - z) and the ruling line passes through the apex (0, 0, h)
+        assert np.abs(np.hypot(X[:, 0], X[:, 1]) - k * (h - X[:, 2])).max() <= 1e-9
+        d = X[1] - X[0]
+        assert np.linalg.norm(np.cross(np.array([0, 0, h]) - X[0], d)) / np.linalg.norm(d) <= 1e-9
+    assert face_developability(s.to_face()).theta_max <= THETA_FACE_DEG
+
+
 # -- composites: shells with shared edges, normal field continuous across the joint ----------
 APEX = np.array([-25.0, 0.0, -2.0])
 
@@ -176,6 +191,8 @@ def test_composite_shell_joint(order, tmp_path):
         assert jump >= 1e-3  # a G1-only joint has a curvature jump (the check can fail)
     back = read_step(write_step(shell, tmp_path / "shell.step"))
     assert len(shell_faces(back)) == 2 and max(joint_normal_deviation(back)) <= 1e-6
+    for f in shell_faces(back):
+        assert face_developability(f).theta_max <= THETA_FACE_DEG
 
 
 # -- planes from build123d, bad input ----------------------------------------------------------
