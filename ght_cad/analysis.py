@@ -14,8 +14,8 @@ Everything is analytic, from the derivatives up to order 3 (``d_r = X^(r)``, any
 The thesis compares the curvature continuity of GHT-Bézier and Bézier chains:
 :func:`bezier_chain_like` builds the classical Bézier chain (γ = 1) on the same control points
 and :func:`compare_curvature` reports the curvature jumps at the joints of both, with a
-side-by-side PNG. PNGs are written atomically (matplotlib is imported inside the functions, Agg
-backend).
+side-by-side PNG. PNGs are written atomically (matplotlib is imported inside the functions; figures
+use the Agg canvas directly, pyplot and its global backend are never touched).
 """
 
 from __future__ import annotations
@@ -289,23 +289,20 @@ def _draw_comb(ax, curve: CurveLike, per_segment: int, scale: float | None, show
 
 def _save(fig, path: str | Path, dpi: int) -> Path:
     target = Path(path)
-    try:
-        with atomic_path(target) as tmp:
-            fig.savefig(tmp, format="png", dpi=dpi)
-    finally:
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
+    with atomic_path(target) as tmp:
+        fig.savefig(tmp, format="png", dpi=dpi)
     return target
 
 
-def _pyplot():
-    import matplotlib
+def _figure(figsize: tuple[float, float], ncols: int = 1):
+    """A stand-alone Agg figure (no pyplot, so no global backend switch in a host GUI)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, ncols)
+    return fig, axes
 
 
 def curvature_comb_plot(
@@ -343,8 +340,7 @@ def curvature_comb_plot(
     n = _check_samples(samples_per_segment)
     if scale is not None and not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale >= 0):
         raise GHTError(f"scale={scale!r} is not allowed; it must be a finite number >= 0 or None")
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 6))
+    fig, ax = _figure((7, 6))
     _draw_comb(ax, curve, n, scale, show_control_polygon)
     ax.set_title(title or f"curvature comb ({type(curve).__name__})")
     fig.tight_layout()
@@ -421,8 +417,7 @@ def compare_curvature(
     if composite.closed:
         result["joints"][-1] = float(composite.n_segments)  # wrap joint: s = n ≡ 0
     if path is not None:
-        plt = _pyplot()
-        fig, axes = plt.subplots(1, 3, figsize=(16, 5.2))
+        fig, axes = _figure((16, 5.2), 3)
         kmax = max(result["ght"]["kappa_max"], result["bezier"]["kappa_max"])
         allp = np.vstack([seg.control_points for seg in composite.segments])
         diag = float(np.linalg.norm(np.ptp(allp, axis=0))) or 1.0
