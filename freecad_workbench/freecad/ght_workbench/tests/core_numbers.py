@@ -10,6 +10,13 @@ from typing import Any, Callable
 
 import numpy as np
 
+#: tolerance of the B-spline fit in :func:`_bspline`. An adaptive fit places its knots from
+#: measured errors |f - C| ~ tol, which carry rounding noise of ~1e-14 absolute, so knots and
+#: values of fits made with different numpy/scipy builds agree to the fit tolerance, not to 1e-12:
+#: keys in FIT_KEYS are compared with FIT_KEYS[key] (absolute), every other key to 1e-12 relative.
+BSPLINE_TOL = 1e-6
+FIT_KEYS = {"bspline/knots": 1e-3, "bspline/at_t": 2 * BSPLINE_TOL, "bspline/max_deviation": BSPLINE_TOL}
+
 PARAMS = [(0.0, 0.0, 0.0), (0.7, -0.3, -1.0), (-1.0, 1.0, 0.4), (0.25, 0.5, 1.0)]
 T = np.linspace(0.0, 1.0, 11)
 POINTS = [(0.0, 0.0, 0.0), (10.0, 20.0, 0.0), (30.0, 20.0, 5.0), (40.0, 0.0, 0.0), (55.0, -5.0, 2.0)]
@@ -41,10 +48,10 @@ def _bspline(out: dict[str, Any]) -> None:
     from ght_cad.bspline import curve_to_bspline
 
     c = GHTCurve(POINTS, 0.3, -0.2, 0.1)
-    d = curve_to_bspline(c, tol=1e-6)
+    d = curve_to_bspline(c, tol=BSPLINE_TOL)
     out["bspline/knots"] = d.knots
-    out["bspline/poles"] = d.poles
     out["bspline/at_t"] = d.evaluate(T)
+    out["bspline/max_deviation"] = float(d.max_deviation)
 
 
 def _join(out: dict[str, Any]) -> None:
