@@ -209,7 +209,14 @@ class CompositeCurve:
         return i % n
 
     def dependent_indices(self, index: int) -> list[int]:
-        """Indices of the control points of segment ``index`` that the joints determine."""
+        """Indices of the control points of segment ``index`` that the joints determine.
+
+        ``0..r_{index-1}`` for ``index >= 1``; plus ``m-r..m`` for the last segment of a closed
+        chain (r the wrap joint's order, m the degree).
+
+        Raises:
+            GHTError: bad index.
+        """
         i = self._check_index(index)
         n = len(self._free)
         m = self._free[i].degree
@@ -261,6 +268,14 @@ class CompositeCurve:
         """Replace segment ``index``'s control points (same or different count); re-solve.
 
         The dependent points (:meth:`dependent_indices`) of the given array are overwritten.
+
+        Args:
+            index: segment index.
+            control_points: (count, dim) array, count >= 3.
+
+        Raises:
+            GHTError: bad index, shape or dimension; SingularJoinError if a joint becomes
+                impossible (the chain is then left unchanged).
         """
         i = self._check_index(index)
         pts = check_points("control_points", control_points, min_count=3)
@@ -378,13 +393,35 @@ class CompositeCurve:
         return out[0] if scalar else out
 
     def evaluate(self, s: Any) -> np.ndarray:
-        """Points at global parameters ``s ∈ [0, n_segments]``; shape (len(s), dim) or (dim,)."""
+        """Points ``X(s) = P_j(s - j)``, ``j = min(floor(s), n-1)``, at global parameters s.
+
+        Args:
+            s: scalar or 1-D array in ``[0, n_segments]``.
+
+        Returns:
+            Array (len(s), dim), or (dim,) for scalar s.
+
+        Raises:
+            GHTError: s outside the domain or not finite.
+        """
         return self._eval(s, 0)
 
     __call__ = evaluate
 
     def derivative(self, s: Any, order: int = 1) -> np.ndarray:
-        """``d^r X / ds^r`` (equal to the segment's ``P^(r)(t)``, t = s - j), r = 0..3."""
+        """``d^r X / ds^r = P_j^(r)(s - j)`` (unit parameter intervals, so no chain-rule factor).
+
+        Args:
+            s: scalar or 1-D array in ``[0, n_segments]``; at an interior joint the right-hand
+                segment is used.
+            order: r = 0..3.
+
+        Returns:
+            Array (len(s), dim), or (dim,) for scalar s.
+
+        Raises:
+            GHTError: s outside the domain, bad order.
+        """
         return self._eval(s, _check_order(order))
 
     def curvature(self, s: Any) -> np.ndarray:
@@ -404,7 +441,14 @@ class CompositeCurve:
     length = property(lambda self: self.arc_length(), doc="Total arc length.")
 
     def joint_reports(self, tol: float = 1e-9) -> list[JointReport]:
-        """:func:`~ght_cad.continuity.measure_continuity` at every joint (wrap joint last)."""
+        """:func:`~ght_cad.continuity.measure_continuity` at every joint (wrap joint last).
+
+        Args:
+            tol: relative tolerance (see measure_continuity for its definition).
+
+        Returns:
+            One :class:`~ght_cad.continuity.JointReport` per joint.
+        """
         return [measure_continuity(*self.joint_segments(j), tol=tol) for j in range(self.n_joints)]
 
     def control_polygon(self) -> np.ndarray:

@@ -355,8 +355,14 @@ def reverse_g_parameters(k: float, beta2: float, beta3: float) -> tuple[float, f
     ``χ' = 1/k``, ``χ'' = β2/k³``, ``χ''' = (3β2² - kβ3)/k⁵`` (inverse-function derivatives).
     So joining ``R~`` (as A) to ``P~`` (as B) with these parameters is the same joint.
 
+    Args:
+        k, beta2, beta3: the forward joint's G parameters (k > 0).
+
     Returns:
         ``(k~, β2~, β3~)``.
+
+    Raises:
+        SingularJoinError: k <= 0.
     """
     k, beta2, beta3 = _check_g_parameters(k, beta2, beta3)
     return 1.0 / k, beta2 / k**3, (3.0 * beta2 * beta2 - k * beta3) / k**5
