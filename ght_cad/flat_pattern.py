@@ -528,14 +528,16 @@ class FlatPattern:
 
         OUTLINE: every loop as a closed LWPOLYLINE (``spline=True``: a closed fit-point SPLINE).
         BEND: bend lines as LINEs with linetype DASHED. LABELS: TEXT. MARKS: edge-mark ticks.
+        Without ezdxf (FreeCAD's Python) a plain R12 file with the same layers is written
+        (:meth:`dxf_r12_text`).
 
-        Raises:
-            GHTError: ezdxf is missing; the target file is then untouched.
+        Returns:
+            The path written.
         """
         try:
             import ezdxf
-        except ImportError as exc:  # pragma: no cover
-            raise GHTError(f"export_dxf needs the ezdxf package: {exc}") from None
+        except ImportError:  # e.g. FreeCAD's own Python: plain R12 writer, same layers
+            return write_text_atomic(path, self.dxf_r12_text())
         doc = ezdxf.new("R2010", setup=True)
         doc.header["$INSUNITS"] = INSUNITS[self.units]
         doc.header["$MEASUREMENT"] = 0 if self.units in ("in", "ft") else 1
@@ -561,6 +563,47 @@ class FlatPattern:
         with atomic_path(path) as tmp:
             doc.saveas(tmp)
         return Path(path)
+
+    def dxf_r12_text(self) -> str:
+        """Minimal ASCII DXF R12 (no ezdxf needed): LTYPE DASHED, layers OUTLINE/BEND/LABELS/MARKS,
+        closed POLYLINEs, LINEs, TEXT; ``$INSUNITS`` in the header."""
+        out: list[str] = []
+
+        def put(code: int, value: Any) -> None:
+            out.append(f"{code}\n{value:.12g}" if isinstance(value, float) else f"{code}\n{value}")
+
+        put(0, "SECTION"), put(2, "HEADER"), put(9, "$ACADVER"), put(1, "AC1009")
+        put(9, "$INSUNITS"), put(70, INSUNITS[self.units]), put(0, "ENDSEC")
+        put(0, "SECTION"), put(2, "TABLES")
+        put(0, "TABLE"), put(2, "LTYPE"), put(70, 2)
+        put(0, "LTYPE"), put(2, "CONTINUOUS"), put(70, 0), put(3, "Solid line"), put(72, 65), put(73, 0), put(40, 0.0)
+        put(0, "LTYPE"), put(2, "DASHED"), put(70, 0), put(3, "Dashed __ __ __"), put(72, 65), put(73, 2)
+        put(40, 0.75), put(49, 0.5), put(49, -0.25)
+        put(0, "ENDTAB")
+        layers = (("OUTLINE", 7, "CONTINUOUS"), ("BEND", 1, "DASHED"), ("LABELS", 3, "CONTINUOUS"), ("MARKS", 5, "CONTINUOUS"))
+        put(0, "TABLE"), put(2, "LAYER"), put(70, len(layers))
+        for name, color, lt in layers:
+            put(0, "LAYER"), put(2, name), put(70, 0), put(62, color), put(6, lt)
+        put(0, "ENDTAB"), put(0, "ENDSEC")
+        put(0, "SECTION"), put(2, "ENTITIES")
+        for lp in self.outlines:
+            put(0, "POLYLINE"), put(8, "OUTLINE"), put(66, 1), put(70, 1)
+            for x, y in lp:
+                put(0, "VERTEX"), put(8, "OUTLINE"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
+            put(0, "SEQEND"), put(8, "OUTLINE")
+        for layer, segs in (("BEND", list(self.bend_lines)), ("MARKS", self.marks)):
+            for p, q in segs:
+                put(0, "LINE"), put(8, layer)
+                if layer == "BEND":
+                    put(6, "DASHED")
+                put(10, float(p[0])), put(20, float(p[1])), put(30, 0.0)
+                put(11, float(q[0])), put(21, float(q[1])), put(31, 0.0)
+        for x, y, text, h in self.labels:
+            put(0, "TEXT"), put(8, "LABELS"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
+            put(40, float(h)), put(1, text), put(72, 1), put(73, 2)
+            put(11, float(x)), put(21, float(y)), put(31, 0.0)
+        put(0, "ENDSEC"), put(0, "EOF")
+        return "\n".join(out) + "\n"
 
     def svg_text(self, margin: float | None = None) -> str:
         """The SVG document as a string (see :meth:`export_svg`)."""

@@ -395,8 +395,8 @@ def unroll(
     trimmed boundaries.
 
     Args:
-        surface_or_face: a RuledSurface, a face, or a list of them (then see
-            :func:`unroll_composite`).
+        surface_or_face: a RuledSurface, a face, or a list of them or a shell/solid/compound
+            with several faces (then one panel per face, see :func:`unroll_composite`).
         best_effort: flatten a surface that is not developable within ``tol_deg`` anyway; its
             distortion is in ``.report``.
         tol_deg: largest accepted ``θ_max`` (degrees) of the developability degree (spec 5).
@@ -429,7 +429,13 @@ def unroll(
             breakpoints=getattr(surface_or_face, "breakpoints", ()),
         )
     if hasattr(surface_or_face, "wrapped") or type(surface_or_face).__module__.startswith("OCP"):
-        from .cad.unroll_faces import unroll_face
+        from .cad.unroll_faces import shape_faces, unroll_face
+
+        faces = shape_faces(surface_or_face)
+        if len(faces) > 1:  # a shell, solid or compound: one panel per face
+            return unroll_composite(
+                faces, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units
+            )
 
         return unroll_face(
             surface_or_face,

@@ -153,3 +153,31 @@ def test_composite_exports_all_panels(tmp_path) -> None:
     assert len(msp.query('LINE[layer=="MARKS"]')) == 6
     root = ET.parse(pat.export_svg(tmp_path / "c.svg")).getroot()
     assert root.tag.endswith("svg")
+
+
+def test_dxf_r12_fallback_without_ezdxf(pattern: FlatPattern, tmp_path, monkeypatch) -> None:
+    """Without ezdxf (FreeCAD's Python) a plain R12 file with the same layers is written."""
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_ezdxf(name, *args, **kwargs):
+        if name == "ezdxf":
+            raise ImportError("no ezdxf here")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_ezdxf)
+    path = pattern.export_dxf(tmp_path / "r12.dxf")
+    monkeypatch.undo()
+    doc = ezdxf.readfile(path)
+    assert doc.dxfversion == "AC1009"
+    assert {"OUTLINE", "BEND", "LABELS"} <= {layer.dxf.name for layer in doc.layers}
+    assert doc.header["$INSUNITS"] == 4
+    msp = doc.modelspace()
+    polys = msp.query('POLYLINE[layer=="OUTLINE"]')
+    assert len(polys) == 1 and polys[0].is_closed
+    pts = np.array([(v.dxf.location.x, v.dxf.location.y) for v in polys[0].vertices])
+    np.testing.assert_allclose(pts, pattern.outlines[0], atol=1e-9)
+    bends = msp.query('LINE[layer=="BEND"]')
+    assert len(bends) == 7 and all(b.dxf.linetype == "DASHED" for b in bends)
+    assert [t.dxf.text for t in msp.query("TEXT")] == ["P1"]

@@ -210,3 +210,12 @@ def test_error_is_100x_smaller_than_freecad_flatmesh() -> None:
         assert r["ours_err"] * 100 <= r["fm_err"], r
     cone = rows[0]
     assert cone["ours_err"] * 100 <= cone["fm_err_intrinsic"], cone  # also vs flatmesh's own mesh
+
+
+def test_shell_gives_one_panel_per_face() -> None:
+    """A box (6 faces, 12 edges): 6 labelled panels, every edge marked on its two panels."""
+    pat = unroll(bd.Box(1.0, 2.0, 3.0), rulings=0)
+    assert len(pat.panels) == 6
+    marks = [t[2] for t in pat.labels if t[2].startswith("E")]
+    assert len(set(marks)) == 12 and len(marks) == 24
+    np.testing.assert_allclose(pat.area, 2 * (2 + 3 + 6), rtol=1e-12)

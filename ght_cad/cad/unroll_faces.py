@@ -51,7 +51,28 @@ from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from ..ruled import RuledSurface
 from ..unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable
 
-__all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction"]
+__all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "shape_faces"]
+
+
+def shape_faces(shape: Any) -> list[TopoDS_Face]:
+    """The faces of a build123d/cadquery/OCP shape (a face gives itself).
+
+    Raises:
+        GHTError: not a shape, or a shape without faces.
+    """
+    raw = shape.wrapped if hasattr(shape, "wrapped") else shape
+    if not isinstance(raw, TopoDS_Shape) or raw.IsNull():
+        raise GHTError(f"cannot unroll a {type(shape).__name__}; expected a build123d/cadquery Face or TopoDS_Face")
+    if raw.ShapeType() == TopAbs_FACE:
+        return [TopoDS.Face_s(raw)]
+    exp = TopExp_Explorer(raw, TopAbs_FACE)
+    faces = []
+    while exp.More():
+        faces.append(TopoDS.Face_s(exp.Current()))
+        exp.Next()
+    if not faces:
+        raise GHTError(f"the {type(shape).__name__} has no faces to unroll")
+    return faces
 
 
 def _topods_face(face: Any) -> TopoDS_Face:
