@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
 
 
 def _best(fn, repeat: int) -> float:

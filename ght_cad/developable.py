@@ -26,7 +26,7 @@ All surfaces are parametrized on ``(u, v) ∈ [0, 1]²`` (``u`` is the surface p
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from math import comb
 from typing import Any, Callable, Sequence
 
@@ -293,6 +293,16 @@ class EnvelopeDevelopable(RuledSurface):
         X = meet(U[0][:, None, :], U[1][:, None, :], self.boundary_planes[None, :, :])
         with np.errstate(divide="ignore", invalid="ignore"):
             return (X[:, :, 1:] / X[:, :, :1]).reshape(-1, 6)
+
+    def boundary_jet(self, u: Any, order: int = 2) -> list[np.ndarray]:
+        """``[(a, b), (a', b'), ...]`` up to ``order`` (<= 2), each (len(u), 6), from one ``U`` jet."""
+        r = _check_derivative(order)
+        U = self._U(u, r + 1)
+        sides = [
+            _jcartesian(_jprod(lambda A, B, E=E: meet(A, B, E), U[: r + 1], U[1 : r + 2]))
+            for E in self.boundary_planes
+        ]
+        return [np.hstack([sides[0][k], sides[1][k]]) for k in range(r + 1)]
 
     # -- geometry -------------------------------------------------------------------------------
     def ruling_direction(self, u: Any) -> np.ndarray:

@@ -434,3 +434,12 @@ def test_g3_join_over_parameter_box(k, beta2, beta3, mu, nu, gamma):
     rep = measure_developable_joint(a, b)
     assert rep.order == 3, rep
     assert rep.dual.g_order == 3
+
+
+def test_boundary_jet_and_values_agree_with_a_and_b():
+    s = ship()
+    u = np.linspace(0, 1, 9)
+    J = s.boundary_jet(u, 2)
+    for r in range(3):
+        np.testing.assert_array_equal(J[r], np.hstack([s.a(u, r), s.b(u, r)]))
+    np.testing.assert_allclose(s.boundary_values(u), J[0], rtol=0, atol=1e-13)

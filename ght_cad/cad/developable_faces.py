@@ -120,10 +120,16 @@ def developable_surface_data(
     def f(u: np.ndarray) -> np.ndarray:
         return fast(u) if fast is not None else np.hstack([surface.a(u), surface.b(u)])
 
-    ends = tuple(
-        [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(min(end_order, degree - 1) + 1)]
-        for e in (0.0, 1.0)
-    )
+    top = min(end_order, degree - 1)
+    jet = getattr(surface, "boundary_jet", None)
+    if jet is not None:
+        J = jet(np.array([0.0, 1.0]), top)
+        ends = tuple([J[r][e] for r in range(top + 1)] for e in (0, 1))
+    else:
+        ends = tuple(
+            [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(top + 1)]
+            for e in (0.0, 1.0)
+        )
     try:
         curve = fit_function(f, tol=tol, degree=degree, end_derivatives=ends)
     except ConversionError as exc:
