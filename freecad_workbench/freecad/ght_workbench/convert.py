@@ -17,7 +17,7 @@ import Part
 
 from . import _ensure_core  # noqa: F401  (makes ght_cad importable)
 from ght_cad.bspline import BSplineCurveData, BSplineSurfaceData, knots_and_multiplicities
-from ght_cad.errors import ConversionError, GHTError
+from ght_cad.errors import GHTError
 
 __all__ = [
     "vec",
@@ -48,46 +48,22 @@ def points_array(points: Iterable[Any]) -> np.ndarray:
     return np.array([[float(p[0]), float(p[1]), float(p[2])] for p in points], dtype=float).reshape(-1, 3)
 
 
-def _fallback_fit(f: Callable[[np.ndarray], np.ndarray], tol: float, max_points: int = 4097) -> BSplineCurveData:
-    """Cubic interpolation of ``f`` at 2^k+1 uniform parameters, k growing until the midpoint error <= tol.
-
-    Only used while the core has no ``ght_cad.bspline.fit_function``; the ends are interpolated
-    exactly (clamped knot vector, not-a-knot conditions).
-    """
-    from scipy.interpolate import make_interp_spline
-
-    n = 17
-    while True:
-        t = np.linspace(0.0, 1.0, n)
-        sp = make_interp_spline(t, f(t), k=3)
-        mid = 0.5 * (t[:-1] + t[1:])
-        err = float(np.max(np.linalg.norm(sp(mid) - f(mid), axis=-1)))
-        if err <= tol or n >= max_points:
-            if err > tol:
-                raise ConversionError(f"cubic fit reached {err:.3g} > tol={tol:g} with {n} points")
-            return BSplineCurveData(np.asarray(sp.c), np.asarray(sp.t), 3, max_deviation=err)
-        n = 2 * n - 1
-
-
 def fit_curve_function(f: Callable[[np.ndarray], np.ndarray], tol: float = DEFAULT_TOL) -> BSplineCurveData:
     """B-spline data of a vector function ``f(t)`` on [0, 1] (shape (len(t), d)), deviation <= tol.
 
-    Uses ``ght_cad.bspline.fit_function`` when the core provides it (one common knot vector for
-    every coordinate, so a 6-D stack of two boundary curves keeps its pairing).
+    ``ght_cad.bspline.fit_function``: one common knot vector for every coordinate, so a 6-D stack
+    of two boundary curves keeps its pairing; the deviation is measured at matched parameters.
     """
-    try:
-        from ght_cad.bspline import fit_function  # type: ignore[attr-defined]
-    except ImportError:
-        return _fallback_fit(f, tol)
+    from ght_cad.bspline import fit_function
+
     return fit_function(f, tol=tol)
 
 
 def curve_data(curve: Any, tol: float = DEFAULT_TOL) -> BSplineCurveData:
-    """B-spline data of a :class:`ght_cad.GHTCurve` via ``ght_cad.bspline.curve_to_bspline``."""
-    try:
-        from ght_cad.bspline import curve_to_bspline  # type: ignore[attr-defined]
-    except ImportError:
-        return _fallback_fit(curve.evaluate, tol)
+    """B-spline data of a :class:`ght_cad.GHTCurve` via ``ght_cad.bspline.curve_to_bspline``
+    (same parametrization, end derivatives up to order 3 exact, deviation <= tol)."""
+    from ght_cad.bspline import curve_to_bspline
+
     return curve_to_bspline(curve, tol=tol)
 
 
@@ -159,14 +135,11 @@ def ruled_surface_data(surface: Any, tol: float | None = None, degree: int = 5, 
     def f(u: np.ndarray) -> np.ndarray:
         return np.hstack([surface.a(u), surface.b(u)])
 
-    try:
-        from ght_cad.bspline import fit_function  # type: ignore[attr-defined]
-    except ImportError:
-        curve = _fallback_fit(f, float(tol))
-    else:
-        order = min(end_order, degree - 1)
-        ends = tuple([np.concatenate([surface.a(e, r)[0], surface.b(e, r)[0]]) for r in range(order + 1)] for e in (0.0, 1.0))
-        curve = fit_function(f, tol=float(tol), degree=degree, end_derivatives=ends)
+    from ght_cad.bspline import fit_function
+
+    order = min(end_order, degree - 1)
+    ends = tuple([np.concatenate([surface.a(e, r)[0], surface.b(e, r)[0]]) for r in range(order + 1)] for e in (0.0, 1.0))
+    curve = fit_function(f, tol=float(tol), degree=degree, end_derivatives=ends)
     poles = np.stack([curve.poles[:, :3], curve.poles[:, 3:]], axis=1)
     return BSplineSurfaceData(
         poles, curve.knots, np.array([0.0, 0.0, 1.0, 1.0]), curve.degree, 1, max_deviation=curve.max_deviation, info=dict(curve.info)

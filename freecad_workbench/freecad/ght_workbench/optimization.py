@@ -20,8 +20,6 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-import numpy as np
-
 import FreeCAD as App
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only

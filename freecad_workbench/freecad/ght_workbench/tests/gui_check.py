@@ -16,10 +16,9 @@ import FreeCAD as App
 import FreeCADGui as Gui
 
 try:
-    from PySide2 import QtCore, QtWidgets
+    from PySide2 import QtCore
 except ImportError:  # pragma: no cover
     from PySide import QtCore  # type: ignore
-    from PySide import QtGui as QtWidgets  # type: ignore
 
 OUT = os.environ.get("GHT_FC_OUT", "/tmp")
 RESULT = {"steps": [], "errors": []}
