@@ -212,10 +212,14 @@ def fit_function(
     span with the end poles fixed by ``end_derivatives`` (a clamped B-spline's first ``r+1``
     poles fix ``C(0), ..., C^(r)(0)``: ``D P_{0..r} = [f(0), ..., f^(r)(0)]`` with the triangular
     matrix ``D[k, j] = N_j^(k)(0)``; likewise at t = 1). The error is then sampled at
-    ``max(16, 4(p+1))`` Chebyshev–Lobatto points per span plus 257 uniform points, each span's
-    worst sample is refined by golden-section search (30 steps), and every span whose error
-    exceeds ``tol`` is split into ``max(2, ceil((e/tol)^{1/(p+1)}))`` equal pieces (the error of a
-    degree-p fit scales as ``h^{p+1}``), until the maximum is ``<= tol``.
+    ``max(16, 4(p+1))`` Chebyshev–Lobatto points per span plus 257 uniform points, and every span
+    whose error exceeds ``tol`` is split into ``max(2, ceil((e/tol)^{1/(p+1)}))`` equal pieces (the
+    error of a degree-p fit scales as ``h^{p+1}``), until the maximum is ``<= tol``. Certification:
+    around each span's worst sample the error is resampled 3 times on 17 points of a bracket that
+    shrinks 8-fold each time, and the maximum must still be ``<= tol``. Pole reduction: up to 4
+    times the breakpoints are re-placed by equidistributing the model ``e_i ≈ c_i h_i^{p+1}`` for
+    a target 0.7 tol (× 0.7 after each failure); a candidate with fewer spans is kept only if it
+    certifies ``<= tol``.
 
     Args:
         func: vectorized map from a 1-D array of parameters (N,) to values (N, d) (or (N,)).
@@ -227,7 +231,7 @@ def fit_function(
 
     Returns:
         :class:`BSplineCurveData` with ``max_deviation`` (the achieved, sampled maximum) and
-        ``info`` = ``{"spans", "samples_checked", "iterations", "end_orders", "tol"}``.
+        ``info`` = ``{"spans", "samples_checked", "iterations", "fits", "end_orders", "tol"}``.
 
     Raises:
         GHTError: bad tol/degree/end_derivatives or a func that returns NaN/inf or bad shapes.
@@ -265,39 +269,33 @@ def fit_function(
     r0, r1 = ends[0].shape[0], ends[1].shape[0]
 
     # start with the fewest spans that leave the two sets of fixed end poles disjoint
-    spans = max(1, r0 + r1 - p)
-    breaks = np.linspace(0.0, 1.0, spans + 1)
+    min_spans = max(1, r0 + r1 - p)
+    state = {"samples": 0, "fits": 0}
     xg, _ = np.polynomial.legendre.leggauss(p + 2)
     xg = 0.5 * (xg + 1.0)
     cheb = _chebyshev_lobatto(max(16, 4 * (p + 1)))
     uniform = np.linspace(0.0, 1.0, 257)
-    golden = 0.5 * (np.sqrt(5.0) - 1.0)
-    samples_checked = 0
-    iterations = 0
-    worst = np.inf
-    while True:
-        iterations += 1
+
+    def fit(breaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Least-squares poles on the breakpoints ``breaks`` with the end poles fixed."""
+        state["fits"] += 1
         knots = clamped_knots(breaks, p)
         n = knots.size - p - 1
         h = np.diff(breaks)
-        # fixed end poles from the end derivatives
         fixed = np.zeros((n, dim))
         is_fixed = np.zeros(n, dtype=bool)
         if r0:
-            D = _end_basis(knots, p, n, 0, r0)
-            fixed[:r0] = np.linalg.solve(D, ends[0])
+            fixed[:r0] = np.linalg.solve(_end_basis(knots, p, n, 0, r0), ends[0])
             is_fixed[:r0] = True
         if r1:
-            D = _end_basis(knots, p, n, 1, r1)
-            fixed[n - r1 :] = np.linalg.solve(D, ends[1])
+            fixed[n - r1 :] = np.linalg.solve(_end_basis(knots, p, n, 1, r1), ends[1])
             is_fixed[n - r1 :] = True
-        # least squares for the free poles
-        ts = (breaks[:-1, None] + h[:, None] * xg[None, :]).ravel()
-        F = _call(func, ts, dim)
-        A = BSpline.design_matrix(ts, knots, p).tocsc()
         poles = fixed.copy()
         free = ~is_fixed
         if free.any():
+            ts = (breaks[:-1, None] + h[:, None] * xg[None, :]).ravel()
+            F = _call(func, ts, dim)
+            A = BSpline.design_matrix(ts, knots, p).tocsc()
             rhs = F - A[:, is_fixed] @ fixed[is_fixed] if is_fixed.any() else F
             Af = A[:, free]
             if Af.shape[1] <= 400:
@@ -305,77 +303,106 @@ def fit_function(
             else:
                 from scipy.sparse.linalg import splu
 
-                M = (Af.T @ Af).tocsc()
-                sol = splu(M).solve(np.asarray(Af.T @ rhs))
+                sol = splu((Af.T @ Af).tocsc()).solve(np.asarray(Af.T @ rhs))
             poles[free] = sol
+        return knots, poles
+
+    def span_errors(breaks: np.ndarray, knots: np.ndarray, poles: np.ndarray, certify: bool) -> np.ndarray:
+        """Max |f - C| per span: Chebyshev–Lobatto + uniform samples, then (certify) zoom-in."""
         sp = BSpline(knots, poles, p, extrapolate=False)
-
-        def err(t: np.ndarray) -> np.ndarray:
-            return np.linalg.norm(_call(func, t, dim) - sp(t), axis=1)
-
-        # dense check: Chebyshev-Lobatto points per span + a uniform grid
-        tc = (breaks[:-1, None] + h[:, None] * cheb[None, :])
-        ec = err(tc.ravel()).reshape(tc.shape)
-        eu = err(uniform)
-        samples_checked += tc.size + uniform.size
+        spans = breaks.size - 1
+        h = np.diff(breaks)
+        tc = breaks[:-1, None] + h[:, None] * cheb[None, :]
+        tt = np.concatenate([tc.ravel(), uniform])
+        e = np.linalg.norm(_call(func, tt, dim) - sp(tt), axis=1)
+        state["samples"] += tt.size
+        ec = e[: tc.size].reshape(tc.shape)
         span_err = ec.max(axis=1)
         su = np.clip(np.searchsorted(breaks, uniform, side="right") - 1, 0, spans - 1)
-        np.maximum.at(span_err, su, eu)
-        if span_err.max() <= tol:
-            # refine each span's worst sample by golden-section search on its neighbouring bracket
+        np.maximum.at(span_err, su, e[tc.size :])
+        if certify:
+            # zoom in on every span's worst sample: 3 rounds of 17 points on a shrinking bracket
             k = ec.argmax(axis=1)
-            lo = tc[np.arange(spans), np.maximum(k - 1, 0)]
-            hi = tc[np.arange(spans), np.minimum(k + 1, cheb.size - 1)]
-            x1 = hi - golden * (hi - lo)
-            x2 = lo + golden * (hi - lo)
-            e1, e2 = err(x1), err(x2)
-            best = np.maximum(e1, e2)
-            for _ in range(30):
-                left = e1 >= e2  # maximum lies in [lo, x2]
-                hi = np.where(left, x2, hi)
-                lo = np.where(left, lo, x1)
-                x2n = np.where(left, x1, lo + golden * (hi - lo))
-                x1n = np.where(left, hi - golden * (hi - lo), x2)
-                xnew = np.where(left, x1n, x2n)
-                enew = err(xnew)
-                e1, e2 = np.where(left, enew, e2), np.where(left, e1, enew)
-                x1, x2 = x1n, x2n
-                best = np.maximum(best, enew)
-            samples_checked += 32 * spans
-            span_err = np.maximum(span_err, best)
-        worst = float(span_err.max())
-        if worst <= tol:
-            break
+            rows = np.arange(spans)
+            lo = tc[rows, np.maximum(k - 1, 0)]
+            hi = tc[rows, np.minimum(k + 1, cheb.size - 1)]
+            grid = np.linspace(0.0, 1.0, 17)
+            for _ in range(3):
+                tz = lo[:, None] + (hi - lo)[:, None] * grid[None, :]
+                ez = np.linalg.norm(_call(func, tz.ravel(), dim) - sp(tz.ravel()), axis=1).reshape(tz.shape)
+                state["samples"] += tz.size
+                span_err = np.maximum(span_err, ez.max(axis=1))
+                j = ez.argmax(axis=1)
+                lo = tz[rows, np.maximum(j - 1, 0)]
+                hi = tz[rows, np.minimum(j + 1, grid.size - 1)]
+        return span_err
+
+    def too_many(spans: int, worst: float) -> ConversionError:
+        return ConversionError(
+            f"B-spline fit did not reach tol={tol:g}: deviation {worst:.3g} with {spans} spans "
+            f"(max_spans={max_spans}); raise tol or max_spans"
+        )
+
+    # 1. refinement: split every span whose error exceeds tol (by the h^(p+1) error model)
+    breaks = np.linspace(0.0, 1.0, min_spans + 1)
+    iterations = 0
+    while True:
+        iterations += 1
+        knots, poles = fit(breaks)
+        span_err = span_errors(breaks, knots, poles, certify=False)
+        if span_err.max() <= tol:
+            span_err = span_errors(breaks, knots, poles, certify=True)
+            if span_err.max() <= tol:
+                break
+        spans = breaks.size - 1
         bad = span_err > tol
         pieces = np.where(bad, np.maximum(2, np.ceil((span_err / tol) ** (1.0 / (p + 1)))), 1).astype(int)
         pieces = np.minimum(pieces, 8)
         if pieces.sum() > max_spans:
-            if spans >= max_spans:
-                raise ConversionError(
-                    f"B-spline fit did not reach tol={tol:g}: deviation {worst:.3g} with {spans} spans "
-                    f"(max_spans={max_spans}); raise tol or max_spans"
-                )
             pieces = np.where(bad, 2, 1)
-            if pieces.sum() > max_spans:
-                raise ConversionError(
-                    f"B-spline fit did not reach tol={tol:g}: deviation {worst:.3g} with {spans} spans "
-                    f"(max_spans={max_spans}); raise tol or max_spans"
-                )
-        new = [breaks[:1]]
-        for i in range(spans):
-            new.append(np.linspace(breaks[i], breaks[i + 1], pieces[i] + 1)[1:])
-        breaks = np.concatenate(new)
-        spans = breaks.size - 1
+            if spans >= max_spans or pieces.sum() > max_spans:
+                raise too_many(spans, float(span_err.max()))
+        breaks = np.concatenate(
+            [breaks[:1]] + [np.linspace(breaks[i], breaks[i + 1], pieces[i] + 1)[1:] for i in range(spans)]
+        )
 
+    # 2. fewer poles: re-place the breakpoints by equidistributing the error model
+    #    e_i ≈ c_i h_i^(p+1) for a target of 0.7 tol (0.5, 0.35 tol if that fails); a candidate is
+    #    accepted only if it has fewer spans and certifies <= tol
+    target = 0.7
+    for _ in range(4):
+        spans = breaks.size - 1
+        if spans <= min_spans:
+            break
+        h = np.diff(breaks)
+        density = (np.maximum(span_err, 1e-300) / (target * tol)) ** (1.0 / (p + 1)) / h
+        cum = np.concatenate([[0.0], np.cumsum(density * h)])
+        count = max(min_spans, int(np.ceil(cum[-1])))
+        if count >= spans:
+            break
+        cand = np.interp(np.linspace(0.0, cum[-1], count + 1), cum, breaks)
+        cand[0], cand[-1] = 0.0, 1.0
+        if np.any(np.diff(cand) <= 0):
+            break
+        c_knots, c_poles = fit(cand)
+        c_err = span_errors(cand, c_knots, c_poles, certify=True)
+        iterations += 1
+        if c_err.max() > tol:
+            target *= 0.7
+            continue
+        breaks, knots, poles, span_err = cand, c_knots, c_poles, c_err
+
+    worst = float(span_err.max())
     return BSplineCurveData(
         poles,
         knots,
         p,
         max_deviation=worst,
         info={
-            "spans": spans,
-            "samples_checked": samples_checked,
+            "spans": breaks.size - 1,
+            "samples_checked": state["samples"],
             "iterations": iterations,
+            "fits": state["fits"],
             "end_orders": (r0 - 1, r1 - 1),
             "tol": tol,
         },
