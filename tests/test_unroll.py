@@ -278,3 +278,57 @@ def test_composite_panels_get_matching_edge_marks() -> None:
         np.testing.assert_allclose(fr, [0.25, 0.5, 0.75], atol=1e-9)
     with pytest.raises(GHTError, match="single-panel"):
         pat.map(0.5, 0.5)
+
+
+def _tangent_developable(P: np.ndarray, v0: float, v1: float) -> FunctionRuledSurface:
+    """X = C + v C' (unnormalized tangent), v in [v0, v1], C a cubic GHT curve: developable."""
+    c = GHTCurve(P, gamma=0.4)
+
+    def side(v):
+        return lambda u, k: c.derivative(u, k) + v * c.derivative(u, k + 1)
+
+    return FunctionRuledSurface(side(v0), side(v1))
+
+
+@settings(max_examples=15)
+@given(
+    P=st.lists(st.tuples(*[st.floats(-3.0, 3.0)] * 3), min_size=4, max_size=4),
+    v0=st.floats(0.05, 0.5),
+    width=st.floats(0.1, 1.0),
+)
+def test_random_tangent_developables_preserve_lengths_and_area(P, v0, width) -> None:
+    """Over a box of cubic spines: boundary, ruling lengths and area preserved to 1e-10."""
+    from hypothesis import assume
+
+    P = np.asarray(P, dtype=float)
+    c = GHTCurve(P, gamma=0.4)
+    t = np.linspace(0.0, 1.0, 201)
+    d1, d2 = c.derivative(t, 1), c.derivative(t, 2)
+    # regular, curved spine (no inflection: the strip would be singular there)
+    sp = np.linalg.norm(d1, axis=1)
+    assume(sp.min() > 0.3)
+    assume((np.linalg.norm(np.cross(d1, d2), axis=1) / sp**3).min() > 0.05)
+    pat = unroll(_tangent_developable(P, v0, v0 + width), rulings=0)
+    e = pat.errors
+    assert e["boundary_length"] < 1e-10 and e["ruling_length"] < 1e-10 and e["area"] < 1e-10, e
+
+
+@settings(max_examples=10)
+@given(angles=st.tuples(*[st.floats(-math.pi, math.pi)] * 3), shift=st.tuples(*[st.floats(-100, 100)] * 3))
+def test_pattern_invariant_under_rigid_motion(angles, shift) -> None:
+    """Unrolling a rotated/translated surface gives a congruent pattern (pairwise distances, 1e-10)."""
+    a, b, g = angles
+    Rz = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+    Ry = np.array([[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]])
+    Rx = np.array([[1, 0, 0], [0, math.cos(g), -math.sin(g)], [0, math.sin(g), math.cos(g)]])
+    R = Rz @ Ry @ Rx
+    P = np.array([(0, 0, 0), (3, 0, 1), (5, 2, 0), (6, 5, 2)], float)
+    s1 = _tangent_developable(P, 0.2, 0.7)
+    s2 = _tangent_developable(P @ R.T + np.asarray(shift), 0.2, 0.7)
+    u = np.linspace(0, 1, 7)
+    U, V = np.meshgrid(u, u)
+    Y1 = unroll(s1, rulings=0).map(U.ravel(), V.ravel())
+    Y2 = unroll(s2, rulings=0).map(U.ravel(), V.ravel())
+    D1 = np.linalg.norm(Y1[:, None] - Y1[None], axis=2)
+    D2 = np.linalg.norm(Y2[:, None] - Y2[None], axis=2)
+    np.testing.assert_allclose(D2, D1, atol=1e-10 * D1.max())
