@@ -49,14 +49,17 @@ def build() -> Any:
 
 
 def main(out_dir: str | Path = "out") -> dict[str, Any]:
-    """Build the transition, export ``duct_transition.step`` (one shell of two faces).
+    """Build the transition, export ``duct_transition.step`` (one shell of two faces) and the
+    flat pattern ``duct_transition_flat.dxf``.
 
     Returns:
-        Report dict: path, validity, face count, θ_max of each face (OCCT normals), normal jump
-        across the shared ruling, the measured joint order.
+        Report dict: paths, validity, face count, θ_max of each face (OCCT normals), normal jump
+        across the shared ruling, the measured joint order, flat-pattern relative errors.
     """
     from ght_cad.cad.developable_faces import face_developability, joint_normal_deviation, shell_faces
     from ght_cad.cad.occ import is_valid, write_step
+
+    from ght_cad import unroll
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -64,8 +67,13 @@ def main(out_dir: str | Path = "out") -> dict[str, Any]:
     shell = duct.to_shell()
     step = write_step(shell, out / "duct_transition.step")
     joint = duct.joints()[0]
+    pattern = unroll(duct.segments, units="m")  # both segments as one flat piece
+    dxf = out / "duct_transition_flat.dxf"
+    pattern.export_dxf(dxf)
     return {
         "step": str(step),
+        "dxf": str(dxf),
+        "flat_errors": dict(pattern.errors),
         "valid": is_valid(shell),
         "faces": len(shell_faces(shell)),
         "theta_max_exact_deg": max(d.theta_max for d in duct.developability()),
