@@ -126,6 +126,7 @@ def test_joint_continuity_survives_in_bspline_edges(continuity):
     wire = ght_wire(cc)
     edges = _edges(wire)
     assert len(edges) == 3 and _valid(wire)
+    assert max(d.max_deviation / d.info["tol"] for d in wire.ght_bspline) <= 1.0
     order = int(continuity[1])
     for j in range(2):
         d = _geom_derivatives(edges[j], 1.0)
@@ -142,6 +143,19 @@ def test_joint_continuity_survives_in_bspline_edges(continuity):
             assert max(res[:order]) <= 1e-9, res
             # and not C1 (k != 1)
             assert np.linalg.norm(e[1] - d[1]) > 1e-3 * np.linalg.norm(d[1])
+
+
+def test_wire_step_round_trip_keeps_length(tmp_path):
+    rng = np.random.default_rng(8)
+    segs = [GHTCurve(rng.normal(size=(m + 1, 3)) + 2 * i, *rng.uniform(-1, 1, 3)) for i, m in enumerate([3, 6, 4, 9])]
+    cc = CompositeCurve(segs, ["G1", "C2", "G3"], k=[0.5, 1.0, 2.0])
+    wire = ght_wire(cc)
+    exact = sum(s.length for s in cc.segments)
+    assert _length(wire) == pytest.approx(exact, rel=1e-6)
+    write_step(wire, tmp_path / "wire.step")
+    back = read_step(tmp_path / "wire.step")
+    assert _valid(back) and len(_edges(back)) == 4
+    assert abs(_length(back) - _length(wire)) <= 1e-9 * _length(wire)
 
 
 def test_closed_g2_glyph_in_builders_has_exact_area(tmp_path):
