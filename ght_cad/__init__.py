@@ -48,6 +48,13 @@ __all__ = [
     "ConversionError",
     "developable_from_planes",
     "unroll",
+    "join",
+    "measure_continuity",
+    "Continuity",
+    "CompositeCurve",
+    "curve_to_bspline",
+    "fit_function",
+    "GHTSurface",
 ]
 
 # Names provided by modules that import scipy or are heavier: loaded on first use so that
@@ -55,6 +62,13 @@ __all__ = [
 _LAZY: dict[str, str] = {
     "developable_from_planes": "ght_cad.developable",
     "unroll": "ght_cad.unroll",
+    "join": "ght_cad.continuity",
+    "measure_continuity": "ght_cad.continuity",
+    "Continuity": "ght_cad.continuity",
+    "CompositeCurve": "ght_cad.composite",
+    "curve_to_bspline": "ght_cad.bspline",
+    "fit_function": "ght_cad.bspline",
+    "GHTSurface": "ght_cad.patch",
 }
 
 

@@ -319,13 +319,27 @@ class GHTCurve:
         return GHTCurve(self._points[::-1], seed=self._seed.reversed())
 
     def with_shape(self, mu: float | None = None, nu: float | None = None, gamma: float | None = None) -> "GHTCurve":
-        """A copy with some shape parameters replaced (control points unchanged)."""
+        """A copy with some shape parameters replaced (control points unchanged).
+
+        GBT(μ, ν) is GHT(μ, ν, -1) and Bernstein is GHT at γ = 1, so curves of those families (and
+        reversed GHT-family seeds) continue in the GHT family, where every parameter is free. A
+        user-registered family keeps its own seed class.
+        """
+        from .seeds import GHTSeed, ReversedSeed, _REGISTRY
+
+        base = self._seed.base if isinstance(self._seed, ReversedSeed) else self._seed
+        family = "ght" if isinstance(base, GHTSeed) or base.name not in _REGISTRY else base.name
+        if isinstance(self._seed, ReversedSeed) and not isinstance(base, GHTSeed):
+            raise GHTError(
+                f"cannot change the shape parameters of a reversed {base.name!r} seed; "
+                "rebuild the curve from its family instead"
+            )
         return GHTCurve(
             self._points,
             self.mu if mu is None else mu,
             self.nu if nu is None else nu,
             self.gamma if gamma is None else gamma,
-            seed=self._seed.name if not type(self._seed).__name__.startswith("Reversed") else "ght",
+            seed=family,
         )
 
     def with_control_points(self, control_points: Any) -> "GHTCurve":

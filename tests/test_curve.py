@@ -127,3 +127,18 @@ def test_dict_round_trip_and_with_shape() -> None:
     assert e.shape_parameters == (-0.5, 0.2, 0.3)
     assert e.degree == c.degree == 3
     assert not c.control_points.flags.writeable
+
+
+def test_with_shape_keeps_geometry_across_families() -> None:
+    """GBT and Bernstein curves continue in the GHT family: the geometry is unchanged, gamma is free."""
+    pts = [(0, 0), (1, 2), (3, 1), (4, 0)]
+    gbt = GHTCurve(pts, 0.3, -0.2, seed="gbt")
+    same = gbt.with_shape()
+    np.testing.assert_allclose(same.evaluate(T), gbt.evaluate(T), atol=1e-15)
+    moved = gbt.with_shape(gamma=0.5)
+    assert moved.gamma == 0.5 and moved.mu == 0.3
+    np.testing.assert_allclose(moved.evaluate(T), GHTCurve(pts, 0.3, -0.2, 0.5).evaluate(T), atol=1e-15)
+    bern = GHTCurve(pts, seed="bernstein").with_shape(gamma=0.0)
+    np.testing.assert_allclose(bern.evaluate(T), GHTCurve(pts, 0, 0, 0).evaluate(T), atol=1e-15)
+    rev = GHTCurve(pts, 0.3, -0.2, 0.1).reversed().with_shape(gamma=0.2)
+    assert rev.shape_parameters == (-0.2, 0.3, 0.2)
