@@ -17,6 +17,7 @@ functions that need them.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import shutil
@@ -711,14 +712,23 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
 # ---------------------------------------------------------------------------------------------
 # optimization
 # ---------------------------------------------------------------------------------------------
+@functools.lru_cache(maxsize=8)
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cached Gauss–Legendre nodes/weights on [0, 1] (numpy's leggauss costs an eigensolve)."""
+    from .curve import gauss_legendre
+
+    t, w = gauss_legendre(n)
+    t.setflags(write=False)
+    w.setflags(write=False)
+    return t, w
+
+
 def dual_curve_objectives(curve: Any, nodes: int = 64) -> dict[str, float]:
     r"""Fairness of a curve (spec section 7) by ``nodes``-point Gauss–Legendre quadrature.
 
     ``AL = ∫|X'|``, ``En = ∫|X''|²``, ``CVEn = ∫|X'''|²`` with analytic derivatives.
     """
-    from .curve import gauss_legendre
-
-    t, w = gauss_legendre(nodes)
+    t, w = _gauss_legendre(nodes)
     d1 = curve.derivative(t, 1)
     d2 = curve.derivative(t, 2)
     d3 = curve.derivative(t, 3)
@@ -779,10 +789,9 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
             return vals[spec.objective]
 
         return f
-    from .curve import gauss_legendre
     from .ruled import developability_from_jets
 
-    t, wq = gauss_legendre(64)
+    t, wq = _gauss_legendre(64)
 
     def g(sh: dict[str, float]) -> float:
         s = _make_surface(design, curves, sh)
