@@ -492,6 +492,33 @@ class EnvelopeDevelopable(RuledSurface):
         """The same envelope restricted to the dual-curve parameters ``t_range``."""
         return EnvelopeDevelopable(self.dual_curve, self.boundary_planes, t_range=t_range)
 
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data: ``{"planes", "boundary_planes", "mu", "nu", "gamma", "seed", "t_range"}``."""
+        c = self.dual_curve
+        return {
+            "planes": c.control_points.tolist(),
+            "boundary_planes": self.boundary_planes.tolist(),
+            "mu": c.mu,
+            "nu": c.nu,
+            "gamma": c.gamma,
+            "seed": c.seed.name,
+            "t_range": list(self.t_range),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "EnvelopeDevelopable":
+        """Inverse of :meth:`to_dict` (the input is validated again)."""
+        curve = GHTCurve.from_dict(
+            {
+                "control_points": data["planes"],
+                "mu": data.get("mu", 0.0),
+                "nu": data.get("nu", 0.0),
+                "gamma": data.get("gamma", 0.0),
+                "seed": data.get("seed", "ght"),
+            }
+        )
+        return cls(curve, data["boundary_planes"], t_range=tuple(data.get("t_range", (0.0, 1.0))))
+
     def __repr__(self) -> str:
         c = self.dual_curve
         return (

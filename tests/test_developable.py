@@ -443,3 +443,13 @@ def test_boundary_jet_and_values_agree_with_a_and_b():
     for r in range(3):
         np.testing.assert_array_equal(J[r], np.hstack([s.a(u, r), s.b(u, r)]))
     np.testing.assert_allclose(s.boundary_values(u), J[0], rtol=0, atol=1e-13)
+
+
+def test_plain_data_round_trip():
+    import json
+
+    s = ship(t_range=(0.1, 0.9))
+    back = EnvelopeDevelopable.from_dict(json.loads(json.dumps(s.to_dict())))
+    u = np.linspace(0, 1, 7)
+    np.testing.assert_array_equal(back.evaluate(u, 0.3), s.evaluate(u, 0.3))
+    assert back.t_range == (0.1, 0.9) and back.dual_curve.shape_parameters == s.dual_curve.shape_parameters
