@@ -879,38 +879,34 @@ class CanalSurface:
         L, M, N = (np.sum(a * n, axis=1) for a in (Xuu, Xuv, Xvv))
         return (L * N - M * M) / (E * G - F * F)
 
-    def kind(self, tol: float = 1e-9) -> str:
+    def kind(self, tol: float = 1e-9, samples: int = 129) -> str:
         """``"cylinder of revolution"``, ``"cone of revolution"`` or ``"not developable"``.
 
-        Structural test on the control data: the centre's control points are collinear and the
-        radius is an affine function of the position along that line at every control point
-        (then r(t) is affine in the position of C(t), as the basis is a partition of unity).
-        Only valid when both curves share the shape parameters.
+        Geometric test on ``samples`` parameters: the centres ``C(t)`` lie on one line (distance
+        ``<= tol L``, L the centre curve's extent) and the radius is an affine function of the
+        position ``s = (C - C(0))·d`` along it, ``r = α + β s`` (residual ``<= tol max(L, r)``); then
+        the spheres envelope a cone of revolution (``β ≠ 0``) or a cylinder (``β = 0``). Works for
+        any parametrizations of the two curves.
         """
-        P = self.center.control_points
-        R = self.radius.control_points[:, 0]
-        if self.center.degree != self.radius.degree or self.center.shape_parameters != self.radius.shape_parameters:
-            same_r = np.allclose(R, R[0], rtol=0, atol=tol * abs(R[0])) and np.allclose(
-                self.radius.control_points, self.radius.control_points[0]
-            )
-            if not same_r:
-                return "not developable"
-        d = P[-1] - P[0]
-        L = float(np.linalg.norm(d))
+        t = np.linspace(0.0, 1.0, samples)
+        C = self.center.evaluate(t)
+        R = self.radius.evaluate(t)[:, 0]
+        ext = C.max(axis=0) - C.min(axis=0)
+        L = float(np.linalg.norm(ext))
         if L == 0.0:
             return "not developable"
-        d /= L
-        off = P - P[0]
-        if np.max(np.linalg.norm(off - np.outer(off @ d, d), axis=1)) > tol * L:
+        i = int(np.argmax(np.linalg.norm(C - C[0], axis=1)))
+        d = (C[i] - C[0]) / np.linalg.norm(C[i] - C[0])
+        off = C - C[0]
+        sp = off @ d
+        if np.max(np.linalg.norm(off - np.outer(sp, d), axis=1)) > tol * L:
             return "not developable"
-        s = off @ d
-        if np.allclose(R, R[0], rtol=0, atol=tol * max(abs(R[0]), L)):
-            return "cylinder of revolution"
-        A = np.column_stack([np.ones_like(s), s])
+        scale = max(L, float(np.abs(R).max()))
+        A = np.column_stack([np.ones_like(sp), sp])
         coef, *_ = np.linalg.lstsq(A, R, rcond=None)
-        if np.max(np.abs(A @ coef - R)) <= tol * max(L, float(np.abs(R).max())):
-            return "cone of revolution"
-        return "not developable"
+        if np.max(np.abs(A @ coef - R)) > tol * scale:
+            return "not developable"
+        return "cylinder of revolution" if abs(coef[1]) * L <= tol * scale else "cone of revolution"
 
     def developability(self, nu: int = 41, nv: int = 24, tol: float = 1e-6) -> CanalReport:
         """Sampled scale-free Gaussian curvature ``K ρ²`` and the structural kind (see :meth:`kind`)."""

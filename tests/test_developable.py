@@ -453,3 +453,17 @@ def test_plain_data_round_trip():
     u = np.linspace(0, 1, 7)
     np.testing.assert_array_equal(back.evaluate(u, 0.3), s.evaluate(u, 0.3))
     assert back.t_range == (0.1, 0.9) and back.dual_curve.shape_parameters == s.dual_curve.shape_parameters
+
+
+def test_canal_cone_with_different_parametrizations_is_recognized():
+    """Centre and radius with different shape parameters and degrees: still a cone of revolution
+    when r is affine in the position along a straight centre line."""
+    centre = GHTCurve([(0, 0, 0), (0, 0, 0.7), (0, 0, 1.3), (0, 0, 2)], mu=0.4, gamma=-0.5)
+    # r = 1 - 0.2 z along the line: evaluate through the centre's own parametrization
+    radius = GHTCurve(1.0 - 0.2 * centre.control_points[:, 2:3], mu=0.4, gamma=-0.5)
+    rep = CanalSurface(centre, radius).developability()
+    assert rep.developable and rep.kind == "cone of revolution"
+    # same curves, but the radius blended with other shape parameters: no longer affine in z
+    other = GHTCurve(radius.control_points, mu=-0.8, gamma=0.9)
+    rep2 = CanalSurface(centre, other).developability()
+    assert not rep2.developable and rep2.k_max > 1e-6
