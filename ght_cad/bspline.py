@@ -419,7 +419,8 @@ def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 
 
     Args:
         curve: the :class:`~ght_cad.curve.GHTCurve` (any dimension).
-        tol: maximum deviation; default ``1e-7 ×`` the diagonal of the curve's bounding box.
+        tol: maximum deviation; default ``1e-7 ×`` the diagonal of the curve's bounding box (at
+            least 64 ulp of the largest control-point coordinate, the rounding floor).
         degree: B-spline degree p (>= 1).
 
     Returns:
@@ -433,7 +434,9 @@ def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 
     if tol is None:
         lo, hi = curve.bounding_box()
         diag = float(np.linalg.norm(hi - lo))
-        tol = 1e-7 * diag if diag > 0 else 1e-12
+        # never below the rounding floor of evaluating the curve (64 ulp of its coordinates)
+        floor = 64.0 * np.finfo(float).eps * max(float(np.abs(curve.control_points).max()), 1e-300)
+        tol = max(1e-7 * diag, floor)
     r = min(3, int(degree) - 1)
     ends = ([curve.derivative(0.0, k) for k in range(r + 1)], [curve.derivative(1.0, k) for k in range(r + 1)])
     out = fit_function(curve.evaluate, tol=tol, degree=int(degree), end_derivatives=ends)

@@ -261,7 +261,8 @@ class GHTSurface:
         if tol is None:
             lo, hi = self.bounding_box()
             diag = float(np.linalg.norm(hi - lo))
-            tol = 1e-7 * diag if diag > 0 else 1e-12
+            rounding = 64.0 * np.finfo(float).eps * max(float(np.abs(P).max()), 1e-300)
+            tol = max(1e-7 * diag, rounding)
         try:
             tol = float(tol)
         except (TypeError, ValueError):

@@ -125,3 +125,21 @@ def test_bad_function_output():
         fit_function(lambda t: np.ones((3, 3, 3)), tol=1e-6)
     with pytest.raises(GHTError, match="NaN"):
         fit_function(lambda t: np.full(t.shape, np.nan), tol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        [(1.0, 1.0, 1.0)] * 4,  # a point: default tol falls back to the rounding floor
+        [(0, 0), (0, 0), (0, 0), (3, -1), (4, 0)],  # vanishing end derivatives
+        np.array([(0, 0, 0), (1, 2, 0), (3, 1, 1)]) + 1e6,  # far from the origin
+        np.array([(0, 0, 0), (1, 2, 0), (3, 1, 1)]) * 1e-9,  # tiny
+    ],
+)
+def test_degenerate_and_badly_scaled_curves_convert(points):
+    curve = GHTCurve(points, 0.2, 0.1, -0.5)
+    bs = curve_to_bspline(curve)
+    assert bs.max_deviation <= bs.info["tol"]
+    assert _independent_deviation(curve, bs) <= bs.info["tol"]
+    scale = float(np.abs(curve.control_points).max())
+    assert bs.info["tol"] >= 64 * np.finfo(float).eps * scale
