@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("OCP")
 pytest.importorskip("build123d")
@@ -224,3 +226,18 @@ def test_bad_input_messages(ship):
         developable_surface_data([1, 2])
     with pytest.raises(GHTError, match=r"needs exactly one face; the shape has 6"):
         face_developability(bd.Solid.make_box(1, 1, 1))
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1))
+@settings(max_examples=6)
+def test_faces_of_perturbed_designs_stay_developable(seed, mu, nu, gamma):
+    """Random perturbations of the ship planes (when they give a usable strip): θ_max of the face,
+    measured with OCCT normals, stays within 0.01°."""
+    rng = np.random.default_rng(seed)
+    P = np.array(SHIP) + rng.normal(scale=0.05, size=(4, 4))
+    try:
+        s = developable_from_planes(P, FRAMES, mu, nu, gamma)
+    except GHTError:
+        assume(False)
+    assert s.developability().theta_max <= 1e-9
+    assert face_developability(s.to_face()).theta_max <= THETA_FACE_DEG
