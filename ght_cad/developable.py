@@ -205,6 +205,19 @@ class EnvelopeDevelopable(RuledSurface):
 
     Use :func:`developable_from_planes` to build one (it validates the input).
 
+    Args:
+        planes: (m+1, 4) control planes, or a 4-D :class:`GHTCurve` of planes (then mu, nu, gamma
+            and normalize must be left at their defaults).
+        boundary_planes: ``(E_a, E_b)``.
+        mu, nu, gamma: shape parameters of the dual curve.
+        t_range: kept dual-curve parameter range (trimming).
+        normalize: rescale the control planes to unit normals first.
+        check: run :meth:`check` (skip only for inputs known to be valid, e.g. inside optimizers).
+        samples: parameters sampled by :meth:`check`.
+
+    Raises:
+        See :func:`developable_from_planes`.
+
     Attributes:
         dual_curve: the 4-D GHT curve of planes ``U(t)``.
         boundary_planes: ``(E_a, E_b)`` as a (2, 4) array.
