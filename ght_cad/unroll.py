@@ -39,6 +39,8 @@ from .ruled import RuledSurface
 __all__ = [
     "unroll",
     "unroll_composite",
+    "unroll_ruled",
+    "ruled_area",
     "RuledDevelopment",
     "DEFAULT_TOL_DEG",
 ]
@@ -342,7 +344,23 @@ def unroll_ruled(
     label: str = "P1",
     breakpoints: Sequence[float] = (),
 ) -> FlatPattern:
-    """Unroll a :class:`~ght_cad.ruled.RuledSurface` (see :func:`unroll`)."""
+    r"""Unroll a :class:`~ght_cad.ruled.RuledSurface` by quadrature along its rulings.
+
+    ``Y(u, v) = A(u) + v |g(u)| D(u)`` with ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥`` (module
+    doc); the panel's outline is a(u), the ruling u = 1, b(u) reversed and the ruling u = 0.
+
+    Args:
+        surface: the ruled surface (u, v ∈ [0, 1]).
+        best_effort, tol_deg, rulings, samples, units, label: as in :func:`unroll`.
+        breakpoints: parameters where a, b are not smooth (B-spline knots).
+
+    Returns:
+        Single-panel FlatPattern; ``pattern.map(u, v)`` is the development map.
+
+    Raises:
+        NotDevelopableError: ``θ_max > tol_deg`` and not best_effort (message: θ_max, θ_rms, DD).
+        DegenerateGeometryError: a zero-length ruling or a directrix tangent to a ruling.
+    """
     dd = _check_developable(surface, tol_deg, best_effort, f"surface {label!r}")
     dev = RuledDevelopment(surface, breakpoints=breakpoints)
     edges = _ruled_edges(surface, dev, samples)
