@@ -307,8 +307,8 @@ def fit_function(
             poles[free] = sol
         return knots, poles
 
-    def span_errors(breaks: np.ndarray, knots: np.ndarray, poles: np.ndarray, certify: bool) -> np.ndarray:
-        """Max |f - C| per span: Chebyshev–Lobatto + uniform samples, then (certify) zoom-in."""
+    def span_errors(breaks: np.ndarray, knots: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, Any]:
+        """Max |f - C| per span on Chebyshev–Lobatto + uniform samples (and what zoom() needs)."""
         sp = BSpline(knots, poles, p, extrapolate=False)
         spans = breaks.size - 1
         h = np.diff(breaks)
@@ -320,22 +320,27 @@ def fit_function(
         span_err = ec.max(axis=1)
         su = np.clip(np.searchsorted(breaks, uniform, side="right") - 1, 0, spans - 1)
         np.maximum.at(span_err, su, e[tc.size :])
-        if certify:
-            # zoom in on every span's worst sample: 3 rounds of 17 points on a shrinking bracket
-            k = ec.argmax(axis=1)
-            rows = np.arange(spans)
-            lo = tc[rows, np.maximum(k - 1, 0)]
-            hi = tc[rows, np.minimum(k + 1, cheb.size - 1)]
-            grid = np.linspace(0.0, 1.0, 17)
-            for _ in range(3):
-                tz = lo[:, None] + (hi - lo)[:, None] * grid[None, :]
-                ez = np.linalg.norm(_call(func, tz.ravel(), dim) - sp(tz.ravel()), axis=1).reshape(tz.shape)
-                state["samples"] += tz.size
-                span_err = np.maximum(span_err, ez.max(axis=1))
-                j = ez.argmax(axis=1)
-                lo = tz[rows, np.maximum(j - 1, 0)]
-                hi = tz[rows, np.minimum(j + 1, grid.size - 1)]
-        return span_err
+        return span_err, (sp, tc, ec)
+
+    def zoom(span_err: np.ndarray, ctx: Any) -> np.ndarray:
+        """Certify: around every span's worst sample, 3 rounds of 17 points on a shrinking bracket."""
+        sp, tc, ec = ctx
+        spans = tc.shape[0]
+        k = ec.argmax(axis=1)
+        rows = np.arange(spans)
+        lo = tc[rows, np.maximum(k - 1, 0)]
+        hi = tc[rows, np.minimum(k + 1, cheb.size - 1)]
+        grid = np.linspace(0.0, 1.0, 17)
+        out = span_err.copy()
+        for _ in range(3):
+            tz = lo[:, None] + (hi - lo)[:, None] * grid[None, :]
+            ez = np.linalg.norm(_call(func, tz.ravel(), dim) - sp(tz.ravel()), axis=1).reshape(tz.shape)
+            state["samples"] += tz.size
+            out = np.maximum(out, ez.max(axis=1))
+            j = ez.argmax(axis=1)
+            lo = tz[rows, np.maximum(j - 1, 0)]
+            hi = tz[rows, np.minimum(j + 1, grid.size - 1)]
+        return out
 
     def too_many(spans: int, worst: float) -> ConversionError:
         return ConversionError(
@@ -349,9 +354,9 @@ def fit_function(
     while True:
         iterations += 1
         knots, poles = fit(breaks)
-        span_err = span_errors(breaks, knots, poles, certify=False)
+        span_err, ctx = span_errors(breaks, knots, poles)
         if span_err.max() <= tol:
-            span_err = span_errors(breaks, knots, poles, certify=True)
+            span_err = zoom(span_err, ctx)
             if span_err.max() <= tol:
                 break
         spans = breaks.size - 1
@@ -367,8 +372,11 @@ def fit_function(
         )
 
     # 2. fewer poles: re-place the breakpoints by equidistributing the error model
-    #    e_i ≈ c_i h_i^(p+1) for a target of 0.7 tol (0.5, 0.35 tol if that fails); a candidate is
-    #    accepted only if it has fewer spans and certifies <= tol
+    #    e_i ≈ c_i h_i^(p+1) for a target of 0.7 tol (× 0.7 after a failure); a candidate is
+    #    accepted if it has fewer spans and its samples are <= tol; the last accepted one is
+    #    certified (zoom) at the end, falling back to the certified refinement result
+    certified = (breaks, knots, poles, span_err)
+    ctx = None
     target = 0.7
     for _ in range(4):
         spans = breaks.size - 1
@@ -385,12 +393,16 @@ def fit_function(
         if np.any(np.diff(cand) <= 0):
             break
         c_knots, c_poles = fit(cand)
-        c_err = span_errors(cand, c_knots, c_poles, certify=True)
+        c_err, c_ctx = span_errors(cand, c_knots, c_poles)
         iterations += 1
         if c_err.max() > tol:
             target *= 0.7
             continue
-        breaks, knots, poles, span_err = cand, c_knots, c_poles, c_err
+        breaks, knots, poles, span_err, ctx = cand, c_knots, c_poles, c_err, c_ctx
+    if ctx is not None:
+        span_err = zoom(span_err, ctx)
+        if span_err.max() > tol:
+            breaks, knots, poles, span_err = certified
 
     worst = float(span_err.max())
     return BSplineCurveData(
