@@ -658,10 +658,7 @@ class FlatPattern:
 
     def plot_png(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
         """PNG preview (matplotlib Agg): outline, dashed bend lines, marks, labels, error summary."""
-        import matplotlib
-
-        matplotlib.use("Agg", force=False)
-        from matplotlib.figure import Figure
+        from matplotlib.figure import Figure  # object API: no pyplot, no global backend switch
 
         fig = Figure(figsize=(8, 6))
         ax = fig.add_subplot(111)
