@@ -467,3 +467,18 @@ def test_canal_cone_with_different_parametrizations_is_recognized():
     other = GHTCurve(radius.control_points, mu=-0.8, gamma=0.9)
     rep2 = CanalSurface(centre, other).developability()
     assert not rep2.developable and rep2.k_max > 1e-6
+
+
+def test_bspline_data_in_the_core_keeps_rulings_paired():
+    """developable_bspline needs no CAD kernel: degree 1 across, pole pairs on matched parameters."""
+    from ght_cad.developable import developable_bspline
+
+    s = ship()
+    data = developable_bspline(s)
+    assert data.degree_v == 1 and list(data.knots_v) == [0, 0, 1, 1] and data.poles.shape[1] == 2
+    u = np.linspace(0, 1, 41)
+    for v, side in ((0.0, s.a), (1.0, s.b)):
+        assert np.abs(data.evaluate(u, v) - side(u)).max() <= 1.01 * data.max_deviation
+    assert data.max_deviation <= 1e-7 * data.info["size"]
+    with pytest.raises(GHTError, match=r"end_order=3 is not allowed; use 0, 1 or 2"):
+        developable_bspline(s, end_order=3)

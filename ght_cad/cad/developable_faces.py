@@ -32,7 +32,8 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-from ..bspline import BSplineSurfaceData, fit_function
+from ..bspline import BSplineSurfaceData
+from ..developable import _size, developable_bspline
 from ..errors import ConversionError, GHTError
 from ..ruled import RuledSurface
 from .occ import is_valid, make_face, unwrap
@@ -77,68 +78,11 @@ def planes_from_build123d(plane_or_face: Any) -> np.ndarray:
     return np.concatenate([[-float(n @ o)], n])
 
 
-def _size(surface: RuledSurface) -> float:
-    g = surface.grid(33, 3).reshape(-1, 3)
-    return float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
-
-
 def developable_surface_data(
     surface: RuledSurface, *, tol: float | None = None, degree: int = 5, end_order: int = 2
 ) -> BSplineSurfaceData:
-    r"""B-spline surface data of a ruled strip from compatible directrix poles.
-
-    ``f(u) = (a(u), b(u)) ∈ R^6`` is fitted by :func:`ght_cad.bspline.fit_function` with
-    ``max_u |f(u) - F(u)| <= tol`` at matched parameters and exact end derivatives up to
-    ``end_order``; poles ``F_i = (A_i, B_i)`` give the net ``P[i, 0] = A_i``, ``P[i, 1] = B_i`` with
-    ``degree_v = 1``, ``knots_v = [0, 0, 1, 1]``, so ``S(u, v) = (1-v) A(u) + v B(u)``.
-
-    Args:
-        surface: any :class:`~ght_cad.ruled.RuledSurface`.
-        tol: absolute deviation bound; default ``1e-7`` times the bounding-box diagonal.
-        degree: B-spline degree in u (>= 3 recommended).
-        end_order: highest end derivative reproduced exactly (0..2).
-
-    Returns:
-        :class:`~ght_cad.bspline.BSplineSurfaceData` with ``max_deviation`` and ``info``.
-
-    Raises:
-        ConversionError: the fit could not reach ``tol``.
-    """
-    if not isinstance(surface, RuledSurface):
-        raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")
-    if end_order not in (0, 1, 2):
-        raise GHTError(f"end_order={end_order!r} is not allowed; use 0, 1 or 2")
-    size = _size(surface)
-    if tol is None:
-        tol = 1e-7 * max(size, 1e-300)
-    tol = float(tol)
-    if not (math.isfinite(tol) and tol > 0):
-        raise GHTError(f"tol={tol!r} must be a positive finite number")
-
-    fast = getattr(surface, "boundary_values", None)
-
-    def f(u: np.ndarray) -> np.ndarray:
-        return fast(u) if fast is not None else np.hstack([surface.a(u), surface.b(u)])
-
-    top = min(end_order, degree - 1)
-    jet = getattr(surface, "boundary_jet", None)
-    if jet is not None:
-        J = jet(np.array([0.0, 1.0]), top)
-        ends = tuple([J[r][e] for r in range(top + 1)] for e in (0, 1))
-    else:
-        ends = tuple(
-            [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(top + 1)]
-            for e in (0.0, 1.0)
-        )
-    try:
-        curve = fit_function(f, tol=tol, degree=degree, end_derivatives=ends)
-    except ConversionError as exc:
-        raise ConversionError(f"could not fit the boundary curves of {surface!r} to tol={tol:g}: {exc}") from exc
-    poles = np.stack([curve.poles[:, :3], curve.poles[:, 3:]], axis=1)
-    info = dict(curve.info)
-    info["size"] = size
-    return BSplineSurfaceData(poles, curve.knots, np.array([0.0, 0.0, 1.0, 1.0]), curve.degree, 1,
-                              max_deviation=curve.max_deviation, info=info)
+    """Alias of :func:`ght_cad.developable.developable_bspline` (core, no CAD kernel needed)."""
+    return developable_bspline(surface, tol=tol, degree=degree, end_order=end_order)
 
 
 def developable_face(surface: RuledSurface, *, tol: float | None = None, degree: int = 5, end_order: int = 2) -> Any:
