@@ -22,7 +22,7 @@ from OCP.TopTools import TopTools_IndexedMapOfShape  # noqa: E402
 from OCP.TopoDS import TopoDS  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
-from ght_cad.cad.curves import GHTBezierLine, GHTCompositeLine, exact_edges, ght_edge, ght_face, ght_wire  # noqa: E402
+from ght_cad.cad.curves import GHTBezierLine, GHTCompositeLine, exact_edges, export_step, ght_edge, ght_face, ght_shape, ght_wire  # noqa: E402
 from ght_cad.cad.occ import read_step, write_step  # noqa: E402
 from ght_cad.composite import CompositeCurve  # noqa: E402
 from ght_cad.curve import gauss_legendre  # noqa: E402
@@ -291,6 +291,26 @@ def test_step_export_is_quiet_and_atomic(tmp_path, capfd):
     with pytest.raises(OSError):
         write_step(edge, bad / "x.step")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file_not_dir", "quiet.step"]
+
+
+def test_export_step_of_mixed_ght_objects(tmp_path):
+    from OCP.TopAbs import TopAbs_FACE
+
+    rng = np.random.default_rng(2)
+    curve = GHTCurve(rng.normal(size=(5, 3)), 0.1, 0.2, 0.3)
+    chain = CompositeCurve([GHTCurve(rng.normal(size=(4, 3))), GHTCurve(rng.normal(size=(6, 3)))], "G2", k=1.3)
+    patch = GHTSurface(rng.normal(size=(4, 3, 3)), 0.5, 0.0, -0.5, 0.0, 0.3, 0.0)
+    path = export_step([curve, chain, patch], tmp_path / "mixed.step")
+    back = read_step(path)
+    assert _valid(back)
+    fmap = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(back, TopAbs_FACE, fmap)
+    assert fmap.Extent() == 1
+    assert len(_edges(back)) == 1 + 2 + 4
+    expected = _length(ght_shape(curve)) + _length(ght_shape(chain)) + _length(ght_face(patch))
+    assert _length(back) == pytest.approx(expected, rel=1e-9)
+    with pytest.raises(GHTError, match="cannot make a CAD shape"):
+        ght_shape(3.0)
 
 
 def test_adapter_errors():

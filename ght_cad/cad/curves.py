@@ -48,6 +48,8 @@ __all__ = [
     "GHTBezierLine",
     "GHTCompositeLine",
     "exact_edges",
+    "ght_shape",
+    "export_step",
 ]
 
 
@@ -249,6 +251,48 @@ def ght_face(patch: GHTSurface, tol: float | None = None, degree: int = 5) -> Fa
     face = make_face(data)
     face.ght_bspline = data
     return face
+
+
+def ght_shape(obj: Any, tol: float | None = None, degree: int = 5) -> Any:
+    """The CAD shape of a ght_cad object: GHTCurve → Edge, CompositeCurve or list of curves →
+    Wire, GHTSurface → Face; build123d/cadquery/OCP shapes are returned unchanged.
+
+    Raises:
+        GHTError: an object of another type.
+    """
+    if isinstance(obj, GHTCurve):
+        return ght_edge(obj, tol, degree)
+    if isinstance(obj, GHTSurface):
+        return ght_face(obj, tol, degree)
+    if hasattr(obj, "wrapped") or type(obj).__module__.startswith("OCP"):
+        return obj
+    if hasattr(obj, "segments") or isinstance(obj, (list, tuple)):
+        return ght_wire(obj, tol, degree)
+    raise GHTError(
+        f"cannot make a CAD shape from a {type(obj).__name__}; expected GHTCurve, CompositeCurve, "
+        "a list of GHTCurves, GHTSurface or a build123d/cadquery/OCP shape"
+    )
+
+
+def export_step(objects: Any, path: Any, tol: float | None = None, degree: int = 5) -> str:
+    """Write GHT curves, composite curves, patches and/or CAD shapes to one STEP file, atomically.
+
+    Each object goes through :func:`ght_shape` (certified B-splines), then
+    :func:`ght_cad.cad.occ.write_step` (validity check, quiet OCCT, atomic write).
+
+    Args:
+        objects: one object or a list of them (a list of GHTCurves counts as several edges; wrap
+            it in a CompositeCurve or a tuple inside the list to get one wire).
+        path: target file.
+        tol, degree: conversion tolerance and B-spline degree.
+
+    Returns:
+        The path written.
+    """
+    from .occ import write_step
+
+    items = list(objects) if isinstance(objects, list) else [objects]
+    return write_step([ght_shape(o, tol, degree) for o in items], path)
 
 
 def _points(pts: Sequence[Any]) -> np.ndarray:
