@@ -391,7 +391,7 @@ class EnvelopeDevelopable(RuledSurface):
             raise DegenerateGeometryError(
                 f"at u={u[i]:.6g} (t={t:.6g}) the dual curve's plane U={_fmt(U[0][i])} and its derivative "
                 f"U'={_fmt(U[1][i])} have parallel normals, so the ruling U ∩ U' is at infinity; "
-                "the control planes must turn (neighbouring planes must not be parallel)" + self._orientation_hint()
+                "the planes' normals must keep turning (no parallel neighbours, no turning back)" + self._orientation_hint()
             )
         dunit = d / dn[:, None]
         names = ("E_a", "E_b")

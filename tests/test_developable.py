@@ -188,6 +188,12 @@ def test_parallel_neighbour_control_planes():
         developable_from_planes([(-1, 1, 0, 0), (-2, 1, 1, 0), (np.nan, 0, 1, 0)], FRAMES)
 
 
+def test_dual_curve_whose_normals_stop_turning():
+    # normals turn from x towards y and back: at t = 1/2 U' has no normal part, the ruling is at infinity
+    with pytest.raises(DegenerateGeometryError, match=r"at u=0.5 \(t=0.5\) the dual curve's plane U=.* and its derivative U'=.* have parallel normals.*no turning back"):
+        developable_from_planes([(0, 1, 0, 0), (-1, 1, 1, 0), (-2, 1, 0, 0)], [(0, 0, 0, 1), (-1, 0, 0, 1)])
+
+
 def test_boundary_plane_containing_a_ruling():
     # y = 0 contains the ruling x = r, y = 0 of the cylinder at t = 0
     with pytest.raises(DegenerateGeometryError, match=r"boundary plane E_a=.* contains the ruling at u=0 \(t=0\)"):
