@@ -86,7 +86,8 @@ def test_features_inside_freecadcmd(tmp_path: Path) -> None:
         assert name in out, f"{name} did not run:\n{_summary(proc)}"
     ran = re.search(r"Ran (\d+) tests?", out)
     assert ran and int(ran.group(1)) >= 16, _summary(proc)
-    assert re.search(r"\nOK\s*$", out) and "skipped=" not in out, _summary(proc)
+    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), _summary(proc)
+    assert "skipped=" not in out, _summary(proc)
     for f in ("curve.step", "composite.step", "developable.step", "flat.step", "flat.dxf", "flat.svg"):
         assert (tmp_path / f).stat().st_size > 0, f
     # the files FreeCAD wrote are read by the project's other tools: ezdxf (DXF) and OCP 7.9 (STEP)
