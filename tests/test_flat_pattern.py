@@ -45,6 +45,7 @@ def test_errors_and_report(pattern: FlatPattern) -> None:
 def test_dxf_reread(pattern: FlatPattern, tmp_path) -> None:
     path = pattern.export_dxf(tmp_path / "p.dxf")
     doc = ezdxf.readfile(path)
+    assert not doc.audit().has_errors
     names = {layer.dxf.name for layer in doc.layers}
     assert {"OUTLINE", "BEND", "LABELS"} <= names
     assert doc.header["$INSUNITS"] == 4  # mm
@@ -170,6 +171,7 @@ def test_dxf_r12_fallback_without_ezdxf(pattern: FlatPattern, tmp_path, monkeypa
     path = pattern.export_dxf(tmp_path / "r12.dxf")
     monkeypatch.undo()
     doc = ezdxf.readfile(path)
+    assert not doc.audit().has_errors
     assert doc.dxfversion == "AC1009"
     assert {"OUTLINE", "BEND", "LABELS"} <= {layer.dxf.name for layer in doc.layers}
     assert doc.header["$INSUNITS"] == 4

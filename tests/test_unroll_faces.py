@@ -25,6 +25,21 @@ def _face(shape, kind):
     return next(f for f in shape.faces() if f.geom_type == kind)
 
 
+def _length(edge) -> float:
+    """Arc length of an edge by adaptive quadrature of |c'| (scipy, relative 1e-13)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    c = BRepAdaptor_Curve(edge.wrapped)
+    p, v = gp_Pnt(), gp_Vec()
+
+    def speed(t: float) -> float:
+        c.D1(t, p, v)
+        return v.Magnitude()
+
+    return quad(speed, c.FirstParameter(), c.LastParameter(), epsabs=0, epsrel=1e-13, limit=400)[0]
+
+
 def _edge_lengths(pat):
     return [(e.length_3d, e.length_flat) for lp in pat.panels[0].loops for e in lp]
 
@@ -76,7 +91,7 @@ def test_extrusion_face_is_rectangle() -> None:
     f = bd.Face.extrude(edge, (0, 0, 2.5))
     assert f.geom_type == bd.GeomType.EXTRUSION
     pat = unroll(f, rulings=4)
-    L = edge.length
+    L = _length(edge)
     np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [L, 2.5], rtol=RTOL)
     assert pat.area == pytest.approx(2.5 * L, rel=RTOL)
     assert pat.panels[0].info["method"].startswith("quadrature")
@@ -219,3 +234,27 @@ def test_shell_gives_one_panel_per_face() -> None:
     marks = [t[2] for t in pat.labels if t[2].startswith("E")]
     assert len(set(marks)) == 12 and len(marks) == 24
     np.testing.assert_allclose(pat.area, 2 * (2 + 3 + 6), rtol=1e-12)
+
+
+def test_bezier_and_rational_bezier_faces() -> None:
+    """Bézier ruled faces (rulings along u here): a general cylinder on a cubic, and a rational
+    one on a weighted cubic (the rulings are lines but v is not affine along them) -> rectangles."""
+    row = np.array([(0, 0, 0), (1, 0, 1), (2, 0, 0), (3, 0, 1)], float)
+    shift = np.array([0.0, 2.0, 0.0])
+    pts = [[tuple(p) for p in row], [tuple(p + shift) for p in row]]
+    for weights in (None, [[1.0, 2.0, 0.5, 1.0], [1.0, 2.0, 0.5, 1.0]]):
+        f = bd.Face.make_bezier_surface(pts, weights=weights)
+        assert f.geom_type == bd.GeomType.BEZIER
+        assert face_ruling_direction(f)[0] == "u"
+        pat = unroll(f)
+        width = _length(next(e for e in f.edges() if abs(e.length - 2.0) > 1e-6))
+        np.testing.assert_allclose(np.sort(np.ptp(pat.outlines[0], axis=0)), np.sort([width, 2.0]), rtol=RTOL)
+        assert pat.errors["max"] < 1e-10
+
+
+def test_cadquery_face() -> None:
+    import cadquery as cq
+
+    face = next(f for f in cq.Workplane().cylinder(5.0, 2.0).val().Faces() if f.geomType() == "CYLINDER")
+    pat = unroll(face)
+    assert pat.area == pytest.approx(2 * math.pi * 2.0 * 5.0, rel=RTOL)
