@@ -38,6 +38,7 @@ from ..ruled import CurvePairRuledSurface, FunctionRuledSurface, RuledSurface
 __all__ = [
     "ght_seed_jets",
     "population_basis",
+    "PopulationBasis",
     "Problem",
     "StripProblem",
     "FairnessProblem",
@@ -111,18 +112,43 @@ def population_basis(
     ``b^{(r)}_{i,m} = Σ_{s=0..r} C(r,s) Σ_{k=0..2} B^{(r-s)}_{i-k,n} f_k^{(s)}``, ``n = m-2``
     (spec section 2), equal to :func:`ght_cad.basis` row by row.
     """
-    t = np.asarray(t, dtype=float)
-    n = degree - 2
-    P = np.asarray(mu).shape[0]
-    out = np.zeros((P, t.size, degree + 1))
-    for s in range(derivative + 1):
-        f0, f2 = ght_seed_jets(t, mu, nu, gamma, s)
-        f1 = (1.0 if s == 0 else 0.0) - f0 - f2
-        B = bernstein(t, n, derivative - s)[None, :, :]
-        c = float(comb(derivative, s))
-        for k, fk in enumerate((f0, f1, f2)):
-            out[:, :, k : k + n + 1] += c * B * fk[:, :, None]
-    return out
+    return PopulationBasis(t, degree)(mu, nu, gamma, (derivative,))[derivative]
+
+
+class PopulationBasis:
+    """Cached :func:`population_basis` on fixed nodes: Bernstein matrices are computed once,
+    seed jets once per call and order.
+
+    Args:
+        t: nodes (N,).
+        degree: basis degree m >= 2.
+    """
+
+    def __init__(self, t: Any, degree: int) -> None:
+        self.t = np.asarray(t, dtype=float)
+        self.degree = int(degree)
+        n = self.degree - 2
+        self._bern = [bernstein(self.t, n, q) for q in range(4)]
+
+    def __call__(self, mu: Any, nu: Any, gamma: Any, orders: Sequence[int]) -> dict[int, np.ndarray]:
+        """``{r: b^{(r)}}`` for the requested orders, each (P, N, m+1)."""
+        top = max(orders)
+        n = self.degree - 2
+        jets = []
+        for s in range(top + 1):
+            f0, f2 = ght_seed_jets(self.t, mu, nu, gamma, s)
+            jets.append((f0, (1.0 if s == 0 else 0.0) - f0 - f2, f2))
+        P = jets[0][0].shape[0]
+        out = {}
+        for r in orders:
+            b = np.zeros((P, self.t.size, self.degree + 1))
+            for s in range(r + 1):
+                B = self._bern[r - s][None, :, :]
+                c = float(comb(r, s))
+                for k, fk in enumerate(jets[s]):
+                    b[:, :, k : k + n + 1] += (c * fk)[:, :, None] * B
+            out[r] = b
+        return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -282,15 +308,16 @@ class StripProblem(Problem):
         super().__init__(names, list(curve_a.shape_parameters) + list(curve_b.shape_parameters), free, bounds)
         self.curve_a, self.curve_b = curve_a, curve_b
         self.t, self.w = gauss_legendre(int(nodes))
+        self._basis = (PopulationBasis(self.t, curve_a.degree), PopulationBasis(self.t, curve_b.degree))
 
     def jets(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``A, A', B, B'`` at the nodes for full parameter rows F: each (pop, N, 3)."""
         out = []
-        for k, c in ((0, self.curve_a), (3, self.curve_b)):
+        for k, c, pb in ((0, self.curve_a, self._basis[0]), (3, self.curve_b, self._basis[1])):
             mu, nu, ga = _split(F, k)
+            Bm = pb(mu, nu, ga, (0, 1))
             for r in (0, 1):
-                Bm = population_basis(self.t, c.degree, mu, nu, ga, r)
-                out.append(np.einsum("pnj,jd->pnd", Bm, c.control_points))
+                out.append(Bm[r] @ c.control_points)
         return out[0], out[1], out[2], out[3]
 
     def evaluate_full(self, F: np.ndarray) -> np.ndarray:
@@ -362,6 +389,7 @@ class FairnessProblem(Problem):
         self.weights = _weights(objective)
         self.objective = objective
         self.t, self.w = gauss_legendre(int(nodes))
+        self._basis = PopulationBasis(self.t, self.degree)
 
     def control_points_for(self, F: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         """Control points per parameter row, (pop, m+1, dim) or (m+1, dim) if fixed."""
@@ -376,8 +404,9 @@ class FairnessProblem(Problem):
         P = self.control_points_for(F)
         spec = "pnj,jd->pnd" if P.ndim == 2 else "pnj,pjd->pnd"
         out = np.empty((F.shape[0], 3))
+        Bm = self._basis(mu, nu, ga, (1, 2, 3))
         for r in (1, 2, 3):
-            D = np.einsum(spec, population_basis(self.t, self.degree, mu, nu, ga, r), P)
+            D = np.einsum(spec, Bm[r], P) if P.ndim == 3 else Bm[r] @ P
             sq = np.sum(D * D, axis=-1)
             out[:, r - 1] = (np.sqrt(sq) if r == 1 else sq) @ self.w
         return np.where(np.isfinite(out), out, np.inf)
