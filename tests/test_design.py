@@ -216,3 +216,25 @@ def test_embedded_default_design_validates() -> None:
     assert d.surface.type == "planes" and d.optimize is not None and len(d.joins) == 1
     assert set(d.outputs.files) == {"step", "dxf", "svg", "json", "md"}
     assert set(d.outputs.figures) == {"basis", "curve", "curvature", "surface", "flat_pattern", "convergence"}
+
+
+from hypothesis import given
+from hypothesis import strategies as st
+
+
+@given(
+    key=st.sampled_from(["mu", "nu", "gamma"]),
+    value=st.one_of(
+        st.floats(min_value=-1.0, max_value=1.0),
+        st.floats(min_value=1.0, exclude_min=True, max_value=1e6),
+        st.floats(max_value=-1.0, exclude_max=True, min_value=-1e6),
+    ),
+)
+def test_shape_parameter_range_is_exactly_the_box(key: str, value: float) -> None:
+    """Every value in [-1, 1] is accepted as given; every value outside is an error naming the key."""
+    data = {"curves": [{"name": "c", "control_points": [[0, 0], [1, 1], [2, 0]], key: value}]}
+    if -1.0 <= value <= 1.0:
+        assert getattr(parse_design(data, "p.toml").curves[0], key) == value
+    else:
+        with pytest.raises(DesignError, match=rf"p\.toml: key 'curves\[0\]\.{key}': .* out of range; allowed: in \[-1, 1\]"):
+            parse_design(data, "p.toml")

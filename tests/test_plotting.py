@@ -102,3 +102,15 @@ def test_failed_plot_keeps_existing_file(tmp_path: Path, monkeypatch: pytest.Mon
         plot_curve(GHTCurve([(0, 0), (1, 1), (2, 0)]), target)
     assert target.read_bytes() == b"old"
     no_leftovers(tmp_path)
+
+
+def test_joined_curves_in_one_figure(tmp_path: Path) -> None:
+    from ght_cad.continuity import join
+
+    a = GHTCurve([(0, 0, 0), (1, 2, 0), (3, 2, 1), (4, 0, 1)], gamma=-0.5)
+    b = join(a, "G2", GHTCurve([(0, 0, 0), (0, 0, 0), (0, 0, 0), (7, 1, 2)], mu=0.2))
+    assert png_size(plot_curve([a, b], tmp_path / "c.png")) == SIZES["curve"]
+    assert png_size(plot_curvature([a, b], tmp_path / "k.png")) == SIZES["curvature"]
+    with pytest.raises(GHTError, match="no curve"):
+        plot_curve([], tmp_path / "x.png")
+    assert not (tmp_path / "x.png").exists()
