@@ -600,8 +600,24 @@ def _size(surface: RuledSurface) -> float:
     return float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
 
 
+def _bspline_theta(curve: Any, samples: int = 513) -> float:
+    """θ_max (degrees) of the ruled B-spline ``(A(u), B(u))`` from its own derivatives."""
+    from .ruled import _theta
+
+    u = np.linspace(0.0, 1.0, samples)
+    F = curve.evaluate(u)
+    F1 = curve.evaluate(u, 1)
+    th, _ = _theta(F1[:, :3], F1[:, 3:], F[:, 3:] - F[:, :3])
+    return float(np.nanmax(th))
+
+
 def developable_bspline(
-    surface: RuledSurface, *, tol: float | None = None, degree: int = 5, end_order: int = 2
+    surface: RuledSurface,
+    *,
+    tol: float | None = None,
+    degree: int = 5,
+    end_order: int = 2,
+    theta_tol_deg: float = 1e-3,
 ) -> BSplineSurfaceData:
     r"""B-spline surface data of a ruled strip from compatible directrix poles.
 
@@ -610,17 +626,25 @@ def developable_bspline(
     ``end_order``; poles ``F_i = (A_i, B_i)`` give the net ``P[i, 0] = A_i``, ``P[i, 1] = B_i`` with
     ``degree_v = 1``, ``knots_v = [0, 0, 1, 1]``, so ``S(u, v) = (1-v) A(u) + v B(u)``.
 
+    The fitted surface's own developability is then checked: ``θ(u)`` from the B-spline's
+    derivatives (``n_A = A' × G``, ``n_B = B' × G``, ``G = B - A``) on 513 parameters; while
+    ``θ_max > theta_tol_deg`` the fit is repeated with ``tol / 10`` (at most 3 times) — the face
+    is then developable to ``theta_tol_deg`` by construction, not only close to a developable.
+
     Args:
         surface: any :class:`~ght_cad.ruled.RuledSurface`.
         tol: absolute deviation bound; default ``1e-7`` times the bounding-box diagonal.
         degree: B-spline degree in u (>= 3 recommended).
         end_order: highest end derivative reproduced exactly (0..2).
+        theta_tol_deg: required θ_max of the B-spline surface (degrees); ``inf`` skips the check.
 
     Returns:
-        :class:`~ght_cad.bspline.BSplineSurfaceData` with ``max_deviation`` and ``info``.
+        :class:`~ght_cad.bspline.BSplineSurfaceData` with ``max_deviation`` and ``info``
+        (``info["theta_max_deg"]``: θ_max of the B-spline surface, ``info["fit_tol"]``).
 
     Raises:
-        ConversionError: the fit could not reach ``tol``.
+        ConversionError: the fit could not reach ``tol``, or θ_max stays above
+            ``theta_tol_deg`` (only for a surface that is not developable itself).
     """
     if not isinstance(surface, RuledSurface):
         raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")
@@ -648,13 +672,33 @@ def developable_bspline(
             [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(top + 1)]
             for e in (0.0, 1.0)
         )
-    try:
-        curve = fit_function(f, tol=tol, degree=degree, end_derivatives=ends)
-    except ConversionError as exc:
-        raise ConversionError(f"could not fit the boundary curves of {surface!r} to tol={tol:g}: {exc}") from exc
+    theta_tol_deg = float(theta_tol_deg)
+    if not theta_tol_deg > 0:
+        raise GHTError(f"theta_tol_deg={theta_tol_deg!r} must be > 0 (use inf to skip the check)")
+    exact_theta = None
+    for attempt in range(4):
+        try:
+            curve = fit_function(f, tol=tol, degree=degree, end_derivatives=ends)
+        except ConversionError as exc:
+            raise ConversionError(f"could not fit the boundary curves of {surface!r} to tol={tol:g}: {exc}") from exc
+        theta = _bspline_theta(curve) if math.isfinite(theta_tol_deg) else float("nan")
+        if not theta > theta_tol_deg:
+            break
+        if exact_theta is None:
+            exact_theta = float(np.nanmax(surface.theta(np.linspace(0.0, 1.0, 513))))
+            if exact_theta > 0.5 * theta_tol_deg:
+                break  # the surface itself is not developable to theta_tol_deg: keep the tol fit
+        if attempt == 3:
+            raise ConversionError(
+                f"the B-spline fit of {surface!r} has θ_max={theta:.3g}° > theta_tol_deg={theta_tol_deg:g}° "
+                f"even at tol={tol:g}; the exact surface has θ_max={exact_theta:.3g}°"
+            )
+        tol /= 10.0
     poles = np.stack([curve.poles[:, :3], curve.poles[:, 3:]], axis=1)
     info = dict(curve.info)
     info["size"] = size
+    info["theta_max_deg"] = theta
+    info["fit_tol"] = tol
     return BSplineSurfaceData(poles, curve.knots, np.array([0.0, 0.0, 1.0, 1.0]), curve.degree, 1,
                               max_deviation=curve.max_deviation, info=info)
 

@@ -488,3 +488,18 @@ def test_bspline_data_in_the_core_keeps_rulings_paired():
     assert data.max_deviation <= 1e-7 * data.info["size"]
     with pytest.raises(GHTError, match=r"end_order=3 is not allowed; use 0, 1 or 2"):
         developable_bspline(s, end_order=3)
+
+
+def test_bspline_data_meets_a_theta_tolerance():
+    from ght_cad.developable import developable_bspline
+
+    s = ship()
+    coarse = developable_bspline(s)
+    fine = developable_bspline(s, theta_tol_deg=1e-5)
+    assert coarse.info["theta_max_deg"] <= 1e-3 and fine.info["theta_max_deg"] <= 1e-5
+    assert fine.poles.shape[0] > coarse.poles.shape[0] and fine.info["fit_tol"] < coarse.info["fit_tol"]
+    # a non-developable strip is converted at the requested tol and reports its own θ
+    twisted = ght_cad.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
+    assert developable_bspline(twisted).info["theta_max_deg"] > 10
+    with pytest.raises(GHTError, match=r"theta_tol_deg=0.0 must be > 0"):
+        developable_bspline(s, theta_tol_deg=0.0)

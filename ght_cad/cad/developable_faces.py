@@ -78,20 +78,26 @@ def planes_from_build123d(plane_or_face: Any) -> np.ndarray:
     return np.concatenate([[-float(n @ o)], n])
 
 
-def developable_surface_data(
-    surface: RuledSurface, *, tol: float | None = None, degree: int = 5, end_order: int = 2
-) -> BSplineSurfaceData:
+def developable_surface_data(surface: RuledSurface, **kwargs: Any) -> BSplineSurfaceData:
     """Alias of :func:`ght_cad.developable.developable_bspline` (core, no CAD kernel needed)."""
-    return developable_bspline(surface, tol=tol, degree=degree, end_order=end_order)
+    return developable_bspline(surface, **kwargs)
 
 
-def developable_face(surface: RuledSurface, *, tol: float | None = None, degree: int = 5, end_order: int = 2) -> Any:
-    r"""One valid build123d ``Face``: the B-spline surface of :func:`developable_surface_data`.
+def developable_face(
+    surface: RuledSurface,
+    *,
+    tol: float | None = None,
+    degree: int = 5,
+    end_order: int = 2,
+    theta_tol_deg: float = 1e-3,
+) -> Any:
+    r"""One valid build123d ``Face``: the B-spline surface of :func:`ght_cad.developable.developable_bspline`
+    (compatible directrix poles, degree 1 across the rulings, θ_max <= ``theta_tol_deg``).
 
     Raises:
         ConversionError: fit failure or a face that fails ``BRepCheck_Analyzer``.
     """
-    data = developable_surface_data(surface, tol=tol, degree=degree, end_order=end_order)
+    data = developable_bspline(surface, tol=tol, degree=degree, end_order=end_order, theta_tol_deg=theta_tol_deg)
     face = make_face(data)
     if not is_valid(face):
         raise ConversionError(f"the B-spline face of {surface!r} is not a valid B-rep (BRepCheck_Analyzer)")
