@@ -195,6 +195,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert r["objects"] == 9 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]
     assert opt["best"] <= opt["initial"] and not opt["status"].startswith("cancelled"), opt
+    cancel = steps["cancel optimization"]["value"]
+    assert cancel["pressed"] and cancel["status"].startswith("cancelled") and cancel["unchanged"], cancel
     for name in ("GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"):
         assert steps[name]["value"]["exists"], name
     for name, s in steps.items():

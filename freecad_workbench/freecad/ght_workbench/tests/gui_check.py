@@ -132,6 +132,35 @@ def main():
             return {"best": opt.BestValue, "initial": opt.InitialValue, "status": opt.Status}
         step("GHT_RunOptimization", run_opt)
 
+        def cancel_opt():
+            from PySide2 import QtWidgets
+
+            opt = ctx["optimization"]
+            target = opt.Targets[0]
+            before = (target.Mu, target.Nu, target.Gamma)
+            pressed = []
+
+            tries = []
+
+            def press_cancel():  # what a user's click on the dialog's Cancel button does
+                for dlg in Gui.getMainWindow().findChildren(QtWidgets.QProgressDialog):
+                    if dlg.isVisible():
+                        dlg.cancel()
+                        pressed.append(dlg.labelText())
+                        return
+                tries.append(1)
+                if len(tries) < 10000:  # the dialog is not up yet: look again on the next event
+                    QtCore.QTimer.singleShot(0, press_cancel)
+
+            QtCore.QTimer.singleShot(0, press_cancel)
+            opt.MaxIterations = 400
+            Gui.Selection.clearSelection()
+            Gui.Selection.addSelection(opt)
+            Gui.runCommand("GHT_RunOptimization", 0)
+            return {"pressed": pressed, "status": opt.Status, "unchanged": before == (target.Mu, target.Nu, target.Gamma)}
+
+        step("cancel optimization", cancel_opt)
+
     from freecad.ght_workbench import export
 
     def exp_step():
