@@ -325,13 +325,26 @@ def plot_surface(
     lo = G.reshape(-1, 3).min(axis=0)
     hi = G.reshape(-1, 3).max(axis=0)
     span = float(np.max(hi - lo)) or 1.0
-    # true proportions, but no axis thinner than 20 % of the largest (keeps long plates visible)
-    ext = np.maximum(hi - lo, 0.2 * span)
+    # true proportions, but no axis shorter than 35 % of the longest (keeps long plates readable)
+    ext = np.maximum(hi - lo, 0.35 * span)
     mid = 0.5 * (lo + hi)
     ax.set_xlim(mid[0] - ext[0] / 2, mid[0] + ext[0] / 2)
     ax.set_ylim(mid[1] - ext[1] / 2, mid[1] + ext[1] / 2)
     ax.set_zlim(mid[2] - ext[2] / 2, mid[2] + ext[2] / 2)
     ax.set_box_aspect(tuple(float(e) for e in ext / ext.max()), zoom=1.1)
+    # look at the surface along its mean normal (from the side the normal points to)
+    if hasattr(surface, "normal"):
+        uu = np.repeat(np.linspace(0.1, 0.9, 9), 3)
+        vv = np.tile([0.25, 0.5, 0.75], 9)
+        n = np.asarray(surface.normal(uu, vv), dtype=float)
+        n = n[np.all(np.isfinite(n), axis=1)]
+        if len(n):
+            m = n.mean(axis=0)
+            if np.linalg.norm(m) > 1e-9:
+                m = m / np.linalg.norm(m)
+                azim = math.degrees(math.atan2(m[1], m[0])) + 20.0
+                elev = float(np.clip(math.degrees(math.asin(np.clip(m[2], -1, 1))), 15.0, 50.0))
+                ax.view_init(elev=elev, azim=azim)
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     ax.set_zlabel("z")
