@@ -146,6 +146,7 @@ def _outputs_text(result: dict[str, Any]) -> str:
 # commands
 # ---------------------------------------------------------------------------------------------
 def cmd_plot_basis(args: argparse.Namespace) -> int:
+    """``ght-cad plot-basis``: PNG of ``b_{i,m}(t; μ,ν,γ)`` (or a derivative), one panel per triple."""
     from .plotting import SIZES, plot_basis
 
     params = []
@@ -168,6 +169,7 @@ def cmd_plot_basis(args: argparse.Namespace) -> int:
 
 
 def cmd_curve(args: argparse.Namespace) -> int:
+    """``ght-cad curve``: properties of ``P(t) = Σ b_{i,m}(t) P_i``; optional STEP edge and plots."""
     import numpy as np
 
     from .curve import GHTCurve
@@ -228,6 +230,7 @@ def _load(args: argparse.Namespace) -> Any:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
+    """``ght-cad demo``: :func:`ght_cad.demo.run_demo` into ``--out``."""
     from .demo import run_demo
 
     report = run_demo(args.out, progress=not args.no_progress, quick=args.quick)
@@ -236,6 +239,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """``ght-cad run``: validate a design file, then :func:`ght_cad.design.run_design`."""
     from .design import load_design, run_design
 
     design = load_design(args.design)
@@ -271,6 +275,7 @@ def _report_text(r: dict[str, Any]) -> str:
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
+    """``ght-cad surface``: developability degree (θ_max, θ_rms, DD, R) of a design's surface."""
     from .design import build_surface, surface_summary
 
     design = _load(args)
@@ -296,6 +301,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
 
 
 def cmd_optimize(args: argparse.Namespace) -> int:
+    """``ght-cad optimize``: :func:`ght_cad.design.optimize_design` with command-line overrides."""
     from .design import optimize_design
 
     design = _load(args)
@@ -323,6 +329,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 
 def cmd_unroll(args: argparse.Namespace) -> int:
+    """``ght-cad unroll``: flat pattern of a design's surface with its relative errors."""
     from .design import build_surface, unroll_surface
 
     design = _load(args)
@@ -361,6 +368,7 @@ _EXPORT_SUFFIXES = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
 
 
 def cmd_export(args: argparse.Namespace) -> int:
+    """``ght-cad export``: write the design's result to files chosen by suffix."""
     from .design import export_files
 
     for f in args.files:
@@ -425,7 +433,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_EPILOG,
     )
     design_arg(sp)
-    sp.add_argument("--out", metavar="DIR", help="output folder (default: <design name>-out)")
+    sp.add_argument("--out", metavar="DIR", help="output folder (default: <DESIGN file name without .toml>-out in the current folder)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     common(sp)
     sp.set_defaults(func=cmd_run)
