@@ -295,14 +295,17 @@ def fit_function(
         if free.any():
             ts = (breaks[:-1, None] + h[:, None] * xg[None, :]).ravel()
             F = _call(func, ts, dim)
-            A = BSpline.design_matrix(ts, knots, p).tocsc()
-            rhs = F - A[:, is_fixed] @ fixed[is_fixed] if is_fixed.any() else F
-            Af = A[:, free]
-            if Af.shape[1] <= 400:
-                sol, *_ = np.linalg.lstsq(Af.toarray(), rhs, rcond=None)
-            else:
+            A = BSpline.design_matrix(ts, knots, p)
+            if n <= 400:  # small: dense least squares (QR/SVD, no squared condition number)
+                A = A.toarray()
+                rhs = F - A[:, is_fixed] @ fixed[is_fixed]
+                sol, *_ = np.linalg.lstsq(A[:, free], rhs, rcond=None)
+            else:  # large: sparse normal equations (banded, well conditioned for B-splines)
                 from scipy.sparse.linalg import splu
 
+                A = A.tocsc()
+                rhs = F - A[:, is_fixed] @ fixed[is_fixed]
+                Af = A[:, free]
                 sol = splu((Af.T @ Af).tocsc()).solve(np.asarray(Af.T @ rhs))
             poles[free] = sol
         return knots, poles

@@ -143,3 +143,14 @@ def test_degenerate_and_badly_scaled_curves_convert(points):
     assert _independent_deviation(curve, bs) <= bs.info["tol"]
     scale = float(np.abs(curve.control_points).max())
     assert bs.info["tol"] >= 64 * np.finfo(float).eps * scale
+
+
+def test_many_spans_use_the_sparse_solver_and_stay_certified():
+    """> 400 poles (sparse normal equations): still within tol, end jets still exact."""
+    f = lambda t: np.column_stack([np.sin(40 * t), np.cos(40 * t)])  # noqa: E731
+    bs = fit_function(f, tol=1e-8, degree=3, end_derivatives=([[0, 1], [40, 0]], []))
+    assert bs.poles.shape[0] > 400
+    assert bs.max_deviation <= 1e-8
+    t = np.random.default_rng(0).uniform(0, 1, 50000)
+    assert np.abs(bs.evaluate(t) - f(t)).max() <= 1e-8
+    assert np.allclose(bs.evaluate([0.0], 1)[0], [40, 0], atol=1e-9)
