@@ -47,6 +47,9 @@ INSUNITS = {"unitless": 0, "in": 1, "ft": 2, "mm": 4, "cm": 5, "m": 6}
 
 _ROMBERG_N = 128
 
+#: 3-D arc-length fractions of the edge-mark ticks (double tick near the start)
+MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
+
 
 def _chords(p: np.ndarray) -> float:
     return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
@@ -357,17 +360,31 @@ def _centroid(poly: np.ndarray) -> np.ndarray:
 
 
 def layout_panels(panels: Sequence[FlatPanel], gap: float | None = None) -> None:
-    """Place panels side by side along +x with ``gap`` between bounding boxes (in place)."""
+    """Place panels in rows (shelves) along +x, ``gap`` between bounding boxes (in place).
+
+    Up to four panels stay in one row; with more, a row is closed when it would exceed
+    ``max(widest panel, 1.5 sqrt(Σ bbox areas))``, so the sheet stays roughly square.
+    """
     sizes = [p.bbox() for p in panels]
     big = max(float(np.max(hi - lo)) for lo, hi in sizes)
     g = 0.05 * big if gap is None else float(gap)
     if not (math.isfinite(g) and g >= 0):
         raise GHTError(f"gap={gap!r} is not allowed; it must be a finite length >= 0")
+    dims = [hi - lo for lo, hi in sizes]
+    row_width = max(max(float(d[0]) for d in dims), 1.5 * math.sqrt(sum(float(d[0] * d[1]) for d in dims)))
+    if len(panels) <= 4:
+        row_width = math.inf
     x = 0.0
-    for p in panels:
-        lo, hi = p.bbox()
-        p.translate(np.array([x - lo[0], -lo[1]]))
-        x += float(hi[0] - lo[0]) + g
+    y = 0.0
+    row_h = 0.0
+    for p, (lo, hi) in zip(panels, sizes):
+        w, h = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+        if x > 0 and x + w > row_width:
+            y -= row_h + g
+            x, row_h = 0.0, 0.0
+        p.translate(np.array([x - lo[0], y - hi[1]]))
+        x += w + g
+        row_h = max(row_h, h)
 
 
 def _polyline_param(poly: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -391,12 +408,26 @@ def _interp_polyline(poly: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.nd
     return p, t / np.linalg.norm(t, axis=1, keepdims=True)
 
 
+def _sagitta3(poly: np.ndarray) -> float:
+    """Chord-to-curve deviation estimate of an open 3-D polyline: a quarter of the largest
+    distance of a vertex from its neighbours' chord (κ h²/8 for spacing h)."""
+    if len(poly) < 3:
+        return 0.0
+    a, b, c = poly[:-2], poly[1:-1], poly[2:]
+    ac = c - a
+    n = np.linalg.norm(ac, axis=1)
+    ok = n > 0
+    d = np.linalg.norm(np.cross(b - a, ac), axis=1)[ok] / n[ok]
+    return float(d.max() / 4) if d.size else 0.0
+
+
 def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int:
     """Give boundary edges shared in 3-D by two panels matching marks (in place).
 
     Two edges (of different panels, or the two sides of a seam in one panel) match when every 3-D sample of each lies within ``rel_tol`` · model size (plus the
     polyline sagitta) of the other. Both get a label ``E<k>`` and ticks across the edge at the
-    points of 3-D arc-length fraction 1/4, 1/2, 3/4 (the same 3-D points on both panels).
+    points of 3-D arc-length fraction 0.2, 0.25, 0.5, 0.75 (the same 3-D points on both panels;
+    the double tick near the start makes the joining direction unambiguous).
 
     Returns:
         Number of shared edges found.
@@ -406,14 +437,24 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
     k = 0
     tick = 0.02 * max(float(np.max(hi - lo)) for lo, hi in (p.bbox() for p in panels))
     items = [(pi, e) for pi, p in enumerate(panels) for lp in p.loops for e in lp]
+    sags = [_sagitta3(e.xyz) for _, e in items]
     used: set[int] = set()
     for i in range(len(items)):
         for j in range(i + 1, len(items)):
             (pi, e1), (pj, e2) = items[i], items[j]
             if i in used or j in used or e1.length_3d == 0 or e2.length_3d == 0:
                 continue
-            sag = 2 * max(_chords(e1.xyz) / len(e1.xyz), _chords(e2.xyz) / len(e2.xyz)) ** 2 / max(size, 1e-300)
-            tol = rel_tol * size + sag
+            tol = rel_tol * size + max(sags[i], sags[j])
+            # cheap prefilter on the end points (either direction; closed edges must both be closed)
+            c1 = np.linalg.norm(e1.xyz[0] - e1.xyz[-1]) <= tol
+            c2 = np.linalg.norm(e2.xyz[0] - e2.xyz[-1]) <= tol
+            if c1 != c2:
+                continue
+            if not c1:
+                fwd = max(np.linalg.norm(e1.xyz[0] - e2.xyz[0]), np.linalg.norm(e1.xyz[-1] - e2.xyz[-1]))
+                bwd = max(np.linalg.norm(e1.xyz[0] - e2.xyz[-1]), np.linalg.norm(e1.xyz[-1] - e2.xyz[0]))
+                if min(fwd, bwd) > tol:
+                    continue
             d12, _ = _polyline_param(e2.xyz, e1.xyz)
             if d12.max() > tol:
                 continue
@@ -423,19 +464,19 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
             k += 1
             used.update((i, j))
             cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(e1.xyz, axis=0), axis=1))])
-            frac_idx = np.interp(np.array([0.25, 0.5, 0.75]) * cum[-1], cum, np.arange(len(cum)))
+            frac_idx = np.interp(np.array(MARK_FRACTIONS) * cum[-1], cum, np.arange(len(cum)))
             p3, _ = _interp_polyline(e1.xyz, frac_idx)
             _, s2 = _polyline_param(e2.xyz, p3)
             for panel, edge, s in ((panels[pi], e1, frac_idx), (panels[pj], e2, s2)):
                 loops = panel.loop_polylines()
                 pos, tan = _interp_polyline(edge.flat + panel.offset, s)
                 nrm = np.stack([-tan[:, 1], tan[:, 0]], axis=1)
-                probe = pos[1] + 2 * tick * nrm[1]
+                probe = pos[2] + 2 * tick * nrm[2]
                 if not _inside(probe[None], loops)[0]:
                     nrm = -nrm
                 for q, nv in zip(pos, nrm):
                     panel.marks.append(np.array([q - tick * nv, q + tick * nv]))
-                tp = pos[1] + 3 * tick * nrm[1]
+                tp = pos[2] + 3 * tick * nrm[2]
                 panel.texts.append((float(tp[0]), float(tp[1]), f"E{k}", 1.5 * tick))
     return k
 

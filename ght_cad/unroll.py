@@ -500,7 +500,7 @@ def unroll_composite(
     Panels are laid side by side along +x (``gap`` between bounding boxes, default 5% of the
     largest panel). Boundary edges shared in 3-D by two panels (same points within 1e-6 of the
     model size, either direction) get matching edge marks: a label ``E<k>`` on both panels and
-    ticks at the same 3-D arc-length fractions 1/4, 1/2, 3/4.
+    ticks at the same 3-D arc-length fractions 0.2, 0.25, 0.5, 0.75 (double tick at the start).
 
     Args:
         parts: RuledSurfaces and/or faces.

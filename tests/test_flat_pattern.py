@@ -151,7 +151,7 @@ def test_composite_exports_all_panels(tmp_path) -> None:
     assert len(msp.query('LWPOLYLINE[layer=="OUTLINE"]')) == 2
     texts = [t.dxf.text for t in msp.query("TEXT")]
     assert {"P1", "P2"} <= set(texts) and texts.count("E1") == 2
-    assert len(msp.query('LINE[layer=="MARKS"]')) == 6
+    assert len(msp.query('LINE[layer=="MARKS"]')) == 8
     root = ET.parse(pat.export_svg(tmp_path / "c.svg")).getroot()
     assert root.tag.endswith("svg")
 

@@ -264,18 +264,20 @@ def test_composite_panels_get_matching_edge_marks() -> None:
     texts = [t[2] for t in pat.labels]
     assert "left" in texts and "right" in texts
     assert texts.count("E1") == 2  # one shared edge, marked on both panels
-    assert len(pat.marks) == 6  # three ticks per side
+    assert len(pat.marks) == 8  # four ticks per side
     lo0, hi0 = pat.panels[0].bbox()
     lo1, hi1 = pat.panels[1].bbox()
     assert hi0[0] < lo1[0]  # laid side by side, no overlap
     assert pat.errors["max"] < 1e-12
-    # ticks sit at the same 3-D arc-length fractions on both sides: 1/4, 1/2, 3/4 of the ruling
-    for panel, name in ((pat.panels[0], "ruling u=1"), (pat.panels[1], "ruling u=0")):
+    # ticks sit at the same 3-D arc-length fractions on both sides (0.2, 0.25, 0.5, 0.75 of the ruling)
+    # (panel 0 runs its ruling u=1 from v=0 up; panel 1 its ruling u=0 from v=1 down: the 3-D
+    # start point a(u) is the flat end of that edge)
+    for panel, name, start in ((pat.panels[0], "ruling u=1", 0), (pat.panels[1], "ruling u=0", -1)):
         edge = next(e for e in panel.loops[0] if e.name == name)
-        p0, p1 = edge.flat[0] + panel.offset, edge.flat[-1] + panel.offset
+        p0, p1 = edge.flat[start] + panel.offset, edge.flat[-1 - start] + panel.offset
         centers = np.array([m.mean(axis=0) for m in panel.marks])
         fr = np.sort(np.linalg.norm(centers - p0, axis=1) / np.linalg.norm(p1 - p0))
-        np.testing.assert_allclose(fr, [0.25, 0.5, 0.75], atol=1e-9)
+        np.testing.assert_allclose(fr, [0.2, 0.25, 0.5, 0.75], atol=1e-9)
     with pytest.raises(GHTError, match="single-panel"):
         pat.map(0.5, 0.5)
 

@@ -234,6 +234,13 @@ def test_shell_gives_one_panel_per_face() -> None:
     marks = [t[2] for t in pat.labels if t[2].startswith("E")]
     assert len(set(marks)) == 12 and len(marks) == 24
     np.testing.assert_allclose(pat.area, 2 * (2 + 3 + 6), rtol=1e-12)
+    boxes = [p.bbox() for p in pat.panels]
+    for i in range(6):
+        for j in range(i + 1, 6):
+            (lo1, hi1), (lo2, hi2) = boxes[i], boxes[j]
+            assert (hi1 < lo2).any() or (hi2 < lo1).any(), "panels overlap"
+    tops = {round(float(hi[1]), 9) for _, hi in boxes}
+    assert len(tops) >= 2  # six panels are packed in more than one row (rows align their tops)
 
 
 def test_bezier_and_rational_bezier_faces() -> None:
