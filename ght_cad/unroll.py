@@ -187,6 +187,7 @@ class RuledDevelopment:
         self.edges = edges
         self.panels = edges.size - 1
         self.quadrature_error_estimate = float(err.max() / size) if size > 0 else 0.0
+        #: max over the final nodes of |d'·n| L (0 on a developable: d' lies in the tangent plane)
         self.normal_turning_max = float(np.max(np.abs(fr["wn"]) * fr["L"]))
         cA = np.polynomial.chebyshev.chebint(c2 * h[:, None, None], lbnd=-1, axis=1)
         totA = np.einsum("pjm,j->pm", cA, np.ones(_N + 2))
@@ -194,7 +195,6 @@ class RuledDevelopment:
         offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
         self._phi = _PanelSeries(edges, cw, offw)
         self._A = _PanelSeries(edges, cA, offA)
-        self._Ap = _PanelSeries(edges, c2)
         # rigid placement: a-edge chord along +x, bounding box at the origin (applied in .map)
         self._R = np.eye(2)
         self._t = np.zeros(2)
@@ -245,7 +245,7 @@ class RuledDevelopment:
 
 
 def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> list[BoundaryEdge]:
-    """The four boundary edges a(u), ruling u=1, b(u) reversed, ruling u=0 (counter-clockwise)."""
+    """The four boundary edges in order around the panel: a(u), ruling u=1, b(u) reversed, ruling u=0."""
 
     def curve_len(which: str) -> float:
         f = (lambda t: np.linalg.norm(surface.a(t, 1), axis=1)) if which == "a" else (
@@ -384,6 +384,8 @@ def unroll_ruled(
             "method": "quadrature along rulings (adaptive Chebyshev/Clenshaw-Curtis panels)",
             "panels": dev.panels,
             "quadrature_error_estimate": dev.quadrature_error_estimate,
+            # max |d' · n| L: the out-of-tangent-plane turning that a best-effort flattening drops
+            "normal_turning_max": dev.normal_turning_max,
             "developability": dd.as_dict(),
             "best_effort": bool(best_effort),
         },
