@@ -576,7 +576,7 @@ def build_curves(design: Design) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     for c in design.curves:
         curves[c.name] = GHTCurve(c.control_points, c.mu, c.nu, c.gamma)
     reports = []
-    for j in design.joins:
+    for i, j in enumerate(design.joins):
         from .continuity import join, measure_continuity
 
         a, b = curves[j.first], curves[j.second]
@@ -587,7 +587,12 @@ def build_curves(design: Design) -> tuple[dict[str, Any], list[dict[str, Any]]]:
             )
         geometric = j.continuity.startswith("G")
         kw = {"k": j.k, "beta2": j.beta2, "beta3": j.beta3} if geometric else {}
-        curves[j.second] = join(a, j.continuity, b, **kw)
+        try:
+            curves[j.second] = join(a, j.continuity, b, **kw)
+        except DesignError:
+            raise
+        except GHTError as exc:
+            raise type(exc)(f"{design.source}: key 'joins[{i}]': {' '.join(str(exc).split())}") from None
         rep = measure_continuity(a, curves[j.second])
         reports.append(
             {

@@ -238,3 +238,13 @@ def test_shape_parameter_range_is_exactly_the_box(key: str, value: float) -> Non
     else:
         with pytest.raises(DesignError, match=rf"p\.toml: key 'curves\[0\]\.{key}': .* out of range; allowed: in \[-1, 1\]"):
             parse_design(data, "p.toml")
+
+
+def test_impossible_join_names_the_join(tmp_path: Path, out_dir: Path, capsys) -> None:
+    """C3 cannot be imposed on a degree-2 second segment (its c_3 is zero): exit 2, joins[0] named."""
+    text = edit('continuity = "G1"', 'continuity = "C3"')
+    before = snapshot(out_dir)
+    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1
+    assert str(path) in err and "'joins[0]'" in err
+    assert snapshot(out_dir) == before
