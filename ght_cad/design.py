@@ -674,7 +674,7 @@ def build_surface(design: Design, shape: dict[str, float] | None = None,
     except DesignError:
         raise
     except GHTError as exc:
-        raise type(exc)(f"{design.source}: [surface]: {' '.join(str(exc).split())}") from None
+        raise type(exc)(f"{design.source}: key 'surface': {' '.join(str(exc).split())}") from None
     return BuiltSurface(design, surf, curves, sh)
 
 

@@ -122,7 +122,7 @@ def test_degenerate_geometry_exit_2_untouched(tmp_path: Path, out_dir: Path, cap
     text = edit("[[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]", "[[-4, 1, 0, 0.5], [-4, 1, 0, 0.5], [-4, 0, 1, 0.5]]")
     before = snapshot(out_dir)
     rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err and "'surface'" in err
     assert snapshot(out_dir) == before
     assert not list(tmp_path.glob(".*ght-cad-tmp"))
 
