@@ -1,0 +1,116 @@
+"""Benchmark of the shape-parameter optimizers (issue 6, spec section 8).
+
+For every problem: ``--seeds`` runs (default 10) of PSO, GWO, I-GWO and scipy's
+``differential_evolution`` (the baseline, measured in the same run) with the same population and
+iteration budget; prints best / median / worst value, mean evaluations, median wall time and the
+evaluations each method needs to reach the same value (``f_best + 1e-3 (f_init - f_best)``: 99.9 %
+of the achievable improvement, see :mod:`ght_cad.optimize.compare`), with the ratio to
+differential_evolution (< 1: fewer evaluations than DE).
+Then times one full run (6 parameters, 30 agents, 200 iterations) of each method on the strip
+problem against the 2 s target, and a Pareto front of (AL, En, CVEn).
+
+Usage::
+
+    python bench/bench_optimize.py [--seeds 10] [--iters 200] [--pop 30] [--out DIR]
+
+With ``--out`` it also writes ``comparison.md`` and convergence PNGs there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ght_cad.io import write_text_atomic
+from ght_cad.optimize import METHODS
+from ght_cad.optimize.compare import compare, format_table
+from ght_cad.optimize.pareto import pareto_front
+from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
+from ght_cad.progress import Progress
+
+
+def rastrigin(X: np.ndarray) -> np.ndarray:
+    return 10.0 * X.shape[1] + np.sum(X**2 - 10.0 * np.cos(2.0 * np.pi * X), axis=1)
+
+
+def rosenbrock(X: np.ndarray) -> np.ndarray:
+    return np.sum(100.0 * (X[:, 1:] - X[:, :-1] ** 2) ** 2 + (1.0 - X[:, :-1]) ** 2, axis=1)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--iters", type=int, default=200)
+    ap.add_argument("--pop", type=int, default=30)
+    ap.add_argument("--out", type=Path, default=None)
+    args = ap.parse_args(argv)
+
+    strip = default_strip_problem()
+    problems = {
+        "strip R (6 params)": (strip, strip.bounds),
+        "dual AL": (default_dual_problem("AL"), (-np.ones(3), np.ones(3))),
+        "dual En": (default_dual_problem("En"), (-np.ones(3), np.ones(3))),
+        "dual CVEn": (default_dual_problem("CVEn"), (-np.ones(3), np.ones(3))),
+        "dual 1*AL+0.1*En+0.01*CVEn": (default_dual_problem({"AL": 1.0, "En": 0.1, "CVEn": 0.01}), (-np.ones(3), np.ones(3))),
+        "interpolation En": (default_interpolation_problem("En"), (-np.ones(3), np.ones(3))),
+        "rastrigin 5-D": (rastrigin, (-5.12 * np.ones(5), 5.12 * np.ones(5))),
+        "rosenbrock 5-D": (rosenbrock, (-2.048 * np.ones(5), 2.048 * np.ones(5))),
+    }
+    methods = ("pso", "gwo", "igwo", "de")
+    seeds = tuple(range(args.seeds))
+    print(f"# optimizer comparison: {args.seeds} seeds, pop {args.pop}, {args.iters} iterations "
+          f"(I-GWO evaluates 2*pop per iteration)\n")
+    total = len(problems) * len(methods) * len(seeds)
+    t0 = time.perf_counter()
+    with Progress(total, "bench") as bar:
+        rows = compare(problems, methods, seeds=seeds, pop_size=args.pop, max_iter=args.iters,
+                       progress=lambda *a: bar.update())
+    table = format_table(rows)
+    print(table)
+    print(f"\n(total {time.perf_counter() - t0:.1f} s)\n")
+    print("## evaluations to reach the common target, ratio to differential_evolution (< 1 = fewer)")
+    for name in problems:
+        rs = {r.method: r for r in rows if r.problem == name}
+        parts = [f"{m} {rs[m].ratio:.2f}" if np.isfinite(rs[m].ratio) else f"{m} -" for m in ("igwo", "pso", "gwo")]
+        verdict = "yes" if all(np.isfinite(rs[m].ratio) and rs[m].ratio < 1 for m in ("igwo", "pso")) else "NO"
+        print(f"  {name:30s} target {rs['de'].target:.4g}: {', '.join(parts)}   I-GWO and PSO fewer than DE: {verdict}")
+
+    print("\n## full run: strip problem, 6 parameters, 30 agents, 200 iterations (target < 2 s)")
+    times = {}
+    for m in methods:
+        ts = []
+        for s in range(3):
+            r = METHODS[m](strip, strip.bounds, pop_size=30, max_iter=200, seed=s)
+            ts.append(r.time)
+        times[m] = min(ts)
+        print(f"  {m:5s} {times[m]:.3f} s  ({r.nfev} evaluations, {1e6 * times[m] / r.nfev:.1f} us/evaluation)"
+              f"  {'OK' if times[m] < 2.0 else 'OVER 2 s'}")
+    print(f"  ratio to DE wall time: " + ", ".join(f"{m} {times[m] / times['de']:.2f}" for m in ("pso", "gwo", "igwo")))
+
+    print("\n## Pareto front of (AL, En, CVEn), dual curve, weighted-sum sweep (15 weights) + archive")
+    t = time.perf_counter()
+    front = pareto_front(default_dual_problem(), divisions=4, pop_size=20, max_iter=50, seed=0)
+    print(f"  {len(front.f)} non-dominated points from {front.nfev} evaluations in {time.perf_counter() - t:.2f} s; "
+          f"ranges AL [{front.f[:, 0].min():.4g}, {front.f[:, 0].max():.4g}], En [{front.f[:, 1].min():.4g}, "
+          f"{front.f[:, 1].max():.4g}], CVEn [{front.f[:, 2].min():.4g}, {front.f[:, 2].max():.4g}]")
+
+    if args.out is not None:
+        from ght_cad.optimize.plots import plot_convergence, plot_pareto
+
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(args.out / "comparison.md", table + "\n")
+        for name in problems:
+            runs = {r.method: r.runs for r in rows if r.problem == name}
+            safe = "".join(c if c.isalnum() else "_" for c in name).strip("_")
+            plot_convergence(runs, args.out / f"convergence_{safe}.png", title=name)
+        plot_pareto(front, args.out / "pareto_dual.png")
+        print(f"\nwrote {args.out}/comparison.md and PNGs")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,142 @@
+"""Comparison of optimizers on the same problems: statistics over seeds and a text table.
+
+For each problem and method, ``seeds`` independent runs with the same population size and
+iteration budget give the best, median and worst final value, the mean evaluation count and the
+median wall time. **Evaluations to reach the same value**: the common target of a problem is
+
+    target = f_best + rtol · (f_init - f_best)
+
+with ``f_best`` the best value of all runs of all methods and ``f_init`` the median best value
+of the initial populations (so ``rtol = 1e-3`` means 99.9 % of the achievable improvement); for
+each run the evaluations after which its best value was first ``<= target`` (per-iteration
+resolution); a run that never reaches it counts as infinite; the median over seeds is reported
+with its ratio to the baseline method (``de`` by default; < 1 means fewer evaluations).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from ..errors import GHTError
+from .optimizers import METHODS, OptimizeResult
+
+__all__ = ["MethodStats", "compare", "format_table"]
+
+
+@dataclass
+class MethodStats:
+    """Statistics of one method on one problem over several seeds."""
+
+    problem: str
+    method: str
+    best: float
+    median: float
+    worst: float
+    nfev: float
+    time: float
+    target: float = math.nan
+    nfev_to_target: float = math.inf
+    reached: int = 0
+    ratio: float = math.nan
+    runs: list[OptimizeResult] = field(default_factory=list, repr=False)
+
+
+def compare(
+    problems: Mapping[str, tuple[Callable[[np.ndarray], Any], Any]],
+    methods: Sequence[str] = ("pso", "gwo", "igwo", "de"),
+    *,
+    seeds: Sequence[int] = tuple(range(10)),
+    pop_size: int = 30,
+    max_iter: int = 200,
+    baseline: str = "de",
+    rtol: float = 1e-3,
+    x0: Mapping[str, Any] | None = None,
+    progress: Callable[[str, str, int], Any] | None = None,
+) -> list[MethodStats]:
+    """Run every method on every problem for every seed and summarize.
+
+    Args:
+        problems: ``name -> (objective, bounds)``.
+        methods: names in :data:`~ght_cad.optimize.METHODS`.
+        seeds: one run per seed (the same seeds for every method).
+        pop_size, max_iter: the same budget for every method (I-GWO spends 2 pop per iteration;
+            compare ``nfev``).
+        baseline: method whose evaluations-to-target are the ratios' denominator.
+        rtol: fraction of the achievable improvement left at the target (see module docstring).
+        x0: optional ``name -> starting point`` placed in every initial population.
+        progress: ``progress(problem, method, seed)`` called before each run.
+
+    Returns:
+        One :class:`MethodStats` per (problem, method), in input order.
+
+    Raises:
+        GHTError: unknown method names or no seeds.
+    """
+    for m in methods:
+        if m not in METHODS:
+            raise GHTError(f"method {m!r} is unknown; choose from {', '.join(METHODS)}")
+    if not len(seeds):
+        raise GHTError("seeds is empty; give at least one seed")
+    out: list[MethodStats] = []
+    for pname, (fun, bounds) in problems.items():
+        rows = []
+        for m in methods:
+            runs = []
+            for s in seeds:
+                if progress is not None:
+                    progress(pname, m, s)
+                runs.append(METHODS[m](fun, bounds, pop_size=pop_size, max_iter=max_iter, seed=int(s),
+                                       x0=None if x0 is None else x0.get(pname)))
+            vals = np.array([r.fun for r in runs])
+            rows.append(MethodStats(
+                problem=pname, method=m, best=float(vals.min()), median=float(np.median(vals)),
+                worst=float(vals.max()), nfev=float(np.mean([r.nfev for r in runs])),
+                time=float(np.median([r.time for r in runs])), runs=runs,
+            ))
+        f_best = min(r.best for r in rows)
+        f_init = float(np.median([run.history[0] for r in rows for run in r.runs]))
+        target = f_best + rtol * (f_init - f_best) if math.isfinite(f_init) else f_best
+        for r in rows:
+            hits = [run.nfev_to_reach(target) for run in r.runs]
+            n = np.array([math.inf if h is None else h for h in hits], dtype=float)
+            r.target = target
+            r.reached = int(np.sum(np.isfinite(n)))
+            r.nfev_to_target = float(np.median(n))
+        base = next((r for r in rows if r.method == baseline), None)
+        for r in rows:
+            if base is not None and math.isfinite(base.nfev_to_target) and base.nfev_to_target > 0:
+                r.ratio = r.nfev_to_target / base.nfev_to_target
+        out.extend(rows)
+    return out
+
+
+def format_table(rows: Sequence[MethodStats], fmt: str = "markdown") -> str:
+    """The comparison as a Markdown (``fmt="markdown"``) or plain-text table.
+
+    Columns: problem, method, best, median, worst, mean nfev, median time, target, median
+    evaluations to reach the target (runs reaching it / runs), ratio to the baseline.
+    """
+    head = ["problem", "method", "best", "median", "worst", "nfev", "time [s]", "target",
+            "nfev to target", "ratio"]
+    body = []
+    for r in rows:
+        body.append([
+            r.problem, r.method, f"{r.best:.4g}", f"{r.median:.4g}", f"{r.worst:.4g}", f"{r.nfev:.0f}",
+            f"{r.time:.3f}", f"{r.target:.4g}",
+            ("never" if not math.isfinite(r.nfev_to_target) else f"{r.nfev_to_target:.0f}")
+            + f" ({r.reached}/{len(r.runs)})",
+            "-" if not math.isfinite(r.ratio) else f"{r.ratio:.2f}",
+        ])
+    if fmt == "markdown":
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(b) + " |" for b in body]
+        return "\n".join(lines)
+    if fmt == "text":
+        widths = [max(len(h), *(len(b[i]) for b in body)) if body else len(h) for i, h in enumerate(head)]
+        fmt_row = lambda cells: "  ".join(c.ljust(w) for c, w in zip(cells, widths))  # noqa: E731
+        return "\n".join([fmt_row(head), fmt_row(["-" * w for w in widths])] + [fmt_row(b) for b in body])
+    raise GHTError(f"fmt={fmt!r} is not allowed; use 'markdown' or 'text'")

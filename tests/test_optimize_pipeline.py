@@ -1,0 +1,98 @@
+"""Pipeline (problem -> optimized object -> B-rep, STEP, flat pattern, plot), comparison table."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from ght_cad.errors import GHTError
+from ght_cad.optimize import igwo, pso
+from ght_cad.optimize.compare import compare, format_table
+from ght_cad.optimize.pipeline import optimize_design
+from ght_cad.optimize.plots import plot_convergence, plot_pareto
+from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def test_dual_problem_to_step_and_flat_pattern(tmp_path):
+    p = default_dual_problem("CVEn")
+    d = optimize_design(p, pop_size=10, max_iter=20, seed=0, out_dir=tmp_path, stem="duct")
+    assert d.after["CVEn"] < d.before["CVEn"] and d.after["theta_max"] < 1e-9
+    assert set(d.files) == {"step", "dxf", "png", "json"}
+    from ght_cad.cad.occ import is_valid, read_step
+
+    assert is_valid(d.shape) and is_valid(read_step(d.files["step"]))
+    assert d.files["dxf"].read_bytes()[:200].count(b"SECTION") >= 1
+    assert d.files["png"].read_bytes()[:8] == PNG
+    data = json.loads(d.files["json"].read_text())
+    assert data["parameters"] == d.parameters and data["after"]["CVEn"] == pytest.approx(d.result.fun)
+    # the flat pattern of an exactly developable surface has round-off distortion only
+    assert d.flat.errors["max"] < 1e-9
+    assert not d.notes
+    assert list(tmp_path.glob("*.part")) == []      # atomic writes leave no temporaries
+
+
+def test_strip_pipeline_best_effort_flat_pattern():
+    d = optimize_design(default_strip_problem(), pop_size=12, max_iter=30, seed=0, cad=False)
+    assert d.after["theta_max"] < 0.2 * d.before["theta_max"]
+    assert d.shape is None and d.files == {}
+    assert d.flat is not None and d.flat.errors["max"] < 1e-4
+    assert any("best_effort" in n for n in d.notes)
+    assert "| theta_max |" in d.summary()
+
+
+def test_curve_pipeline_gives_an_edge(tmp_path):
+    d = optimize_design(default_interpolation_problem(), pop_size=8, max_iter=10, seed=0, out_dir=tmp_path, plot=False)
+    assert d.shape is not None and d.flat is None and "step" in d.files and "png" not in d.files
+    assert any("curve" in n for n in d.notes)
+
+
+def test_pipeline_callback_stops_and_bad_stem():
+    d = optimize_design(default_dual_problem(), pop_size=8, max_iter=100, seed=0, cad=False, flat=False,
+                        callback=lambda s: s.nit >= 2)
+    assert d.result.nit == 2 and d.result.message == "stopped by callback"
+    with pytest.raises(GHTError, match="stem='a/b'"):
+        optimize_design(default_dual_problem(), stem="a/b")
+
+
+def test_compare_table_and_target():
+    sphere = lambda X: np.sum((X - 0.3) ** 2, axis=1)  # noqa: E731
+    rows = compare({"sphere": (sphere, (-np.ones(3), np.ones(3)))}, ("pso", "igwo", "de"), seeds=(0, 1, 2),
+                   pop_size=8, max_iter=30)
+    assert [r.method for r in rows] == ["pso", "igwo", "de"]
+    for r in rows:
+        assert r.best <= r.median <= r.worst and len(r.runs) == 3
+        # target = f_best + 1e-3 (f_init - f_best) with f_best the best of all runs
+        assert r.target >= min(q.best for q in rows)
+        if r.reached:
+            hits = [run.nfev_to_reach(r.target) for run in r.runs]
+            assert all(h is None or run.history[list(run.history_nfev).index(h)] <= r.target
+                       for h, run in zip(hits, r.runs))
+    de = rows[-1]
+    assert de.ratio == pytest.approx(1.0)
+    md = format_table(rows)
+    assert md.splitlines()[0].startswith("| problem | method | best") and len(md.splitlines()) == 5
+    assert "sphere" in format_table(rows, "text")
+    with pytest.raises(GHTError, match="fmt='html'"):
+        format_table(rows, "html")
+    with pytest.raises(GHTError, match="'nelder'"):
+        compare({"s": (sphere, (-np.ones(2), np.ones(2)))}, ("nelder",))
+
+
+def test_plots_are_png(tmp_path):
+    f = lambda X: np.sum(X**2, axis=1)  # noqa: E731
+    runs = [igwo(f, (-np.ones(2), np.ones(2)), pop_size=6, max_iter=10, seed=s) for s in range(3)]
+    runs.append(pso(f, (-np.ones(2), np.ones(2)), pop_size=6, max_iter=10, seed=0))
+    out = plot_convergence(runs, tmp_path / "c.png", x="nit")
+    assert out.read_bytes()[:8] == PNG
+    from ght_cad.optimize.pareto import pareto_front
+
+    front = pareto_front(default_dual_problem(), divisions=1, pop_size=6, max_iter=5, seed=0)
+    assert plot_pareto(front, tmp_path / "p.png").read_bytes()[:8] == PNG
+    with pytest.raises(GHTError, match="x='time'"):
+        plot_convergence(runs, tmp_path / "d.png", x="time")
+    assert not (tmp_path / "d.png").exists()
