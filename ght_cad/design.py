@@ -1130,132 +1130,131 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
 
     stage = _Stage(out)
     try:
-        if True:
-            # 1. curves
-            step("curves")
-            curves, joins = build_curves(design)
-            report["curves"] = [
-                {
-                    "name": k,
-                    "degree": c.degree,
-                    "dim": c.dim,
-                    "mu": c.mu,
-                    "nu": c.nu,
-                    "gamma": c.gamma,
-                    "control_points": c.control_points.tolist(),
-                    "arc_length": c.arc_length(),
-                    "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
-                }
-                for k, c in curves.items()
-            ]
-            report["joins"] = joins
+        # 1. curves
+        step("curves")
+        curves, joins = build_curves(design)
+        report["curves"] = [
+            {
+                "name": k,
+                "degree": c.degree,
+                "dim": c.dim,
+                "mu": c.mu,
+                "nu": c.nu,
+                "gamma": c.gamma,
+                "control_points": c.control_points.tolist(),
+                "arc_length": c.arc_length(),
+                "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
+            }
+            for k, c in curves.items()
+        ]
+        report["joins"] = joins
 
-            built = None
-            opt = None
-            if design.surface is not None:
-                # 2. surface
-                step("surface")
-                built = build_surface(design, curves=curves)
-                report["developability_initial"] = built.surface.developability().as_dict()
-                # 3. optimization
-                if design.optimize is not None:
-                    step("optimize")
-                    opt = optimize_design(design, progress=progress, curves=curves)
-                    built = build_surface(design, opt.shape, curves=curves)
-                    report["optimization"] = opt.summary()
-                # 4. measures
-                step("measure")
-                report.update(surface_summary(built))
-                # 5. B-rep
-                step("B-rep + STEP")
-                face = brep_face(built)
-                from .cad.occ import is_valid
+        built = None
+        opt = None
+        if design.surface is not None:
+            # 2. surface
+            step("surface")
+            built = build_surface(design, curves=curves)
+            report["developability_initial"] = built.surface.developability().as_dict()
+            # 3. optimization
+            if design.optimize is not None:
+                step("optimize")
+                opt = optimize_design(design, progress=progress, curves=curves)
+                built = build_surface(design, opt.shape, curves=curves)
+                report["optimization"] = opt.summary()
+            # 4. measures
+            step("measure")
+            report.update(surface_summary(built))
+            # 5. B-rep
+            step("B-rep + STEP")
+            face = brep_face(built)
+            from .cad.occ import is_valid
 
-                valid = is_valid(face)
-                report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": 1}
-                if not valid:
-                    raise GHTError(f"{design.source}: the B-rep face of the surface is not valid (BRepCheck)")
-                edges = curve_edges(curves)
-                report["brep"]["curve_edges"] = len(edges)
-                if "step" in want_files:
-                    from .cad.occ import write_step
+            valid = is_valid(face)
+            report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": 1}
+            if not valid:
+                raise GHTError(f"{design.source}: the B-rep face of the surface is not valid (BRepCheck)")
+            edges = curve_edges(curves)
+            report["brep"]["curve_edges"] = len(edges)
+            if "step" in want_files:
+                from .cad.occ import write_step
 
-                    write_step([face] + edges, stage.path(FILE_NAMES["step"]))
-                # 6. flat pattern
-                step("flat pattern")
-                pattern = unroll_surface(built)
-                report["flat_pattern"] = {
-                    "area": float(pattern.area),
-                    "errors": pattern_errors(pattern),
-                    "report": pattern.report.as_dict(),
-                    "outline_points": int(sum(len(o) for o in pattern.outlines)),
-                    "bend_lines": int(len(pattern.bend_lines)),
-                    "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
-                             np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
-                }
-                if "dxf" in want_files:
-                    pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
-                if "svg" in want_files:
-                    pattern.export_svg(stage.path(FILE_NAMES["svg"]))
-            else:
-                pattern = None
-                if "step" in want_files and curves:
-                    from .cad.occ import write_step
+                write_step([face] + edges, stage.path(FILE_NAMES["step"]))
+            # 6. flat pattern
+            step("flat pattern")
+            pattern = unroll_surface(built)
+            report["flat_pattern"] = {
+                "area": float(pattern.area),
+                "errors": pattern_errors(pattern),
+                "report": pattern.report.as_dict(),
+                "outline_points": int(sum(len(o) for o in pattern.outlines)),
+                "bend_lines": int(len(pattern.bend_lines)),
+                "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
+                         np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
+            }
+            if "dxf" in want_files:
+                pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
+            if "svg" in want_files:
+                pattern.export_svg(stage.path(FILE_NAMES["svg"]))
+        else:
+            pattern = None
+            if "step" in want_files and curves:
+                from .cad.occ import write_step
 
-                    write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]))
+                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]))
 
-            # 7. figures
-            step("figures")
-            from . import plotting as P
+        # 7. figures
+        step("figures")
+        from . import plotting as P
 
-            if "basis" in want_figs:
-                if built is not None and design.surface is not None and design.surface.type == "planes":
-                    deg = built.surface.dual_curve.degree
-                    sh = built.shape
-                    params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (design.surface.mu, design.surface.nu, design.surface.gamma),
-                              (sh["mu"], sh["nu"], sh["gamma"])]
-                elif curves:
-                    c0 = next(iter(curves.values()))
-                    deg = c0.degree
-                    params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (c0.mu, c0.nu, c0.gamma)]
-                else:  # pragma: no cover - validation guarantees curves or a surface
-                    deg, params = 3, [(0.0, 0.0, 0.0)]
-                uniq = []
-                for p in params:
-                    if p not in uniq:
-                        uniq.append(p)
-                P.plot_basis(stage.path(FIGURE_NAMES["basis"]), max(deg, 2), uniq)
-            if "curve" in want_figs and curves:
-                P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
-            if "curvature" in want_figs and curves:
-                P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
-            if "surface" in want_figs and built is not None:
-                P.plot_surface(built.surface, stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
-            if "flat_pattern" in want_figs and pattern is not None:
-                plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
-            if "convergence" in want_figs and opt is not None:
-                P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
-                                   stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")
+        if "basis" in want_figs:
+            if built is not None and design.surface is not None and design.surface.type == "planes":
+                deg = built.surface.dual_curve.degree
+                sh = built.shape
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (design.surface.mu, design.surface.nu, design.surface.gamma),
+                          (sh["mu"], sh["nu"], sh["gamma"])]
+            elif curves:
+                c0 = next(iter(curves.values()))
+                deg = c0.degree
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (c0.mu, c0.nu, c0.gamma)]
+            else:  # pragma: no cover - validation guarantees curves or a surface
+                deg, params = 3, [(0.0, 0.0, 0.0)]
+            uniq = []
+            for p in params:
+                if p not in uniq:
+                    uniq.append(p)
+            P.plot_basis(stage.path(FIGURE_NAMES["basis"]), max(deg, 2), uniq)
+        if "curve" in want_figs and curves:
+            P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
+        if "curvature" in want_figs and curves:
+            P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
+        if "surface" in want_figs and built is not None:
+            P.plot_surface(built.surface, stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
+        if "flat_pattern" in want_figs and pattern is not None:
+            plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
+        if "convergence" in want_figs and opt is not None:
+            P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
+                               stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")
 
-            # 8. report
-            step("report")
-            files = sorted(p.name for p in stage.tmp.iterdir() if p.is_file())
-            if "json" in want_files:
-                files.append(FILE_NAMES["json"])
-            if "md" in want_files:
-                files.append(FILE_NAMES["md"])
-            report["files"] = sorted(files)
-            report["out_dir"] = str(out)
-            report["versions"] = _versions()
-            report["elapsed_s"] = time.perf_counter() - t_start
-            report = _jsonable(report)
-            from .io import write_text_atomic
-            import json
+        # 8. report
+        step("report")
+        files = sorted(p.name for p in stage.tmp.iterdir() if p.is_file())
+        if "json" in want_files:
+            files.append(FILE_NAMES["json"])
+        if "md" in want_files:
+            files.append(FILE_NAMES["md"])
+        report["files"] = sorted(files)
+        report["out_dir"] = str(out)
+        report["versions"] = _versions()
+        report["elapsed_s"] = time.perf_counter() - t_start
+        report = _jsonable(report)
+        from .io import write_text_atomic
+        import json
 
-            if "json" in want_files:
-                write_text_atomic(stage.path(FILE_NAMES["json"]), json.dumps(report, indent=2) + "\n")
-            if "md" in want_files:
-                write_text_atomic(stage.path(FILE_NAMES["md"]), report_markdown(report))
+        if "json" in want_files:
+            write_text_atomic(stage.path(FILE_NAMES["json"]), json.dumps(report, indent=2) + "\n")
+        if "md" in want_files:
+            write_text_atomic(stage.path(FILE_NAMES["md"]), report_markdown(report))
         stage.commit()
     except BaseException:
         stage.cleanup()
