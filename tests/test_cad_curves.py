@@ -313,6 +313,14 @@ def test_export_step_of_mixed_ght_objects(tmp_path):
         ght_shape(3.0)
 
 
+def test_open_chain_that_closes_geometrically_gives_a_closed_wire():
+    a = GHTCurve([(0, 0), (1, 1), (2, 0)])
+    b = GHTCurve([(2, 0), (1, -1), (0, 0)])
+    assert ght_wire(CompositeCurve([a, b], "C0")).is_closed
+    assert not ght_wire([a]).is_closed
+    assert not ght_wire([a, GHTCurve([(2, 0), (1, -1), (0.5, 0)])]).is_closed
+
+
 def test_adapter_errors():
     with pytest.raises(GHTError, match="dim"):
         ght_edge(GHTCurve(np.zeros((3, 4)) + np.arange(3)[:, None]))

@@ -167,8 +167,8 @@ def ght_edge(curve: GHTCurve, tol: float | None = None, degree: int = 5) -> Edge
 
 def _wire_edges(curves: Any, tol: float | None, degree: int, closed: bool | None) -> tuple[Any, list[BSplineCurveData]]:
     segs, flag = segments_of(curves)
-    if closed is None:
-        closed = flag
+    if closed is None and flag:
+        closed = True  # a closed composite; an open one may still close geometrically
     starts = np.array([_xyz(s.evaluate(0.0)) for s in segs])
     ends = np.array([_xyz(s.evaluate(1.0)) for s in segs])
     allpts = np.vstack([np.vstack([s.control_points for s in segs]).min(axis=0), np.vstack([s.control_points for s in segs]).max(axis=0)])
@@ -219,8 +219,9 @@ def ght_wire(
         curves: ``CompositeCurve`` (uses ``.segments`` and ``.closed``), GHTCurve or sequence.
         tol: maximum deviation per segment (default 1e-7 × each segment's box diagonal).
         degree: B-spline degree.
-        closed: force closed/open; default: the composite's flag, else closed when the last end
-            meets the first start.
+        closed: True requires a closed chain (error otherwise); default: closed for a closed
+            composite, else closed when the last end meets the first start (to 1e-9 × the
+            chain's size).
 
     Returns:
         ``Wire`` with ``wire.ght_bspline`` = list of BSplineCurveData.
