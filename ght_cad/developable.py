@@ -383,14 +383,25 @@ class EnvelopeDevelopable(RuledSurface):
         n0, n1 = U[0][:, 1:], U[1][:, 1:]
         d = np.cross(n0, n1)
         dn = np.linalg.norm(d, axis=1)
-        ref = np.linalg.norm(n0, axis=1) * np.linalg.norm(n1, axis=1)
+        # turning rate |n × n'| compared with |n| max(|n'|, |n|): a vanishing U' (a cusp of the dual
+        # curve, e.g. nu = gamma = -1 at t = 1) is degenerate too, not only parallel n and n'
+        n0n = np.linalg.norm(n0, axis=1)
+        ref = n0n * np.maximum(np.linalg.norm(n1, axis=1), n0n)
         bad = ~(dn > PARALLEL_TOL * ref)
         if bad.any():
             i = int(np.argmax(bad))
             t = float(self.dual_parameter(u[i])[0])
+            stationary = np.linalg.norm(n1[i]) <= PARALLEL_TOL * n0n[i]
+            what = (
+                "has a vanishing normal derivative (the dual curve is stationary there, e.g. "
+                "nu = gamma = -1 gives U'(1) = 0 and mu = gamma = -1 gives U'(0) = 0), so the ruling "
+                "U ∩ U' is undefined"
+                if stationary
+                else "have parallel normals, so the ruling U ∩ U' is at infinity"
+            )
             raise DegenerateGeometryError(
                 f"at u={u[i]:.6g} (t={t:.6g}) the dual curve's plane U={_fmt(U[0][i])} and its derivative "
-                f"U'={_fmt(U[1][i])} have parallel normals, so the ruling U ∩ U' is at infinity; "
+                f"U'={_fmt(U[1][i])} {what}; "
                 "the planes' normals must keep turning (no parallel neighbours, no turning back)" + self._orientation_hint()
             )
         dunit = d / dn[:, None]

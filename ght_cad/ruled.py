@@ -64,14 +64,32 @@ def _unit(v: np.ndarray) -> np.ndarray:
         return v / n
 
 
+#: relative size of ``|a' × g|`` (against ``|a'| |g|``) below which the normal at that end of the
+#: ruling is undefined (a singular point of the boundary curve, e.g. a' = 0 at an end)
+SINGULAR_NORMAL_TOL = 1e-10
+
+
 def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(θ in degrees, n_a·n_b) with ``n_a = a'×g/|a'×g|`` and ``n_b = b'×g/|b'×g|``."""
-    na = _unit(np.cross(a1, g))
-    nb = _unit(np.cross(b1, g))
-    dot = np.clip(np.sum(na * nb, axis=-1), -1.0, 1.0)
-    # atan2 of |na × nb| and na·nb is accurate near 0 where arccos is not
-    cr = np.linalg.norm(np.cross(na, nb), axis=-1)
-    return np.degrees(np.arctan2(cr, dot)), dot
+    """(θ in degrees, n_a·n_b) with ``n_a = a'×g/|a'×g|`` and ``n_b = b'×g/|b'×g|``.
+
+    Where a normal is undefined (``|a'×g| <= SINGULAR_NORMAL_TOL |a'||g|`` or the same for b, or
+    a zero ruling) θ and the dot product are NaN; callers ignore those parameters.
+    """
+    ca = np.cross(a1, g)
+    cb = np.cross(b1, g)
+    la, lb = np.linalg.norm(ca, axis=-1), np.linalg.norm(cb, axis=-1)
+    gl = np.linalg.norm(g, axis=-1)
+    ok = (la > SINGULAR_NORMAL_TOL * np.linalg.norm(a1, axis=-1) * gl) & (
+        lb > SINGULAR_NORMAL_TOL * np.linalg.norm(b1, axis=-1) * gl
+    ) & (gl > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        na = ca / la[..., None]
+        nb = cb / lb[..., None]
+        dot = np.clip(np.sum(na * nb, axis=-1), -1.0, 1.0)
+        # atan2 of |na × nb| and na·nb is accurate near 0 where arccos is not
+        cr = np.linalg.norm(np.cross(na, nb), axis=-1)
+        th = np.degrees(np.arctan2(cr, dot))
+    return np.where(ok, th, np.nan), np.where(ok, dot, np.nan)
 
 
 def developability_from_jets(
@@ -80,9 +98,14 @@ def developability_from_jets(
     """θ_rms, DD, R and θ_max from directrix values/derivatives at quadrature nodes."""
     g = b0 - a0
     th, dot = _theta(a1, b1, g)
-    theta_rms = float(np.sqrt(np.sum(weights * th**2) / np.sum(weights)))
-    dd = float(np.sum(weights * np.cos(np.radians(th))) / np.sum(weights))
-    R = float(np.sum(weights * (1.0 - dot)) / np.sum(weights))
+    ok = np.isfinite(th)
+    if not ok.any():
+        raise GHTError("the surface normal is undefined at every sample: the rulings or boundary tangents vanish")
+    w = weights[ok]
+    th, dot = th[ok], dot[ok]
+    theta_rms = float(np.sqrt(np.sum(w * th**2) / np.sum(w)))
+    dd = float(np.sum(w * np.cos(np.radians(th))) / np.sum(w))
+    R = float(np.sum(w * (1.0 - dot)) / np.sum(w))
     return float(th.max()), theta_rms, dd, R
 
 
@@ -182,7 +205,7 @@ class RuledSurface(ABC):
         t, w = gauss_legendre(nodes)
         _, theta_rms, dd, R = developability_from_jets(self.a(t), self.a(t, 1), self.b(t), self.b(t, 1), w)
         uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
-        theta_max = float(np.max(self.theta(uu)))
+        theta_max = float(np.nanmax(self.theta(uu)))  # singular points (undefined normal) skipped
         res = float(np.max(np.abs(self.developability_residual(uu))))
         return Developability(theta_max, theta_rms, dd, R, res)
 
