@@ -272,33 +272,43 @@ def _sagitta(loop: np.ndarray) -> float:
 
 
 def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
-    """Clip (k, 2, 2) segments to the region inside ``loops[0]`` and outside ``loops[1:]``."""
-    out = []
-    edges = [(lp, np.roll(lp, -1, axis=0)) for lp in loops]
+    """Clip (k, 2, 2) segments to the region inside ``loops[0]`` and outside ``loops[1:]``.
+
+    Crossings within a few polyline sagittas of a segment end are the end meeting the polygonal
+    approximation of a curved boundary, not a cut, and are ignored. Vectorized over segments x
+    polygon edges; only segments with interior crossings are split one by one.
+    """
+    segments = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
+    if segments.shape[0] == 0:
+        return segments
+    A = np.concatenate(loops, axis=0)
+    B = np.concatenate([np.roll(lp, -1, axis=0) for lp in loops], axis=0)
+    S = B - A  # (m, 2)
+    P, Q = segments[:, 0], segments[:, 1]
+    R = Q - P  # (k, 2)
     sag = max(_sagitta(lp) for lp in loops)
-    for p, q in segments:
-        r = q - p
-        # crossings within a few sagittas of an end are the end itself meeting the polygonal
-        # approximation of a curved boundary, not a cut
-        dt = min(1e-3, 8.0 * sag / max(float(np.linalg.norm(r)), 1e-300))
-        ts = [0.0, 1.0]
-        for a, b in edges:
-            s = b - a
-            den = r[0] * s[:, 1] - r[1] * s[:, 0]
-            ok = np.abs(den) > 1e-300
-            ap = a - p
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = (ap[:, 0] * s[:, 1] - ap[:, 1] * s[:, 0]) / den
-                w = (ap[:, 0] * r[1] - ap[:, 1] * r[0]) / den
-            sel = ok & (t > dt) & (t < 1 - dt) & (w >= 0) & (w <= 1)
-            ts.extend(t[sel].tolist())
-        ts = np.unique(ts)
-        mids = p + (0.5 * (ts[:-1] + ts[1:]))[:, None] * r
+    dt = np.minimum(1e-3, 8.0 * sag / np.maximum(np.linalg.norm(R, axis=1), 1e-300))[:, None]
+    den = R[:, 0:1] * S[None, :, 1] - R[:, 1:2] * S[None, :, 0]  # (k, m)
+    AP = A[None, :, :] - P[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (AP[..., 0] * S[None, :, 1] - AP[..., 1] * S[None, :, 0]) / den
+        w = (AP[..., 0] * R[:, 1:2] - AP[..., 1] * R[:, 0:1]) / den
+    sel = (np.abs(den) > 1e-300) & (t > dt) & (t < 1 - dt) & (w >= 0) & (w <= 1)
+    crossing = sel.any(axis=1)
+    out: list[tuple[int, np.ndarray]] = []  # (segment index, piece): keeps the input order
+    plain = np.nonzero(~crossing)[0]
+    if plain.size:
+        keep = _inside(P[plain] + 0.5 * R[plain], loops)
+        out.extend((int(i), segments[i]) for i in plain[keep])
+    for i in np.nonzero(crossing)[0]:
+        ts = np.unique(np.concatenate([[0.0, 1.0], t[i, sel[i]]]))
+        mids = P[i] + (0.5 * (ts[:-1] + ts[1:]))[:, None] * R[i]
         keep = _inside(mids, loops)
-        for i in np.nonzero(keep)[0]:
-            if ts[i + 1] - ts[i] > 1e-9:
-                out.append([p + ts[i] * r, p + ts[i + 1] * r])
-    return np.asarray(out, dtype=float).reshape(-1, 2, 2)
+        for j in np.nonzero(keep)[0]:
+            if ts[j + 1] - ts[j] > 1e-9:
+                out.append((int(i), np.array([P[i] + ts[j] * R[i], P[i] + ts[j + 1] * R[i]])))
+    out.sort(key=lambda item: item[0])
+    return np.asarray([seg for _, seg in out], dtype=float).reshape(-1, 2, 2)
 
 
 def measure_panel(panel: FlatPanel) -> DistortionReport:
