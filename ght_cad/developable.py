@@ -391,9 +391,9 @@ class EnvelopeDevelopable(RuledSurface):
         if bad.any():
             i = int(np.argmax(bad))
             t = float(self.dual_parameter(u[i])[0])
-            stationary = np.linalg.norm(n1[i]) <= PARALLEL_TOL * n0n[i]
+            stationary = np.linalg.norm(U[1][i]) <= PARALLEL_TOL * np.linalg.norm(U[0][i])
             what = (
-                "has a vanishing normal derivative (the dual curve is stationary there, e.g. "
+                "vanishes (the dual curve is stationary there, e.g. "
                 "nu = gamma = -1 gives U'(1) = 0 and mu = gamma = -1 gives U'(0) = 0), so the ruling "
                 "U ∩ U' is undefined"
                 if stationary
