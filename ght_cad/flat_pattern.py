@@ -240,7 +240,10 @@ class FlatPanel:
 
 
 def _point_in_polygon(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Even-odd ray casting, vectorized over points."""
+    """Even-odd ray casting, vectorized over points (in chunks of ~2e6 point-edge pairs)."""
+    step = max(1, int(2e6 // max(len(poly), 1)))
+    if len(pts) > step:
+        return np.concatenate([_point_in_polygon(pts[i : i + step], poly) for i in range(0, len(pts), step)])
     x, y = pts[:, 0][:, None], pts[:, 1][:, None]
     x0, y0 = poly[:, 0][None, :], poly[:, 1][None, :]
     x1, y1 = np.roll(poly[:, 0], -1)[None, :], np.roll(poly[:, 1], -1)[None, :]
@@ -281,6 +284,10 @@ def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
     segments = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
     if segments.shape[0] == 0:
         return segments
+    step = max(1, int(2e6 // sum(len(lp) for lp in loops)))
+    if segments.shape[0] > step:  # bound the (segments x edges) work arrays
+        parts = [clip_segments(segments[i : i + step], loops) for i in range(0, segments.shape[0], step)]
+        return np.concatenate(parts, axis=0)
     A = np.concatenate(loops, axis=0)
     B = np.concatenate([np.roll(lp, -1, axis=0) for lp in loops], axis=0)
     S = B - A  # (m, 2)
