@@ -26,6 +26,10 @@ from .errors import (
 )
 from .seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
 
+# ``ght_cad.unroll`` is both a submodule and the stable function of spec section 9: importing the
+# function here binds the package attribute to the function for good (numpy-only, ~30 ms).
+from .unroll import unroll
+
 __version__ = "0.1.0"
 
 __all__ = [
@@ -61,7 +65,6 @@ __all__ = [
 # ``import ght_cad`` stays fast (< 0.3 s) and never touches a CAD kernel.
 _LAZY: dict[str, str] = {
     "developable_from_planes": "ght_cad.developable",
-    "unroll": "ght_cad.unroll",
     "join": "ght_cad.continuity",
     "measure_continuity": "ght_cad.continuity",
     "Continuity": "ght_cad.continuity",
