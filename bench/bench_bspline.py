@@ -12,6 +12,7 @@ target is the default tolerance ``tol = 1e-7 ×`` bounding-box diagonal.
 
   - ``matched``: the parameters t_k are passed to OCCT, so its B-spline is parametrized by t and
     the deviation is measured exactly like ours (matched parameters, same fresh t).
+  - ``matched5``: as ``matched`` with DegMax 5 (same maximum degree as our default).
   - ``chord``: OCCT's default (chord-length) parametrization; deviation = max distance of 20 000
     points of the OCCT curve to the exact curve by dense projection (nearest of 20 001 samples,
     refined by 4 Newton steps on ``|P(t) - q|²``): a weaker metric, favourable to OCCT.
@@ -45,7 +46,7 @@ def _timed(fn, repeat: int = 3):
     return best, out
 
 
-def _occt_fit(curve: GHTCurve, n: int, tol3d: float, matched: bool) -> BSplineCurveData | None:
+def _occt_fit(curve: GHTCurve, n: int, tol3d: float, matched: bool, deg_max: int = 8) -> BSplineCurveData | None:
     from OCP.GeomAbs import GeomAbs_C2
     from OCP.GeomAPI import GeomAPI_PointsToBSpline
     from OCP.gp import gp_Pnt
@@ -61,9 +62,9 @@ def _occt_fit(curve: GHTCurve, n: int, tol3d: float, matched: bool) -> BSplineCu
         par = TColStd_Array1OfReal(1, n)
         for i, x in enumerate(t, 1):
             par.SetValue(i, float(x))
-        api = GeomAPI_PointsToBSpline(arr, par, 3, 8, GeomAbs_C2, tol3d)
+        api = GeomAPI_PointsToBSpline(arr, par, 3, deg_max, GeomAbs_C2, tol3d)
     else:
-        api = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, tol3d)
+        api = GeomAPI_PointsToBSpline(arr, 3, deg_max, GeomAbs_C2, tol3d)
     if not api.IsDone():
         return None
     c = api.Curve()
@@ -94,12 +95,12 @@ def _projected_deviation(curve: GHTCurve, bs: BSplineCurveData, dense: int = 200
     return float(np.linalg.norm(curve.evaluate(t) - q, axis=1).max())
 
 
-def _occt_search(curve: GHTCurve, tol: float, matched: bool, t_check: np.ndarray):
+def _occt_search(curve: GHTCurve, tol: float, matched: bool, t_check: np.ndarray, deg_max: int = 8):
     n = 16
     while n <= 4096:
         found = []
         for f in (1.0, 0.3, 0.1):
-            bs = _occt_fit(curve, n, f * tol, matched)
+            bs = _occt_fit(curve, n, f * tol, matched, deg_max)
             if bs is None:
                 continue
             dev = _matched_deviation(curve, bs, t_check) if matched else _projected_deviation(curve, bs)
@@ -107,7 +108,7 @@ def _occt_search(curve: GHTCurve, tol: float, matched: bool, t_check: np.ndarray
                 found.append((bs.poles.shape[0], f, dev))
         if found:
             poles, f, dev = min(found)
-            secs, _ = _timed(lambda: _occt_fit(curve, n, f * tol, matched))
+            secs, _ = _timed(lambda: _occt_fit(curve, n, f * tol, matched, deg_max))
             return {"poles": poles, "time": secs, "n": n, "f": f, "dev": dev}
         n *= 2
     return None
@@ -122,7 +123,8 @@ def main(argv: list[str] | None = None) -> int:
     t_check = np.concatenate([rng.uniform(0, 1, 20000), np.linspace(0, 1, 4001)])
     rows = []
     print(f"{'deg':>3} {'ours5 poles':>11} {'ms':>6} {'dev/tol':>7} {'ours8 poles':>11} {'ms':>6} | "
-          f"{'matched poles':>13} {'N':>5} {'ms':>6} | {'chord poles':>11} {'N':>5} {'ms':>7}")
+          f"{'matched poles':>13} {'N':>5} {'ms':>6} | {'chord poles':>11} {'N':>5} {'ms':>7} | "
+          f"{'matched5 poles':>14} {'N':>5} {'ms':>6}")
     for degree in range(2, 11):
         for _ in range(args.curves_per_degree):
             curve = GHTCurve(rng.normal(size=(degree + 1, 3)) * 10, *rng.uniform(-1, 1, 3))
@@ -137,15 +139,17 @@ def main(argv: list[str] | None = None) -> int:
                 ours[p] = {"poles": bs.poles.shape[0], "time": secs, "dev": dev}
             occ_m = _occt_search(curve, tol, True, t_check)
             occ_c = _occt_search(curve, tol, False, t_check)
-            rows.append((ours, occ_m, occ_c))
+            occ_5 = _occt_search(curve, tol, True, t_check, deg_max=5)
+            rows.append((ours, occ_m, occ_c, occ_5))
 
             def cell(o, w=13):
                 return f"{o['poles']:>{w}} {o['n']:>5} {1e3 * o['time']:>6.2f}" if o else f"{'failed':>{w}} {'':>5} {'':>6}"
 
             o5, o8 = ours[5], ours[8]
             print(f"{degree:>3} {o5['poles']:>11} {1e3 * o5['time']:>6.2f} {o5['dev'] / tol:>7.3f} "
-                  f"{o8['poles']:>11} {1e3 * o8['time']:>6.2f} | {cell(occ_m)} | {cell(occ_c, 11)}")
-    for label, k in (("matched parameters", 1), ("chord length + projection", 2)):
+                  f"{o8['poles']:>11} {1e3 * o8['time']:>6.2f} | {cell(occ_m)} | {cell(occ_c, 11)} | "
+                  f"{cell(occ_5, 14)}")
+    for label, k in (("matched parameters", 1), ("chord length + projection", 2), ("matched, DegMax 5", 3)):
         ok = [r for r in rows if r[k] is not None]
         if not ok:
             print(f"OCCT ({label}): never reached the tolerance")
