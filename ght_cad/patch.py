@@ -163,6 +163,44 @@ class GHTSurface:
         return GHTSurface(np.swapaxes(self._P, 0, 1), sv.mu, sv.nu, sv.gamma, su.mu, su.nu, su.gamma,
                           seed=self._seed_name)
 
+    def transformed(self, matrix: Any, offset: Any = None) -> "GHTSurface":
+        """Affine image ``A S(u,v) + b`` (exact: both bases are partitions of unity).
+
+        Args:
+            matrix: (dim, dim) linear part, or a (dim+1, dim+1) homogeneous matrix.
+            offset: translation b (dim,), only with a (dim, dim) matrix.
+        """
+        d = self.dim
+        A = np.asarray(matrix, dtype=float)
+        if A.shape == (d + 1, d + 1):
+            if offset is not None:
+                raise GHTError("offset must be omitted with a homogeneous matrix")
+            A, b = A[:d, :d], A[:d, d]
+        elif A.shape == (d, d):
+            b = np.zeros(d) if offset is None else np.asarray(offset, dtype=float).reshape(d)
+        else:
+            raise GHTError(f"matrix has shape {A.shape}; expected ({d}, {d}) or ({d+1}, {d+1})")
+        return self.with_control_points(self._P @ A.T + b)
+
+    def translated(self, offset: Any) -> "GHTSurface":
+        """Translated copy ``S(u, v) + b``."""
+        return self.transformed(np.eye(self.dim), offset)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form: ``{"control_points", "mu_u", "nu_u", "gamma_u", "mu_v", "nu_v",
+        "gamma_v", "seed"}``."""
+        keys = ("mu_u", "nu_u", "gamma_u", "mu_v", "nu_v", "gamma_v")
+        out: dict[str, Any] = {"control_points": self._P.tolist()}
+        out.update(dict(zip(keys, self.shape_parameters)))
+        out["seed"] = self._seed_name
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "GHTSurface":
+        """Inverse of :meth:`to_dict`."""
+        keys = ("mu_u", "nu_u", "gamma_u", "mu_v", "nu_v", "gamma_v")
+        return cls(data["control_points"], *(data.get(k, 0.0) for k in keys), seed=data.get("seed", "ght"))
+
     # -- evaluation --------------------------------------------------------------------------
     def _bases(self, u: Any, v: Any, du: int, dv: int) -> tuple[np.ndarray, np.ndarray, tuple]:
         uu, su = as_parameter_array(u, "u")

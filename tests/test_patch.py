@@ -152,6 +152,21 @@ def test_join_patches_across_v():
     assert np.allclose(j.derivative(u, 0.0, dv=1), 2.0 * a.derivative(u, 1.0, dv=1), atol=1e-10)
 
 
+def test_affine_invariance_and_round_trip():
+    rng = np.random.default_rng(9)
+    s = GHTSurface(rng.normal(size=(4, 5, 3)), 0.1, -0.2, 0.3, 0.4, -0.5, 0.6)
+    A = rng.normal(size=(3, 3))
+    b = rng.normal(size=3)
+    u, v = rng.uniform(0, 1, (2, 100))
+    assert np.allclose(s.transformed(A, b).evaluate(u, v), s.evaluate(u, v) @ A.T + b, atol=1e-12)
+    assert np.allclose(s.translated(b).evaluate(u, v), s.evaluate(u, v) + b, atol=1e-13)
+    back = GHTSurface.from_dict(s.to_dict())
+    assert back.shape_parameters == s.shape_parameters
+    assert np.array_equal(back.control_points, s.control_points)
+    with pytest.raises(GHTError, match="matrix"):
+        s.transformed(np.eye(2))
+
+
 def test_patch_errors():
     with pytest.raises(GHTError, match="shape"):
         GHTSurface(np.zeros((2, 3, 3)))
