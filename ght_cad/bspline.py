@@ -159,16 +159,21 @@ def _end_basis(knots: np.ndarray, degree: int, n_poles: int, end: int, orders: i
     """Matrix ``D[k, j] = N_j^(k)(end)`` for k = 0..orders-1 over the ``orders`` poles at that end.
 
     At a clamped end the first k+1 poles alone determine the k-th derivative, so ``D`` is
-    triangular with a nonzero diagonal.
+    triangular with a nonzero diagonal. Computed with the derivative-pole recurrence
+    ``P^(k)_i = (p-k+1) / (u_{i+p+1} - u_{i+k}) (P^(k-1)_{i+1} - P^(k-1)_i)``,
+    ``C^(k)(0) = P^(k)_0``; at t = 1 on the reversed knot vector with the sign ``(-1)^k``
+    (columns then ordered from the last pole inwards: column j is pole ``n-1-j``).
     """
-    from scipy.interpolate import BSpline
-
-    idx = np.arange(orders) if end == 0 else np.arange(n_poles - orders, n_poles)
-    coef = np.zeros((n_poles, orders))
-    coef[idx, np.arange(orders)] = 1.0
-    sp = BSpline(knots, coef, degree, extrapolate=False)
-    x = float(knots[0] if end == 0 else knots[-1])
-    return np.array([sp(x, nu=k) for k in range(orders)])  # (orders, orders): row k, column pole
+    p = int(degree)
+    u = np.asarray(knots, dtype=float)
+    if end == 1:
+        u = (u[-1] + u[0]) - u[::-1]
+    Q = np.eye(orders)
+    rows = [Q[0].copy()]
+    for k in range(1, orders):
+        Q = np.array([(p - k + 1) / (u[i + p + 1] - u[i + k]) * (Q[i + 1] - Q[i]) for i in range(orders - k)])
+        rows.append(Q[0] * (-1.0) ** k if end == 1 else Q[0])
+    return np.array(rows)
 
 
 def _call(func: Callable[[np.ndarray], np.ndarray], t: np.ndarray, dim: int | None) -> np.ndarray:
@@ -288,7 +293,7 @@ def fit_function(
             fixed[:r0] = np.linalg.solve(_end_basis(knots, p, n, 0, r0), ends[0])
             is_fixed[:r0] = True
         if r1:
-            fixed[n - r1 :] = np.linalg.solve(_end_basis(knots, p, n, 1, r1), ends[1])
+            fixed[n - r1 :] = np.linalg.solve(_end_basis(knots, p, n, 1, r1), ends[1])[::-1]
             is_fixed[n - r1 :] = True
         poles = fixed.copy()
         free = ~is_fixed
