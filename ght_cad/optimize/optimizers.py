@@ -204,7 +204,7 @@ class _Run:
         pop_size: int,
         max_iter: int | None,
         max_nfev: int | None,
-        evals_per_iter: int,
+        per_agent: int,
         tol: float,
         patience: int,
         target: float | None,
@@ -235,7 +235,8 @@ class _Run:
         if callback is not None and not callable(callback):
             raise GHTError(f"callback={callback!r} is not callable")
         self.callback = callback
-        self.max_iter = self._resolve_budget(max_iter, max_nfev, evals_per_iter)
+        self.per_iter = per_agent * self.pop
+        self.max_iter = self._resolve_budget(max_iter, max_nfev, self.per_iter)
         self.max_nfev = None if max_nfev is None else int(max_nfev)
         self.x0 = None
         if x0 is not None:
@@ -309,12 +310,10 @@ class _Run:
             if self.callback(state) is True:
                 return "stopped by callback"
         if nit >= self.max_iter:
-            if self.max_nfev is not None and self.nfev + self._per_iter_hint > self.max_nfev:
+            if self.max_nfev is not None and self.nfev + self.per_iter > self.max_nfev:
                 return "evaluation budget max_nfev reached"
             return "iteration budget max_iter reached"
         return None
-
-    _per_iter_hint = 0
 
     def result(self, nit: int, message: str) -> OptimizeResult:
         return OptimizeResult(
@@ -384,9 +383,8 @@ def pso(
     per component. Initial velocities are uniform in ``[-v_max (ub-lb), v_max (ub-lb)]``.
     """
     run = _Run("pso", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               per_agent=1, tol=tol, patience=patience,
                target=target, seed=seed, callback=callback, x0=x0)
-    run._per_iter_hint = run.pop
     rng, lb, ub = run.rng, run.lb, run.ub
     vmax = float(v_max) * (ub - lb)
     x = run.initial_population()
@@ -454,9 +452,8 @@ def gwo(
     wolf moves to ``X_GWO = (X_α* + X_β* + X_δ*) / 3``, clipped to the box.
     """
     run = _Run("gwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               per_agent=1, tol=tol, patience=patience,
                target=target, seed=seed, callback=callback, x0=x0)
-    run._per_iter_hint = run.pop
     rng, lb, ub = run.rng, run.lb, run.ub
     X = run.initial_population()
     fX = run.evaluate(X)
@@ -517,9 +514,8 @@ def igwo(
        ``X_GWO`` twice); the better candidate replaces ``X_i`` only if it improves on it.
     """
     run = _Run("igwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               evals_per_iter=2 * pop_size if isinstance(pop_size, int) else 1, tol=tol,
+               per_agent=2, tol=tol,
                patience=patience, target=target, seed=seed, callback=callback, x0=x0)
-    run._per_iter_hint = 2 * run.pop
     rng, lb, ub = run.rng, run.lb, run.ub
     N, D = run.pop, run.dim
     X = run.initial_population()
@@ -593,9 +589,8 @@ def differential_evolution(
     from scipy import optimize as _so
 
     run = _Run("de", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               evals_per_iter=pop_size if isinstance(pop_size, int) else 1, tol=tol, patience=patience,
+               per_agent=1, tol=tol, patience=patience,
                target=target, seed=seed, callback=callback, x0=x0, min_pop=5)
-    run._per_iter_hint = run.pop
     init = run.initial_population()
     state = {"calls": 0, "msg": None}
 
