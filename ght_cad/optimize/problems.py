@@ -33,7 +33,7 @@ import numpy as np
 from ..basis import bernstein
 from ..curve import GHTCurve, gauss_legendre
 from ..errors import GHTError
-from ..ruled import CurvePairRuledSurface, FunctionRuledSurface, RuledSurface
+from ..ruled import CurvePairRuledSurface, RuledSurface
 
 __all__ = [
     "ght_seed_jets",
