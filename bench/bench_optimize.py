@@ -27,7 +27,7 @@ import numpy as np
 
 from ght_cad.io import write_text_atomic
 from ght_cad.optimize import METHODS
-from ght_cad.optimize.compare import compare, format_table
+from ght_cad.optimize.compare import compare, format_table, set_target
 from ght_cad.optimize.pareto import pareto_front
 from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
 from ght_cad.progress import Progress
@@ -91,6 +91,17 @@ def main(argv: list[str] | None = None) -> int:
         verdict = "yes" if fewer("igwo") and fewer("pso") else "NO"
         print(f"  {name:30s} target {rs['de'].target:.4g}: {', '.join(cell(m) for m in ('igwo', 'pso', 'gwo'))}"
               f"   I-GWO and PSO fewer than DE: {verdict}")
+
+    print("\n## the same ratios for looser targets (fraction of the achievable improvement left: 0.1, 0.01, 0.001)")
+    for name in problems:
+        rs = [r for r in rows if r.problem == name]
+        cells = []
+        for rt in (0.1, 0.01, 0.001):
+            set_target(rs, rt)
+            d = {r.method: r.ratio for r in rs}
+            cells.append(f"rtol {rt:g}: " + " ".join(f"{m} {d[m]:.2f}" if np.isfinite(d[m]) else f"{m} -"
+                                                    for m in ("igwo", "pso", "gwo")))
+        print(f"  {name:30s} " + " | ".join(cells))
 
     print("\n## problem 1 (strip) before/after, best I-GWO run; problem 2 surfaces stay developable")
     best = min((r for r in rows if r.problem.startswith("strip") and r.method == "igwo"), key=lambda r: r.best)

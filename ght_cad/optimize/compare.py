@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import GHTError
 from .optimizers import METHODS, OptimizeResult
 
-__all__ = ["MethodStats", "compare", "format_table"]
+__all__ = ["MethodStats", "compare", "format_table", "set_target"]
 
 
 @dataclass
@@ -97,21 +97,38 @@ def compare(
                 worst=float(vals.max()), nfev=float(np.mean([r.nfev for r in runs])),
                 time=float(np.median([r.time for r in runs])), runs=runs,
             ))
-        f_best = min(r.best for r in rows)
-        f_init = float(np.median([run.history[0] for r in rows for run in r.runs]))
-        target = f_best + rtol * (f_init - f_best) if math.isfinite(f_init) else f_best
-        for r in rows:
-            hits = [run.nfev_to_reach(target) for run in r.runs]
-            n = np.array([math.inf if h is None else h for h in hits], dtype=float)
-            r.target = target
-            r.reached = int(np.sum(np.isfinite(n)))
-            r.nfev_to_target = float(np.median(n))
-        base = next((r for r in rows if r.method == baseline), None)
-        for r in rows:
-            if base is not None and math.isfinite(base.nfev_to_target) and base.nfev_to_target > 0:
-                r.ratio = r.nfev_to_target / base.nfev_to_target
+        set_target(rows, rtol, baseline)
         out.extend(rows)
     return out
+
+
+def set_target(rows: Sequence[MethodStats], rtol: float = 1e-3, baseline: str = "de") -> float:
+    """(Re)compute target, evaluations to target and ratios of the rows of ONE problem, in place.
+
+    ``target = f_best + rtol (f_init - f_best)`` (module docstring); returns the target.
+
+    Raises:
+        GHTError: rows of several problems, or ``rtol`` outside [0, 1].
+    """
+    if len({r.problem for r in rows}) != 1:
+        raise GHTError("set_target needs the rows of exactly one problem")
+    if not 0.0 <= float(rtol) <= 1.0:
+        raise GHTError(f"rtol={rtol!r} is not allowed; use a fraction in [0, 1]")
+    f_best = min(r.best for r in rows)
+    f_init = float(np.median([run.history[0] for r in rows for run in r.runs]))
+    target = f_best + rtol * (f_init - f_best) if math.isfinite(f_init) else f_best
+    for r in rows:
+        hits = [run.nfev_to_reach(target) for run in r.runs]
+        n = np.array([math.inf if h is None else h for h in hits], dtype=float)
+        r.target = target
+        r.reached = int(np.sum(np.isfinite(n)))
+        r.nfev_to_target = float(np.median(n))
+        r.ratio = math.nan
+    base = next((r for r in rows if r.method == baseline), None)
+    for r in rows:
+        if base is not None and math.isfinite(base.nfev_to_target) and base.nfev_to_target > 0:
+            r.ratio = r.nfev_to_target / base.nfev_to_target
+    return target
 
 
 def format_table(rows: Sequence[MethodStats], fmt: str = "markdown") -> str:
