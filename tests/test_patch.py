@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
-from ght_cad import GHTCurve, basis
+from ght_cad import basis
 from ght_cad.errors import GHTError, SingularJoinError
 from ght_cad.patch import GHTSurface, join_patches, measure_patch_continuity, patches_to_bspline
 
