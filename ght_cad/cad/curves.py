@@ -312,7 +312,9 @@ class GHTBezierLine(BaseEdgeObject):
     r"""Line object: a GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i`` as one certified edge.
 
     Use inside ``BuildLine`` (and hence ``BuildSketch``/``BuildPart``) like build123d's
-    ``Bezier``; outside a builder it is simply an ``Edge``.
+    ``Bezier``; outside a builder it is simply an ``Edge``. Wrap the builders in
+    :func:`exact_edges` so that build123d's clean-up does not re-approximate tangent-continuous
+    edges (see the module docstring).
 
     Args:
         *control_points: three or more points (VectorLike, or one sequence of them), or a single
@@ -352,7 +354,8 @@ class GHTCompositeLine(BaseLineObject):
     r"""Line object: a chain of GHT segments (CompositeCurve or list of GHTCurves) as one Wire.
 
     Use inside ``BuildLine``; ``BuildSketch``'s ``make_face()`` turns a closed chain into a face.
-    See :func:`ght_wire` for the arguments.
+    See :func:`ght_wire` for the arguments, and wrap the builders in :func:`exact_edges` (build123d
+    would otherwise merge the smooth chain into one re-approximated edge).
     """
 
     _applies_to = BaseLineObject._applies_to
