@@ -173,6 +173,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
         dest = Path(os.environ["ARTIFACTS_DIR"])
         dest.mkdir(parents=True, exist_ok=True)
         shutil.copy(shot, dest / "freecad_ght_workbench.png")
+        if (tmp_path / "ght_workbench_window.png").exists():
+            shutil.copy(tmp_path / "ght_workbench_window.png", dest / "freecad_ght_workbench_window.png")
     assert not res["errors"], res["errors"]
     assert res["workbenches"] and res["active_workbench"] == "GHTWorkbench"
     expected = {

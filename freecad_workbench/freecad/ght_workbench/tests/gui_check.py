@@ -189,7 +189,14 @@ def main():
         view.fitAll()
         path = os.path.join(OUT, "ght_workbench.png")
         view.saveImage(path, 1024, 768, "White")
-        return {"path": path, "size": os.path.getsize(path)}
+        # the whole main window too: menus, the GHT toolbar and the tree, as a user sees them
+        from PySide2 import QtWidgets
+        mw = Gui.getMainWindow()
+        mw.resize(1280, 860)
+        QtWidgets.QApplication.processEvents()
+        window = os.path.join(OUT, "ght_workbench_window.png")
+        grabbed = bool(mw.grab().save(window))
+        return {"path": path, "size": os.path.getsize(path), "window": window if grabbed else None}
 
     step("screenshot", screenshot)
 
