@@ -7,7 +7,7 @@ Subcommands::
     ght-cad curve ...                   one GHT-Bézier curve: properties, STEP edge, plots
     ght-cad surface DESIGN.toml ...     developable surface of a design: measures, STEP face, view
     ght-cad optimize DESIGN.toml ...    shape-parameter optimization of a design's surface
-    ght-cad unroll DESIGN.toml ...      flat pattern of a design's surface: DXF, SVG, PNG, errors
+    ght-cad unroll DESIGN.toml|FILE.step  flat pattern of a design's surface or a STEP file's faces
     ght-cad export DESIGN.toml FILE...  write a design's result to STEP/DXF/SVG/JSON/PNG by suffix
     ght-cad plot-basis ...              PNG of the GHT-Bernstein basis for chosen shape parameters
 
@@ -329,23 +329,21 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 
 def cmd_unroll(args: argparse.Namespace) -> int:
-    """``ght-cad unroll``: flat pattern of a design's surface with its relative errors."""
+    """``ght-cad unroll``: flat pattern of a design's surface, or of the faces of a STEP file."""
+    if Path(args.design).suffix.lower() in (".step", ".stp"):
+        return _unroll_step(args)
+    for opt, val in (("--face", args.face), ("--best-effort", args.best_effort or None), ("--units", args.units),
+                     ("--tol-deg", args.tol_deg), ("--rulings", args.rulings)):
+        if val is not None:
+            raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file); "
+                             "allowed for design files: --dxf, --svg, --png, --json")
     from .design import build_surface, unroll_surface
 
     design = _load(args)
     built = build_surface(design)
     pattern = unroll_surface(built)
     result: dict[str, Any] = {"command": "unroll", "name": design.name, "errors": _errors_dict(pattern), "outputs": {}}
-    if args.dxf:
-        pattern.export_dxf(args.dxf)
-        result["outputs"]["dxf"] = str(args.dxf)
-    if args.svg:
-        pattern.export_svg(args.svg)
-        result["outputs"]["svg"] = str(args.svg)
-    if args.png:
-        from .design import plot_pattern
-
-        result["outputs"]["png"] = str(plot_pattern(pattern, args.png, title=design.name))
+    result["outputs"] = _write_pattern(args, pattern, design.name)
 
     def text(r: dict[str, Any]) -> str:
         s = f"{r['name']}: flat pattern errors " + ", ".join(
@@ -353,6 +351,61 @@ def cmd_unroll(args: argparse.Namespace) -> int:
         )
         out = _outputs_text(r)
         return s + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def _write_pattern(args: argparse.Namespace, pattern: Any, title: str) -> dict[str, str]:
+    """Write ``--dxf``/``--svg``/``--png`` (each atomically); returns ``{kind: path}``."""
+    out: dict[str, str] = {}
+    if args.dxf:
+        pattern.export_dxf(args.dxf)
+        out["dxf"] = str(args.dxf)
+    if args.svg:
+        pattern.export_svg(args.svg)
+        out["svg"] = str(args.svg)
+    if args.png:
+        from .design import plot_pattern
+
+        out["png"] = str(plot_pattern(pattern, args.png, title=title))
+    return out
+
+
+def _unroll_step(args: argparse.Namespace) -> int:
+    """``ght-cad unroll FILE.step``: one panel per (selected) face; refuses non-developable faces."""
+    from .design import unroll_step
+
+    tol = 0.01 if args.tol_deg is None else args.tol_deg
+    res = unroll_step(args.design, faces=args.face, best_effort=args.best_effort, units=args.units,
+                      tol_deg=tol, rulings=args.rulings if args.rulings is not None else 16)
+    pattern = res.pattern
+    name = Path(args.design).name
+    result: dict[str, Any] = {
+        "command": "unroll",
+        "name": name,
+        "source": str(args.design),
+        "units": res.units,
+        "file_units": res.file_units,
+        "face_count": res.face_count,
+        "panels": len(pattern.panels),
+        "area": float(pattern.area),
+        "errors": _errors_dict(pattern),
+        "faces": res.faces,
+        "outputs": {},
+    }
+    result["outputs"] = _write_pattern(args, pattern, name)
+
+    def text(r: dict[str, Any]) -> str:
+        lines = [f"{r['name']}: {r['panels']} panel(s) of {r['face_count']} face(s), units {r['units']}, "
+                 f"flat area {r['area']:.9g}"]
+        for f in r["faces"]:
+            d = f.get("developability")
+            dev = f", theta_max={d['theta_max']:.3e} deg" if d else ""
+            lines.append(f"  F{f['face']}: {f['surface_type']} ({f['method']}){dev}, max rel. error "
+                         f"{max(f['errors'].get(k, 0.0) for k in ('boundary_length', 'ruling_length', 'area')):.2e}")
+        out = _outputs_text(r)
+        return "\n".join(lines) + ("\n" + out if out else "")
 
     _emit(args, result, text)
     return EXIT_OK
@@ -489,15 +542,29 @@ def build_parser() -> argparse.ArgumentParser:
 
     sp = sub.add_parser(
         "unroll",
-        help="flat pattern of a design's surface (DXF, SVG, PNG) with its errors",
-        description="Unroll the design's developable surface into the plane (spec section 6) and "
-        "report the relative length and area errors of the pattern.",
+        help="flat pattern (DXF, SVG, PNG) of a design's surface or of a STEP file's faces",
+        description="Unroll a developable surface into the plane (spec section 6) and report the "
+        "relative length and area errors of the pattern. FILE is a design file (.toml) or a STEP "
+        "file (.step/.stp, detected by suffix) made by any CAD tool: every developable face "
+        "(cylinder, cone, plane, extrusion, ruled B-spline) becomes one labelled panel F<n> "
+        "(n = face number), with matching edge marks on edges shared by two faces. A face that is "
+        "not developable within --tol-deg is refused (exit 2, naming the face and its theta_max "
+        "and DD) unless --best-effort is given.",
         epilog=_EPILOG,
     )
-    design_arg(sp)
-    sp.add_argument("--dxf", metavar="FILE", help="write the pattern as DXF")
+    sp.add_argument("design", metavar="FILE", help="design file (.toml, docs/design-files.md) or STEP file (.step/.stp)")
+    sp.add_argument("--dxf", metavar="FILE", help="write the pattern as DXF (layers OUTLINE, BEND, LABELS, MARKS)")
     sp.add_argument("--svg", metavar="FILE", help="write the pattern as SVG")
     sp.add_argument("--png", metavar="FILE", help="plot of the pattern (900x700 px)")
+    sp.add_argument("--face", type=int, action="append", metavar="N",
+                    help="STEP only: unroll face N (1-based, file order; repeatable; default all faces)")
+    sp.add_argument("--best-effort", action="store_true",
+                    help="STEP only: flatten non-developable faces anyway and report their distortion")
+    sp.add_argument("--units", choices=("mm", "cm", "m", "in", "ft"),
+                    help="STEP only: unit of the pattern (default: the file's length unit, else mm)")
+    sp.add_argument("--tol-deg", type=float, metavar="DEG",
+                    help="STEP only: largest accepted theta_max in degrees (default 0.01)")
+    sp.add_argument("--rulings", type=int, metavar="N", help="STEP only: bend lines per face (default 16)")
     common(sp)
     sp.set_defaults(func=cmd_unroll)
 

@@ -1,0 +1,160 @@
+"""`ght-cad unroll FILE.step`: developable faces of a STEP file → one labelled panel per face.
+
+STEP files are written into tmp_path from the project's own faces (an exact quarter cone from
+control planes, a shell of two G2-joined strips) and from build123d (cylinder, cone), plus a
+twisted bilinear patch that is not developable.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import build123d as bd
+import ezdxf
+import numpy as np
+import pytest
+
+from ght_cad.bspline import BSplineSurfaceData
+from ght_cad.cad.occ import make_face, write_step
+from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.developable import CompositeDevelopable, developable_from_planes, join_developable
+
+RTOL = 1e-9
+
+# strips of the duct transition of examples/design_duct_two_strips.toml (planes through an apex)
+STRIP_A = [[-0.996546, 0.996546, 0.0, -0.083045], [-0.99876, 0.864952, 0.49938, -0.049778],
+           [-0.999133, 0.499567, 0.865275, 0.041631], [-0.986394, 0.0, 0.986394, 0.164399]]
+STRIP_B = [[-0.978638, -0.169939, 0.96377, 0.205591], [-0.969645, -0.331638, 0.911168, 0.244517],
+           [-0.96, -0.48, 0.831384, 0.28], [-0.941433, -0.721179, 0.605141, 0.3372],
+           [-0.927967, -0.872004, 0.317383, 0.372662], [-0.923077, -0.923077, 0.0, 0.384615]]
+ENDS = [[0, 0, 0, 1], [-2.5, -0.15, 0, 1]]
+
+
+def _face(shape, kind):
+    return next(f for f in shape.faces() if f.geom_type == kind)
+
+
+def _run(argv: list[str], capsys) -> tuple[int, dict, str]:
+    rc = main(argv + ["--json"])
+    cap = capsys.readouterr()
+    return rc, json.loads(cap.out), cap.err
+
+
+def _dxf(path: Path) -> dict:
+    doc = ezdxf.readfile(path)
+    msp = doc.modelspace()
+    outlines = [e for e in msp if e.dxftype() == "LWPOLYLINE" and e.dxf.layer == "OUTLINE"]
+    assert outlines and all(e.closed for e in outlines)
+    return {
+        "layers": {layer.dxf.name for layer in doc.layers},
+        "outlines": [np.array([(p[0], p[1]) for p in e.get_points()]) for e in outlines],
+        "bends": [e for e in msp if e.dxftype() == "LINE" and e.dxf.layer == "BEND"],
+        "labels": [e.dxf.text for e in msp if e.dxftype() == "TEXT"],
+        "insunits": doc.header["$INSUNITS"],
+    }
+
+
+def test_cylinder_step_is_r_theta_by_h(tmp_path: Path, capsys) -> None:
+    R, H, arc = 30.0, 50.0, 120.0
+    step = tmp_path / "cyl.step"
+    write_step(_face(bd.Solid.make_cylinder(R, H, angle=arc), bd.GeomType.CYLINDER), step)
+    rc, out, err = _run(["unroll", str(step), "--dxf", str(tmp_path / "c.dxf"), "--rulings", "5"], capsys)
+    assert rc == EXIT_OK, err
+    assert out["units"] == "mm" and out["file_units"] == "millimetre" and out["panels"] == 1
+    d = _dxf(tmp_path / "c.dxf")
+    assert {"OUTLINE", "BEND", "LABELS", "MARKS"} <= d["layers"] and d["insunits"] == 4
+    assert len(d["outlines"]) == 1 and len(d["bends"]) == 5 and "F1" in d["labels"]
+    ext = np.sort(np.ptp(d["outlines"][0], axis=0))
+    np.testing.assert_allclose(ext, np.sort([R * math.radians(arc), H]), rtol=RTOL)
+    np.testing.assert_allclose(out["area"], R * math.radians(arc) * H, rtol=RTOL)
+
+
+def test_cone_step_units_and_annular_sector(tmp_path: Path, capsys) -> None:
+    """A cone written in mm, unrolled in cm: the annular sector of spec section 6, scaled by 1/10."""
+    r1, r2, h, arc = 20.0, 40.0, 30.0, 90.0
+    step = tmp_path / "cone.stp"
+    write_step(_face(bd.Solid.make_cone(r1, r2, h, angle=arc), bd.GeomType.CONE), step)
+    rc, out, err = _run(["unroll", str(step), "--units", "cm", "--svg", str(tmp_path / "c.svg")], capsys)
+    assert rc == EXIT_OK, err
+    slant = math.hypot(r2 - r1, h)
+    rho2, rho1 = r2 * slant / (r2 - r1), r1 * slant / (r2 - r1)
+    angle = math.radians(arc) * r2 / rho2
+    assert out["units"] == "cm"
+    np.testing.assert_allclose(out["area"], 0.5 * angle * (rho2**2 - rho1**2) / 100.0, rtol=RTOL)
+    assert out["errors"]["max"] < RTOL
+    assert (tmp_path / "c.svg").read_text().lstrip().startswith("<")
+
+
+def test_project_face_and_two_strip_shell(tmp_path: Path, capsys) -> None:
+    """An exact quarter cone from control planes, and a shell of two G2-joined strips: one panel
+    per face, the shared ruling marked on both panels, each panel's area = its strip's area."""
+    from ght_cad.cad.developable_faces import composite_shell
+    from ght_cad.unroll import ruled_area
+
+    quarter = developable_from_planes([[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]],
+                                      [[0, 0, 0, 1], [-400, 0, 0, 1]], 0, 0, -1)
+    write_step(quarter.to_face(), tmp_path / "q.step")
+    rc, out, err = _run(["unroll", str(tmp_path / "q.step")], capsys)
+    assert rc == EXIT_OK, err
+    rho2 = math.hypot(400, 800)
+    ang = (math.pi / 2) * 400 / rho2
+    np.testing.assert_allclose(out["area"], 0.5 * ang * (rho2**2 - (rho2 / 2) ** 2), rtol=1e-7)  # fit tol 1e-7
+
+    a = developable_from_planes(STRIP_A, ENDS, gamma=-1.0)
+    b = join_developable(a, "G2", STRIP_B, mu=0.0, nu=0.0, gamma=-1.0)
+    comp = CompositeDevelopable([a, b])
+    write_step(composite_shell(comp), tmp_path / "duct.step")
+    rc, out, err = _run(["unroll", str(tmp_path / "duct.step"), "--dxf", str(tmp_path / "d.dxf")], capsys)
+    assert rc == EXIT_OK, err
+    assert out["face_count"] == 2 and out["panels"] == 2
+    d = _dxf(tmp_path / "d.dxf")
+    assert len(d["outlines"]) == 2 and {"F1", "F2"} <= set(d["labels"])
+    marks = [t for t in d["labels"] if t.startswith("E")]
+    assert marks == ["E1", "E1"]  # the joint ruling, marked on both panels
+    areas = sorted(f["area_flat"] for f in out["faces"])
+    np.testing.assert_allclose(areas, sorted([ruled_area(a), ruled_area(b)]), rtol=1e-7)  # B-spline fit 1e-7
+    for f in out["faces"]:
+        assert f["developability"]["theta_max"] < 1e-3  # B-spline fit of a tolerance-1e-7 strip
+        np.testing.assert_allclose(f["area_flat"], f["area_3d"], rtol=1e-12)
+
+    # --face picks one face; a face number out of range is exit 2
+    rc, out, _ = _run(["unroll", str(tmp_path / "duct.step"), "--face", "2"], capsys)
+    assert rc == EXIT_OK and out["panels"] == 1 and out["faces"][0]["label"] == "F2"
+    rc, out, err = _run(["unroll", str(tmp_path / "duct.step"), "--face", "3"], capsys)
+    assert rc == EXIT_USAGE and "face 3 does not exist; allowed: face numbers 1..2" in out["error"]
+
+
+def test_twisted_face_is_refused_then_best_effort(tmp_path: Path, capsys) -> None:
+    net = np.array([[[0, 0, 0], [0, 10, 10]], [[10, 0, 0], [10, 10, 0]]], float)
+    step = tmp_path / "twist.step"
+    write_step([make_face(BSplineSurfaceData(net, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)),
+                _face(bd.Solid.make_cylinder(3.0, 5.0, angle=90), bd.GeomType.CYLINDER)], step)
+    dxf = tmp_path / "t.dxf"
+    rc = main(["unroll", str(step), "--dxf", str(dxf)])
+    err = capsys.readouterr().err
+    assert rc == EXIT_USAGE and not dxf.exists()
+    assert err.count("\n") == 1
+    assert f"{step}: face 1 of 2 is not developable within tol_deg=0.01: theta_max=45 deg" in err
+    assert "DD=0.75" in err and "--best-effort" in err
+    rc, out, err = _run(["unroll", str(step), "--face", "2"], capsys)  # the cylinder alone is fine
+    assert rc == EXIT_OK and out["faces"][0]["surface_type"] == "cylinder"
+    rc, out, err = _run(["unroll", str(step), "--best-effort", "--dxf", str(dxf)], capsys)
+    assert rc == EXIT_OK and dxf.exists() and out["panels"] == 2
+    twisted = out["faces"][0]
+    assert twisted["best_effort"] and twisted["developability"]["theta_max"] == pytest.approx(45.0, rel=1e-6)
+    assert out["errors"]["area"] > 1e-3  # the distortion is reported
+
+
+def test_step_input_errors(tmp_path: Path, capsys) -> None:
+    rc, out, _ = _run(["unroll", str(tmp_path / "missing.step")], capsys)
+    assert rc == EXIT_USAGE and "missing.step: no such STEP file" in out["error"]
+    bad = tmp_path / "bad.step"
+    bad.write_text("not a step file\n")
+    rc, out, _ = _run(["unroll", str(bad)], capsys)
+    assert rc == EXIT_USAGE and "not a readable STEP file" in out["error"]
+    toml = tmp_path / "d.toml"
+    toml.write_text("[surface]\nplanes = [[0,1,0,0],[0,1,1,0],[0,0,1,0]]\nboundary_planes = [[0,0,0,1],[-1,0,0,1]]\n")
+    rc, out, _ = _run(["unroll", str(toml), "--face", "1"], capsys)
+    assert rc == EXIT_USAGE and "--face applies to STEP input only" in out["error"]
