@@ -276,7 +276,7 @@ def _report_text(r: dict[str, Any]) -> str:
 
 def cmd_surface(args: argparse.Namespace) -> int:
     """``ght-cad surface``: developability degree (θ_max, θ_rms, DD, R) of a design's surface."""
-    from .design import build_surface, surface_summary
+    from .design import build_surface, surface_summary, surface_view
 
     design = _load(args)
     built = build_surface(design)
@@ -288,7 +288,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
     if args.plot:
         from .plotting import plot_surface
 
-        result["outputs"]["surface_png"] = str(plot_surface(built.surface, args.plot, title=design.name))
+        result["outputs"]["surface_png"] = str(plot_surface(surface_view(built), args.plot, title=design.name))
 
     def text(r: dict[str, Any]) -> str:
         d = r["developability"]

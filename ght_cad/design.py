@@ -36,6 +36,7 @@ __all__ = [
     "Design",
     "CurveSpec",
     "JoinSpec",
+    "SegmentSpec",
     "SurfaceSpec",
     "OptimizeSpec",
     "UnrollSpec",
@@ -48,6 +49,9 @@ __all__ = [
     "build_curves",
     "build_surface",
     "BuiltSurface",
+    "brep_shape",
+    "shared_edge_count",
+    "surface_view",
     "unroll_step",
     "StepUnroll",
     "MM_PER_UNIT",
@@ -71,7 +75,9 @@ METHODS = ("pso", "gwo", "igwo")
 #: objectives: fairness of the dual curve (planes) or developability R (curve-pair strips)
 PLANE_OBJECTIVES = ("AL", "En", "CVEn", "weighted")
 STRIP_OBJECTIVES = ("R",)
-SURFACE_TYPES = ("planes", "curves")
+SURFACE_TYPES = ("planes", "curves", "composite")
+#: joins between the strips of a composite surface (spec 5.6)
+STRIP_JOINS = ("G1", "G2", "G3")
 CONTINUITIES = ("C0", "C1", "C2", "C3", "G0", "G1", "G2", "G3")
 UNITS = ("mm", "cm", "m", "in", "ft")
 SHAPE_NAMES = ("mu", "nu", "gamma")
@@ -118,8 +124,29 @@ class JoinSpec:
 
 
 @dataclass
+class SegmentSpec:
+    """One strip of a ``composite`` surface: an enveloping developable of control planes.
+
+    Strip 0 is built from its planes (spec 5.2); strip i > 0 is joined to strip i-1 with
+    ``continuity`` (G1/G2/G3) by :func:`ght_cad.developable.join_developable`, which re-solves
+    its first ``r+1`` control planes (``r`` = the order) and keeps the others.
+    """
+
+    name: str
+    planes: list[list[float]]
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+    continuity: str | None = None
+    k: float = 1.0
+    beta2: float = 0.0
+    beta3: float = 0.0
+
+
+@dataclass
 class SurfaceSpec:
-    """The design's surface: ``type = "planes"`` (spec 5.2) or ``"curves"`` (ruled strip)."""
+    """The design's surface: ``type = "planes"`` (spec 5.2), ``"curves"`` (ruled strip) or
+    ``"composite"`` (several strips from control planes joined G1/G2/G3, spec 5.6)."""
 
     type: str
     planes: list[list[float]] | None = None
@@ -130,6 +157,7 @@ class SurfaceSpec:
     curve_a: str | None = None
     curve_b: str | None = None
     normalize: bool = True
+    segments: list[SegmentSpec] | None = None
 
 
 @dataclass
@@ -438,6 +466,8 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
             shape = {k: ck.number(st, k, "surface", 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
             normalize = ck.boolean(st, "normalize", "surface", True)
             surface = SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
+        elif stype == "composite":
+            surface = _parse_composite(ck, st)
         else:
             ck.keys(st, "surface", ("type", "curve_a", "curve_b"))
             names = sorted(seen)
@@ -459,6 +489,9 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     if ot is not None:
         if surface is None:
             raise ck.fail("optimize", "needs a [surface] table to optimize")
+        if surface.type == "composite":
+            raise ck.fail("optimize", "is not available for a composite surface (its strips are joined with "
+                          "their given shape parameters); allowed: [optimize] with surface.type planes or curves")
         ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
         method = ck.string(ot, "method", "optimize", "igwo", choices=METHODS)
         objs = PLANE_OBJECTIVES if surface.type == "planes" else STRIP_OBJECTIVES
@@ -522,6 +555,56 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     if not outputs.files and not outputs.figures:
         raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
     return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source)
+
+
+_SEGMENT_KEYS = ("name", "planes", "mu", "nu", "gamma", "continuity", "k", "beta2", "beta3")
+
+
+def _parse_composite(ck: _Checker, st: dict) -> SurfaceSpec:
+    """``[surface] type = "composite"``: shared boundary planes and ``[[surface.segments]]``."""
+    ck.keys(st, "surface", ("type", "boundary_planes", "normalize", "segments"))
+    bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
+    for i, r in enumerate(bplanes or []):
+        if math.hypot(*r[1:]) < 1e-12:
+            raise ck.fail(f"surface.boundary_planes[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane "
+                          "u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
+    normalize = ck.boolean(st, "normalize", "surface", True)
+    raw = ck.required(st, "segments", "surface", "an array of at least 2 tables [[surface.segments]]")
+    if not isinstance(raw, list) or not all(isinstance(x, dict) for x in raw):
+        raise ck.fail("surface.segments", f"expected an array of tables [[surface.segments]], got {_tname(raw)} {_short(raw)}")
+    if len(raw) < 2:
+        raise ck.fail("surface.segments", f"has {len(raw)} strip(s); allowed: at least 2 (one strip: use type = \"planes\")")
+    segs: list[SegmentSpec] = []
+    names: set[str] = set()
+    prev: dict[str, float] = {k: 0.0 for k in SHAPE_NAMES}
+    for i, t in enumerate(raw):
+        path = f"surface.segments[{i}]"
+        ck.keys(t, path, _SEGMENT_KEYS)
+        name = ck.string(t, "name", path, f"strip{i + 1}")
+        if name in names:
+            raise ck.fail(f"{path}.name", f"{name!r} is used twice; allowed: a name unique among the strips")
+        names.add(name)
+        if i == 0:
+            for key in ("continuity", "k", "beta2", "beta3"):
+                if key in t:
+                    raise ck.fail(f"{path}.{key}", "the first strip has no joint before it; allowed: "
+                                  "continuity, k, beta2, beta3 on segments[1] and later")
+            cont, k, b2, b3 = None, 1.0, 0.0, 0.0
+        else:
+            cont = ck.string(t, "continuity", path, "G1", choices=STRIP_JOINS)
+            k = ck.number(t, "k", path, 1.0, lo=0.0, lo_open=True)
+            b2 = ck.number(t, "beta2", path, 0.0)
+            b3 = ck.number(t, "beta3", path, 0.0)
+        order = int(cont[1]) if cont else 0
+        planes = ck.matrix(t, "planes", path, cols=(4,), min_rows=max(3, order + 1))
+        for j, r in enumerate(planes or []):
+            if math.hypot(*r[1:]) < 1e-12:
+                raise ck.fail(f"{path}.planes[{j}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane with a non-zero normal")
+        # shape parameters default to the previous strip's (as join_developable does)
+        shape = {key: ck.number(t, key, path, prev[key], lo=-1.0, hi=1.0) for key in SHAPE_NAMES}
+        prev = shape
+        segs.append(SegmentSpec(name, planes, shape["mu"], shape["nu"], shape["gamma"], cont, k, b2, b3))  # type: ignore[arg-type]
+    return SurfaceSpec("composite", boundary_planes=bplanes, normalize=normalize, segments=segs)
 
 
 def parse_design_text(text: str, source: str = "<design>") -> Design:
@@ -626,6 +709,8 @@ class BuiltSurface:
 def _shape_names(spec: SurfaceSpec) -> tuple[str, ...]:
     if spec.type == "planes":
         return SHAPE_NAMES
+    if spec.type == "composite":
+        return tuple(f"{g.name}.{k}" for g in spec.segments or [] for k in SHAPE_NAMES)
     return tuple(f"{s}.{k}" for s in ("a", "b") for k in SHAPE_NAMES)
 
 
@@ -634,6 +719,8 @@ def _initial_shape(design: Design, curves: dict[str, Any]) -> dict[str, float]:
     assert spec is not None
     if spec.type == "planes":
         return {"mu": spec.mu, "nu": spec.nu, "gamma": spec.gamma}
+    if spec.type == "composite":
+        return {f"{g.name}.{k}": float(getattr(g, k)) for g in spec.segments or [] for k in SHAPE_NAMES}
     out = {}
     for side, cname in (("a", spec.curve_a), ("b", spec.curve_b)):
         c = curves[cname]
@@ -650,11 +737,94 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
         return developable_from_planes(
             spec.planes, spec.boundary_planes, shape["mu"], shape["nu"], shape["gamma"], normalize=spec.normalize
         )
+    if spec.type == "composite":
+        return _make_composite(design, shape)
     from .ruled import CurvePairRuledSurface
 
     ca = curves[spec.curve_a].with_shape(shape["a.mu"], shape["a.nu"], shape["a.gamma"])
     cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
     return CurvePairRuledSurface(ca, cb)
+
+
+def _make_composite(design: Design, shape: dict[str, float]) -> Any:
+    r"""Strips of a ``composite`` surface: strip 0 from its planes, strip i joined to strip i-1.
+
+    Join (spec 5.6): the 4-D dual curves meet with ``V(0) = U(1)`` and G1 ``V' = k U'``,
+    G2 ``V'' = k² U'' + β2 U'``, G3 ``V''' = k³ U''' + 3kβ2 U'' + β3 U'``
+    (:func:`ght_cad.developable.join_developable`); all strips share the boundary planes, so
+    consecutive strips share their joint ruling segment.
+
+    Raises:
+        GHTError: a join that cannot be solved or a degenerate strip, naming the segment.
+    """
+    from .developable import CompositeDevelopable, developable_from_planes, join_developable
+    from .planes import normalize_planes
+
+    spec = design.surface
+    assert spec is not None and spec.segments
+    segs: list[Any] = []
+    for i, g in enumerate(spec.segments):
+        P = np.asarray(g.planes, dtype=float)
+        if spec.normalize:
+            P = normalize_planes(P)
+        sh = {k: shape[f"{g.name}.{k}"] for k in SHAPE_NAMES}
+        try:
+            if i == 0:
+                segs.append(developable_from_planes(P, spec.boundary_planes, sh["mu"], sh["nu"], sh["gamma"]))
+            else:
+                segs.append(join_developable(segs[-1], g.continuity or "G1", P, mu=sh["mu"], nu=sh["nu"],
+                                             gamma=sh["gamma"], k=g.k, beta2=g.beta2, beta3=g.beta3))
+        except GHTError as exc:
+            raise type(exc)(f"{design.source}: key 'surface.segments[{i}]' ({g.name}): {' '.join(str(exc).split())}") from None
+    try:
+        comp = CompositeDevelopable(segs)
+    except GHTError as exc:
+        raise type(exc)(f"{design.source}: key 'surface.segments': {' '.join(str(exc).split())}") from None
+    comp.names = [g.name for g in spec.segments]  # type: ignore[attr-defined]
+    return comp
+
+
+def _is_composite(surface: Any) -> bool:
+    return hasattr(surface, "segments") and hasattr(surface, "joints")
+
+
+def _developability_dict(surface: Any) -> dict[str, float]:
+    """Developability degree of a surface; for a composite the worst strip per quantity
+    (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed)."""
+    if not _is_composite(surface):
+        return surface.developability().as_dict()
+    ds = [d.as_dict() for d in surface.developability()]
+    return {
+        "theta_max": max(d["theta_max"] for d in ds),
+        "theta_rms": float(math.sqrt(sum(d["theta_rms"] ** 2 for d in ds) / len(ds))),
+        "dd": min(d["dd"] for d in ds),
+        "R": float(sum(d["R"] for d in ds)),
+        "residual_max": max(d["residual_max"] for d in ds),
+    }
+
+
+class _CompositeView:
+    """A composite surface seen as one ruled strip for plots: ``grid`` and ``theta`` by strip."""
+
+    def __init__(self, composite: Any) -> None:
+        self.segments = list(composite.segments)
+
+    def _split(self, n: int) -> list[int]:
+        k = len(self.segments)
+        return [max(2, n // k + (1 if i < n % k else 0)) for i in range(k)]
+
+    def grid(self, nu: int, nv: int) -> np.ndarray:
+        return np.concatenate([s.grid(m, nv) for s, m in zip(self.segments, self._split(int(nu)))], axis=0)
+
+    def theta(self, u: Any) -> np.ndarray:
+        n = int(np.size(u))
+        return np.concatenate([np.asarray(s.theta(np.linspace(0.0, 1.0, m)), dtype=float)
+                               for s, m in zip(self.segments, self._split(n))])
+
+
+def surface_view(built: "BuiltSurface") -> Any:
+    """What :func:`ght_cad.plotting.plot_surface` draws: the surface, or all strips of a composite."""
+    return _CompositeView(built.surface) if _is_composite(built.surface) else built.surface
 
 
 def build_surface(design: Design, shape: dict[str, float] | None = None,
@@ -695,8 +865,17 @@ def ruled_area(surface: Any, nodes: int = 64) -> float:
 
 
 def surface_summary(built: BuiltSurface) -> dict[str, Any]:
-    """Developability degree (θ_max, θ_rms, DD, R), area and shape parameters of a built surface."""
+    """Developability degree (θ_max, θ_rms, DD, R), area and shape parameters of a built surface.
+
+    A composite surface also gets ``surface.strips`` (per strip: name, shape parameters, area,
+    ruling lengths, developability) and ``surface.joints`` (per joint: requested continuity, the
+    order measured by :func:`ght_cad.developable.measure_developable_joint`, its residuals, the
+    angle between the end tangent planes and the ruling distance); ``developability`` is then the
+    worst strip's (see ``_developability_dict``).
+    """
     s = built.surface
+    if _is_composite(s):
+        return _composite_summary(built)
     dev = s.developability()
     out: dict[str, Any] = {
         "surface": {
@@ -715,6 +894,57 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
         out["surface"]["normalized"] = bool(spec.normalize)
         out["surface"]["edge_of_regression"] = "outside the strip (checked on construction)"
     return out
+
+
+def _composite_summary(built: BuiltSurface) -> dict[str, Any]:
+    from .unroll import ruled_area as exact_area
+
+    comp = built.surface
+    spec = built.design.surface
+    assert spec is not None and spec.segments
+    u = np.linspace(0, 1, 257)
+    strips = []
+    for g, seg, dev in zip(spec.segments, comp.segments, comp.developability()):
+        L = seg.ruling_lengths(u)
+        strips.append({
+            "name": g.name,
+            "shape_parameters": {k: float(getattr(g, k)) for k in SHAPE_NAMES},
+            "control_planes": np.asarray(seg.planes).tolist(),
+            "area_3d": exact_area(seg),
+            "ruling_length_min": float(np.min(L)),
+            "ruling_length_max": float(np.max(L)),
+            "developability": dev.as_dict(),
+        })
+    joints = []
+    for i, (g, rep) in enumerate(zip(spec.segments[1:], comp.joints())):
+        joints.append({
+            "first": spec.segments[i].name,
+            "second": g.name,
+            "requested": g.continuity,
+            "k": g.k,
+            "beta2": g.beta2,
+            "beta3": g.beta3,
+            "achieved_G": int(rep.order),
+            "satisfied": bool(rep.satisfies(g.continuity or "G1")),
+            "residuals": [float(r) for r in rep.residuals],
+            "plane_angle_deg": float(rep.plane_angle),
+            "ruling_distance": float(rep.ruling_distance),
+            "tol": float(rep.tol),
+        })
+    return {
+        "surface": {
+            "type": "composite",
+            "shape_parameters": dict(built.shape),
+            "area_3d": float(sum(x["area_3d"] for x in strips)),
+            "ruling_length_min": min(x["ruling_length_min"] for x in strips),
+            "ruling_length_max": max(x["ruling_length_max"] for x in strips),
+            "boundary_planes": np.asarray(comp.segments[0].boundary_planes).tolist(),
+            "normalized": bool(spec.normalize),
+            "strips": strips,
+            "joints": joints,
+        },
+        "developability": _developability_dict(comp),
+    }
 
 
 # ---------------------------------------------------------------------------------------------
@@ -916,6 +1146,30 @@ def brep_face(built: BuiltSurface, tol: float | None = None) -> Any:
     return _ruled_face(s, tol)
 
 
+def brep_shape(built: BuiltSurface, tol: float | None = None) -> Any:
+    """The B-rep of the built surface: one face (:func:`brep_face`), or for a composite one shell
+    of one B-spline face per strip sewn along the joint rulings
+    (:func:`ght_cad.cad.developable_faces.composite_shell`)."""
+    if _is_composite(built.surface):
+        from .cad.developable_faces import composite_shell
+
+        return composite_shell(built.surface, tol=tol)
+    return brep_face(built, tol)
+
+
+def shared_edge_count(shape: Any) -> int:
+    """Number of edges of a B-rep shared by two or more of its faces (``TopExp`` edge→face map)."""
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    from .cad.occ import unwrap
+
+    m = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(unwrap(shape), TopAbs_EDGE, TopAbs_FACE, m)
+    return sum(1 for i in range(1, m.Extent() + 1) if m.FindFromIndex(i).Size() >= 2)
+
+
 def curve_edges(curves: dict[str, Any]) -> list[Any]:
     """Certified B-spline edges (``curve_to_bspline``) of the 2-D/3-D curves."""
     from .bspline import curve_to_bspline
@@ -928,7 +1182,7 @@ def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bo
     """Write the surface face (and the design's curves as edges) to one STEP file, atomically."""
     from .cad.occ import write_step
 
-    shapes = [brep_face(built)]
+    shapes = [brep_shape(built)]
     if with_curves:
         shapes += curve_edges(built.curves)
     write_step(shapes, path)
@@ -944,6 +1198,11 @@ def unroll_surface(built: BuiltSurface) -> Any:
     from .unroll import unroll
 
     d = built.design
+    if _is_composite(built.surface):
+        from .unroll import unroll_composite
+
+        return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                                units=d.units, labels=list(built.surface.names))
     best_effort = d.surface is not None and d.surface.type == "curves"
     return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                   units=d.units, label=d.name[:24])
@@ -1007,7 +1266,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
             from .plotting import plot_curve, plot_surface
 
             if built is not None:
-                plot_surface(built.surface, f, title=design.name)
+                plot_surface(surface_view(built), f, title=design.name)
             else:
                 plot_curve(list(curves.values()), f)
         out[suf.lstrip(".") + (f"_{len(out)}" if suf.lstrip(".") in out else "")] = str(f)
@@ -1158,7 +1417,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             # 2. surface
             step("surface")
             built = build_surface(design, curves=curves)
-            report["developability_initial"] = built.surface.developability().as_dict()
+            report["developability_initial"] = _developability_dict(built.surface)
             # 3. optimization
             if design.optimize is not None:
                 step("optimize")
@@ -1170,13 +1429,20 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             report.update(surface_summary(built))
             # 5. B-rep
             step("B-rep + STEP")
-            face = brep_face(built)
+            face = brep_shape(built)
             from .cad.occ import is_valid
 
             valid = is_valid(face)
-            report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": 1}
+            nfaces = len(face.faces()) if hasattr(face, "faces") else 1
+            report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": nfaces}
+            if _is_composite(built.surface):
+                from .cad.developable_faces import joint_normal_deviation
+
+                report["brep"]["shape"] = "shell"
+                report["brep"]["shared_edges"] = shared_edge_count(face)
+                report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
             if not valid:
-                raise GHTError(f"{design.source}: the B-rep face of the surface is not valid (BRepCheck)")
+                raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
             edges = curve_edges(curves)
             report["brep"]["curve_edges"] = len(edges)
             if "step" in want_files:
@@ -1194,6 +1460,10 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 "bend_lines": int(len(pattern.bend_lines)),
                 "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
                          np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
+                "panels": [{"label": pn.label, "area_flat": float(pn.area_flat), "area_3d": float(pn.area_3d),
+                            "max_error": float(pn.report.max_relative_error) if pn.report is not None else None}
+                           for pn in pattern.panels],
+                "edge_marks": sorted({t[2] for t in pattern.labels if t[2].startswith("E")}),
             }
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
@@ -1211,7 +1481,10 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         from . import plotting as P
 
         if "basis" in want_figs:
-            if built is not None and design.surface is not None and design.surface.type == "planes":
+            if built is not None and design.surface is not None and design.surface.type == "composite":
+                deg = max(sg.dual_curve.degree for sg in built.surface.segments)
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0)] + [(g.mu, g.nu, g.gamma) for g in design.surface.segments or []]
+            elif built is not None and design.surface is not None and design.surface.type == "planes":
                 deg = built.surface.dual_curve.degree
                 sh = built.shape
                 params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (design.surface.mu, design.surface.nu, design.surface.gamma),
@@ -1232,7 +1505,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         if "curvature" in want_figs and curves:
             P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
         if "surface" in want_figs and built is not None:
-            P.plot_surface(built.surface, stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
+            P.plot_surface(surface_view(built), stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
         if "flat_pattern" in want_figs and pattern is not None:
             plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
         if "convergence" in want_figs and opt is not None:
@@ -1302,6 +1575,22 @@ def report_markdown(r: dict[str, Any]) -> str:
             if d:
                 L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
         L.append("")
+        if s.get("strips"):
+            L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
+            for x in s["strips"]:
+                sp, d = x["shape_parameters"], x["developability"]
+                L.append(f"| {x['name']} | {sp['mu']:.4g} | {sp['nu']:.4g} | {sp['gamma']:.4g} | {x['area_3d']:.9g} | "
+                         f"{d['theta_max']:.3e} | {d['dd']:.12f} |")
+            L.append("")
+        if s.get("joints"):
+            L += ["### Joints between strips (measured independently of the construction)", "",
+                  "| first → second | requested | achieved | satisfied | plane angle [deg] | residuals |",
+                  "|---|---|---|---|---|---|"]
+            for j in s["joints"]:
+                L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
+                         f"{'yes' if j['satisfied'] else 'NO'} | {j['plane_angle_deg']:.2e} | "
+                         + ", ".join(f"{x:.1e}" for x in j["residuals"]) + " |")
+            L.append("")
     if r.get("optimization"):
         o = r["optimization"]
         L += ["## Shape-parameter optimization", "",
@@ -1310,11 +1599,14 @@ def report_markdown(r: dict[str, Any]) -> str:
               + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
     if r.get("brep"):
         b = r["brep"]
-        L += ["## B-rep", "", f"{b['faces']} face (valid: {b['valid']}), area {b['area']:.9g} {r['units']}², "
+        L += ["## B-rep", "", f"{b['faces']} face(s){' in one shell' if b.get('shape') == 'shell' else ''} "
+              f"(valid: {b['valid']}), area {b['area']:.9g} {r['units']}², "
               f"{b['curve_edges']} curve edge(s).", ""]
     if r.get("flat_pattern"):
         p = r["flat_pattern"]
-        L += ["## Flat pattern (spec section 6)", "", f"Area {p['area']:.9g} {r['units']}², {p['bend_lines']} bend lines.", "",
+        L += ["## Flat pattern (spec section 6)", "", f"Area {p['area']:.9g} {r['units']}², {p['bend_lines']} bend lines, "
+              f"{len(p.get('panels') or [1])} panel(s)" + (f", edge marks {', '.join(p['edge_marks'])}" if p.get("edge_marks") else "")
+              + ".", "",
               "| quantity | max | rms |", "|---|---|---|"]
         for k, v in p["report"].items():
             L.append(f"| {k} | {v['max']:.3e} | {v['rms']:.3e} |")
