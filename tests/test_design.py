@@ -203,7 +203,7 @@ def test_optimize_block_validation() -> None:
             parse_design({**base, "optimize": bad}, "f.toml")
 
 
-@pytest.mark.parametrize("name", ["design_duct.toml", "design_hull_plate.toml"])
+@pytest.mark.parametrize("name", ["design_duct.toml", "design_hull_plate.toml", "design_duct_two_strips.toml"])
 def test_example_designs_validate(name: str) -> None:
     d = load_design(Path(__file__).parent.parent / "examples" / name)
     assert d.surface is not None
@@ -247,4 +247,113 @@ def test_impossible_join_names_the_join(tmp_path: Path, out_dir: Path, capsys) -
     rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
     assert rc == 2 and len(err.strip().splitlines()) == 1
     assert str(path) in err and "'joins[0]'" in err
+    assert snapshot(out_dir) == before
+
+
+# ---------------------------------------------------------------------------------------------
+# composite surfaces: several strips joined G1/G2/G3 (spec 5.6)
+# ---------------------------------------------------------------------------------------------
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+TWO_STRIPS = (EXAMPLES / "design_duct_two_strips.toml").read_text()
+
+
+def strips_edit(old: str, new: str) -> str:
+    assert old in TWO_STRIPS, old
+    return TWO_STRIPS.replace(old, new, 1)
+
+
+def test_two_strip_design_end_to_end(tmp_path: Path) -> None:
+    """Shell STEP valid with one shared edge, one panel per strip whose area equals the strip's
+    area (independent Gauss–Legendre quadrature in 3-D) to 1e-9, joint G2 as requested."""
+    import ezdxf
+
+    from ght_cad.cad.occ import is_valid, read_step
+    from ght_cad.design import build_surface, ruled_area, shared_edge_count
+
+    out = tmp_path / "out"
+    assert main(["run", str(EXAMPLES / "design_duct_two_strips.toml"), "--out", str(out), "--no-progress"]) == 0
+    r = json.loads((out / "report.json").read_text())
+    assert r["surface"]["type"] == "composite" and len(r["surface"]["strips"]) == 2
+    (j,) = r["surface"]["joints"]
+    assert j["requested"] == "G2" and j["achieved_G"] == 2 and j["satisfied"]
+    for s in r["surface"]["strips"]:
+        assert s["developability"]["theta_max"] < 1e-10
+    # B-rep: one valid shell of two faces sharing the joint ruling, also after re-import
+    assert r["brep"] == {**r["brep"], "valid": True, "faces": 2, "shape": "shell", "shared_edges": 1}
+    shape = read_step(out / "model.step")
+    assert is_valid(shape) and shared_edge_count(shape) == 1
+    # pattern: one panel per strip, areas = strip areas (independent quadrature) to 1e-9
+    comp = build_surface(load_design(EXAMPLES / "design_duct_two_strips.toml")).surface
+    panels = r["flat_pattern"]["panels"]
+    assert [p["label"] for p in panels] == ["quarter", "second-quarter"]
+    for p, seg in zip(panels, comp.segments):
+        assert math.isclose(p["area_flat"], ruled_area(seg), rel_tol=1e-9), (p, ruled_area(seg))
+    assert r["flat_pattern"]["edge_marks"] == ["E1"]
+    doc = ezdxf.readfile(out / "flat_pattern.dxf")
+    msp = doc.modelspace()
+    outlines = [e for e in msp if e.dxftype() == "LWPOLYLINE" and e.dxf.layer == "OUTLINE"]
+    assert len(outlines) == 2 and all(e.closed for e in outlines)
+    assert len([e for e in msp if e.dxftype() == "LINE" and e.dxf.layer == "BEND"]) == 2 * 10
+    texts = [e.dxf.text for e in msp if e.dxftype() == "TEXT"]
+    assert texts.count("E1") == 2 and "quarter" in texts and "second-quarter" in texts
+    md = (out / "report.md").read_text()
+    assert "| quarter → second-quarter | G2 | G2 | yes |" in md
+
+
+@pytest.mark.parametrize("order", ["G1", "G3"])
+def test_requested_joint_order_is_achieved(order: str) -> None:
+    """The measured joint order equals the requested one (generic free planes: not higher)."""
+    from ght_cad.design import build_surface, surface_summary
+
+    d = parse_design_text(strips_edit('continuity = "G2"', f'continuity = "{order}"'), "two.toml")
+    summ = surface_summary(build_surface(d))
+    (j,) = summ["surface"]["joints"]
+    assert j["requested"] == order and j["achieved_G"] == int(order[1]), j
+    assert j["plane_angle_deg"] < 1e-10 and j["ruling_distance"] < 1e-10
+
+
+STRIP_PLANES_B = TWO_STRIPS[TWO_STRIPS.index("[[surface.segments]]", TWO_STRIPS.index("quarter")):
+                            TWO_STRIPS.index("[unroll]")]
+BROKEN_STRIPS = {
+    "no segments": (TWO_STRIPS[:TWO_STRIPS.index("[[surface.segments]]")] + TWO_STRIPS[TWO_STRIPS.index("[unroll]"):],
+                    "surface.segments", "at least 2 tables"),
+    "one segment": (TWO_STRIPS.replace(STRIP_PLANES_B, ""), "surface.segments", "at least 2"),
+    "G0 join": (strips_edit('continuity = "G2"', 'continuity = "G0"'), "surface.segments[1].continuity", "G1, G2, G3"),
+    "join on first": (strips_edit('name = "quarter"', 'name = "quarter"\ncontinuity = "G1"'),
+                      "surface.segments[0].continuity", "segments[1] and later"),
+    "k zero": (strips_edit("k = 1.0", "k = 0"), "surface.segments[1].k", "> 0"),
+    "shape out of range": (strips_edit("mu = 0.0", "mu = -1.5"), "surface.segments[1].mu", "[-1, 1]"),
+    "unknown key": (strips_edit("k = 1.0", "kk = 1.0"), "surface.segments[1].kk", "continuity, k, beta2"),
+    "duplicate name": (strips_edit('name = "second-quarter"', 'name = "quarter"'), "surface.segments[1].name", "unique"),
+    "curves key": (strips_edit('type = "composite"', 'type = "composite"\ncurve_a = "c1"'), "surface.curve_a",
+                   "type, boundary_planes, normalize, segments"),
+    "optimize": (TWO_STRIPS.replace("[unroll]", "[optimize]\nmethod = \"pso\"\n\n[unroll]"), "optimize",
+                 "planes or curves"),
+    "bad type": (strips_edit('type = "composite"', 'type = "strips"'), "surface.type", "planes, curves, composite"),
+    "G3 with 3 planes": (strips_edit('continuity = "G2"', 'continuity = "G3"').replace(
+        "  [-0.941433, -0.721179, 0.605141, 0.3372],\n  [-0.927967, -0.872004, 0.317383, 0.372662],\n"
+        "  [-0.923077, -0.923077, 0.0, 0.384615],\n", ""), "surface.segments[1].planes", "at least 4 arrays"),
+}
+
+
+@pytest.mark.parametrize("case", list(BROKEN_STRIPS))
+def test_broken_multi_strip_design_exit_2_untouched(case: str, tmp_path: Path, out_dir: Path, capsys) -> None:
+    text, key, allowed = BROKEN_STRIPS[case]
+    before = snapshot(out_dir)
+    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
+    assert rc == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert str(path) in lines[0] and f"'{key}'" in lines[0] and allowed in lines[0], lines[0]
+    assert snapshot(out_dir) == before
+    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+
+
+def test_unsolvable_strip_join_names_the_segment(tmp_path: Path, out_dir: Path, capsys) -> None:
+    """Geometry that fails while computing (second strip's free planes parallel to each other)."""
+    text = strips_edit("  [-0.927967, -0.872004, 0.317383, 0.372662],\n", "  [-0.941433, -0.721179, 0.605141, 0.3372],\n")
+    before = snapshot(out_dir)
+    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1, err
+    assert f"{path}: key 'surface.segments[1]' (second-quarter)" in err
     assert snapshot(out_dir) == before
