@@ -1061,6 +1061,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
 
     if design.surface is None:
         raise DesignError(f"{design.source}: key 'surface': missing; optimization needs a [surface] table")
+    if design.surface.type == "composite":
+        raise DesignError(f"{design.source}: key 'surface.type': 'composite' cannot be optimized (the strips keep "
+                          "their given shape parameters); allowed for optimization: planes, curves")
     spec = design.optimize or OptimizeSpec(
         objective="CVEn" if design.surface.type == "planes" else "R",
         parameters=list(_shape_names(design.surface)),
