@@ -9,16 +9,20 @@ from __future__ import annotations
 
 import json
 import math
+import tempfile
 from pathlib import Path
 
 import build123d as bd
 import ezdxf
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from ght_cad.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face, write_step
 from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.design import unroll_step
 from ght_cad.developable import CompositeDevelopable, developable_from_planes, join_developable
 
 RTOL = 1e-9
@@ -71,20 +75,45 @@ def test_cylinder_step_is_r_theta_by_h(tmp_path: Path, capsys) -> None:
     np.testing.assert_allclose(out["area"], R * math.radians(arc) * H, rtol=RTOL)
 
 
-def test_cone_step_units_and_annular_sector(tmp_path: Path, capsys) -> None:
-    """A cone written in mm, unrolled in cm: the annular sector of spec section 6, scaled by 1/10."""
-    r1, r2, h, arc = 20.0, 40.0, 30.0, 90.0
-    step = tmp_path / "cone.stp"
-    write_step(_face(bd.Solid.make_cone(r1, r2, h, angle=arc), bd.GeomType.CONE), step)
-    rc, out, err = _run(["unroll", str(step), "--units", "cm", "--svg", str(tmp_path / "c.svg")], capsys)
-    assert rc == EXIT_OK, err
+@given(st.floats(5.0, 40.0), st.floats(0.2, 0.9), st.floats(5.0, 60.0), st.floats(20.0, 350.0))
+@settings(max_examples=6, deadline=None)
+def test_cone_step_is_annular_sector(r2: float, ratio: float, h: float, arc: float) -> None:
+    """Cone frustum faces over a parameter box, written to STEP and unrolled in cm: the annular
+    sector of spec section 6 (radii ρ = r·slant/(r2 - r1), angle θ r2/ρ2), scaled by 1/10."""
+    r1 = ratio * r2
+    with tempfile.TemporaryDirectory() as tmp:
+        step = Path(tmp) / "cone.stp"
+        write_step(_face(bd.Solid.make_cone(r1, r2, h, angle=arc), bd.GeomType.CONE), step)
+        res = unroll_step(step, units="cm", rulings=3)
+    assert res.units == "cm" and res.file_units == "millimetre"
     slant = math.hypot(r2 - r1, h)
     rho2, rho1 = r2 * slant / (r2 - r1), r1 * slant / (r2 - r1)
     angle = math.radians(arc) * r2 / rho2
-    assert out["units"] == "cm"
-    np.testing.assert_allclose(out["area"], 0.5 * angle * (rho2**2 - rho1**2) / 100.0, rtol=RTOL)
-    assert out["errors"]["max"] < RTOL
-    assert (tmp_path / "c.svg").read_text().lstrip().startswith("<")
+    np.testing.assert_allclose(res.pattern.area, 0.5 * angle * (rho2**2 - rho1**2) / 100.0, rtol=RTOL)
+    # the straight sides of the sector have the slant length
+    lengths = sorted(e.length_flat for e in res.pattern.panels[0].loops[0])
+    assert any(math.isclose(x, slant / 10.0, rel_tol=RTOL) for x in lengths), (lengths, slant / 10)
+    assert res.pattern.errors["max"] < RTOL
+
+
+def test_file_units_are_the_default(tmp_path: Path, capsys) -> None:
+    """A STEP file that declares metres gives a pattern in metres (DXF $INSUNITS 6)."""
+    from OCP.Interface import Interface_Static
+
+    R, H, arc = 300.0, 500.0, 90.0  # mm in the model
+    step = tmp_path / "cyl_m.step"
+    old = Interface_Static.CVal_s("write.step.unit")
+    Interface_Static.SetCVal_s("write.step.unit", "M")
+    try:
+        write_step(_face(bd.Solid.make_cylinder(R, H, angle=arc), bd.GeomType.CYLINDER), step)
+    finally:
+        Interface_Static.SetCVal_s("write.step.unit", old)
+    rc, out, err = _run(["unroll", str(step), "--dxf", str(tmp_path / "m.dxf"), "--svg", str(tmp_path / "m.svg")], capsys)
+    assert rc == EXIT_OK, err
+    assert out["file_units"] == "metre" and out["units"] == "m"
+    np.testing.assert_allclose(out["area"], R * math.radians(arc) * H / 1e6, rtol=RTOL)
+    assert _dxf(tmp_path / "m.dxf")["insunits"] == 6
+    assert (tmp_path / "m.svg").read_text().lstrip().startswith("<")
 
 
 def test_project_face_and_two_strip_shell(tmp_path: Path, capsys) -> None:
