@@ -1766,14 +1766,19 @@ def unroll_step(
         kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
         try:
             pat = unroll(face, best_effort=best_effort, **kw)
-        except NotDevelopableError:
-            dev = None
-            try:  # measure how far off it is (the ruled surface between its boundary isolines)
-                dev = unroll(face, best_effort=True, **kw).panels[0].info.get("developability")
+        except NotDevelopableError as exc:
+            info_be: dict[str, Any] = {}
+            try:  # measure how far off it is (for a non-ruled face: the ruled surface between its boundary isolines)
+                info_be = unroll(face, best_effort=True, **kw).panels[0].info or {}
             except GHTError:
-                dev = None
+                info_be = {}
+            dev = info_be.get("developability")
+            straight = min(info_be.get("deviation_u", 0.0), info_be.get("deviation_v", 0.0))
             how = (f"theta_max={dev['theta_max']:.6g} deg, developability degree DD={dev['dd']:.12f} (1 = developable)"
-                   if dev else "it is not a ruled face")
+                   if dev else " ".join(str(exc).split()))
+            if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
+                how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
+                       "relative to their chords (allowed 1e-9), so it has no rulings to unroll along")
             raise NotDevelopableError(
                 f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; "
                 "allowed: developable faces, or --best-effort to flatten it with a distortion report"

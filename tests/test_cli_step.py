@@ -187,3 +187,14 @@ def test_step_input_errors(tmp_path: Path, capsys) -> None:
     toml.write_text("[surface]\nplanes = [[0,1,0,0],[0,1,1,0],[0,0,1,0]]\nboundary_planes = [[0,0,0,1],[-1,0,0,1]]\n")
     rc, out, _ = _run(["unroll", str(toml), "--face", "1"], capsys)
     assert rc == EXIT_USAGE and "--face applies to STEP input only" in out["error"]
+
+
+def test_non_ruled_face_is_refused_with_its_deviation(tmp_path: Path, capsys) -> None:
+    step = tmp_path / "sphere.step"
+    write_step(bd.Sphere(3.0).faces()[0], step)
+    rc, out, _ = _run(["unroll", str(step), "--png", str(tmp_path / "s.png")], capsys)
+    assert rc == EXIT_USAGE and not (tmp_path / "s.png").exists()
+    assert f"{step}: face 1 of 1 is not developable" in out["error"]
+    assert "it is not ruled: its straightest isolines deviate 0.5 from straight lines" in out["error"]
+    rc, out, _ = _run(["unroll", str(step), "--best-effort"], capsys)
+    assert rc == EXIT_OK and out["errors"]["area"] > 0.1  # the distortion is reported
