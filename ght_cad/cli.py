@@ -516,7 +516,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_EPILOG,
     )
     design_arg(sp)
-    sp.add_argument("--step", metavar="FILE", help="write the surface as a STEP face")
+    sp.add_argument("--step", metavar="FILE", help="write the surface as a STEP face (a shell for a composite)")
     sp.add_argument("--plot", metavar="PNG", help="rendered view of the surface (900x700 px)")
     common(sp)
     sp.set_defaults(func=cmd_surface)
@@ -572,7 +572,7 @@ def build_parser() -> argparse.ArgumentParser:
         "export",
         help="write a design's result to files chosen by suffix",
         description="Build the design (with its given shape parameters) and write each FILE by its "
-        "suffix: .step/.stp (surface face and curves), .dxf/.svg (flat pattern), .json (report), "
+        "suffix: .step/.stp (surface face, or a shell for a composite, and curves), .dxf/.svg (flat pattern), .json (report), "
         ".png (rendered surface).",
         epilog=_EPILOG,
     )

@@ -1,8 +1,9 @@
 r"""Design files (TOML): schema, validation and the pipeline runner behind ``ght-cad run``/``demo``.
 
 A design file describes GHT-Bézier curves (control points and shape parameters, optional joins),
-one surface (an enveloping developable from control planes, spec 5.2, or a ruled strip between
-two curves), an optional shape-parameter optimization and the outputs to write. The schema is
+one surface (an enveloping developable from control planes, spec 5.2, a ruled strip between two
+curves, or a composite of developable strips joined G1/G2/G3, spec 5.6), an optional
+shape-parameter optimization (single-strip surfaces) and the outputs to write. The schema is
 documented in ``docs/design-files.md``; :func:`parse_design` validates a parsed file completely
 before anything is computed, and every error is one line naming the file, the key and the
 allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.errors.GHTError`, so
@@ -10,6 +11,9 @@ allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.errors.GHTErr
 
 :func:`run_design` computes everything into a temporary folder beside the output folder and moves
 the files in only when every step succeeded, so a failure leaves the output folder untouched.
+
+:func:`unroll_step` unrolls the developable faces of a STEP file made by any CAD tool (one panel
+per face), for ``ght-cad unroll FILE.step``.
 
 Imports numpy at module level only; scipy, matplotlib and the CAD kernel are imported inside the
 functions that need them.
@@ -1745,6 +1749,8 @@ def unroll_step(
         raise DesignError(f"{p}: units={units!r} is not allowed; allowed: {', '.join(MM_PER_UNIT)}")
     if not (isinstance(tol_deg, (int, float)) and math.isfinite(tol_deg) and 0 < tol_deg <= 90):
         raise DesignError(f"{p}: tol_deg={tol_deg!r} is out of range; allowed: a number in (0, 90]")
+    if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or not 0 <= rulings <= 1000:
+        raise DesignError(f"{p}: rulings={rulings!r} is out of range; allowed: an integer in [0, 1000]")
     shape, unit, file_unit = _read_step_in(p, units)
     from .cad.unroll_faces import shape_faces
 
