@@ -459,6 +459,9 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     st = ck.table(data, "surface", "surface")
     if st is not None:
         stype = ck.string(st, "type", "surface", "planes", choices=SURFACE_TYPES)
+        if stype != "composite" and "segments" in st:
+            raise ck.fail("surface.segments", f"strips need type = \"composite\" (this surface has type = \"{stype}\"); "
+                          "allowed: [[surface.segments]] only with type = \"composite\"")
         if stype == "planes":
             ck.keys(st, "surface", ("type", "planes", "boundary_planes", "mu", "nu", "gamma", "normalize"))
             planes = ck.matrix(st, "planes", "surface", cols=(4,), min_rows=3)

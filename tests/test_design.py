@@ -300,12 +300,14 @@ def test_two_strip_design_end_to_end(tmp_path: Path) -> None:
     assert "| quarter → second-quarter | G2 | G2 | yes |" in md
 
 
-@pytest.mark.parametrize("order", ["G1", "G3"])
-def test_requested_joint_order_is_achieved(order: str) -> None:
+@pytest.mark.parametrize("order, normalize", [("G1", "false"), ("G3", "false"), ("G2", "true")])
+def test_requested_joint_order_is_achieved(order: str, normalize: str) -> None:
     """The measured joint order equals the requested one (generic free planes: not higher)."""
     from ght_cad.design import build_surface, surface_summary
 
-    d = parse_design_text(strips_edit('continuity = "G2"', f'continuity = "{order}"'), "two.toml")
+    text = strips_edit('continuity = "G2"', f'continuity = "{order}"').replace("normalize = false", f"normalize = {normalize}")
+    d = parse_design_text(text, "two.toml")
+    assert d.surface.normalize is (normalize == "true")
     summ = surface_summary(build_surface(d))
     (j,) = summ["surface"]["joints"]
     assert j["requested"] == order and j["achieved_G"] == int(order[1]), j
@@ -330,6 +332,8 @@ BROKEN_STRIPS = {
     "optimize": (TWO_STRIPS.replace("[unroll]", "[optimize]\nmethod = \"pso\"\n\n[unroll]"), "optimize",
                  "planes or curves"),
     "bad type": (strips_edit('type = "composite"', 'type = "strips"'), "surface.type", "planes, curves, composite"),
+    "type missing": (strips_edit('type = "composite"\n', ''), "surface.segments", 'only with type = "composite"'),
+    "normalize type": (strips_edit("normalize = false", 'normalize = "no"'), "surface.normalize", "true or false"),
     "G3 with 3 planes": (strips_edit('continuity = "G2"', 'continuity = "G3"').replace(
         "  [-0.941433, -0.721179, 0.605141, 0.3372],\n  [-0.927967, -0.872004, 0.317383, 0.372662],\n"
         "  [-0.923077, -0.923077, 0.0, 0.384615],\n", ""), "surface.segments[1].planes", "at least 4 arrays"),
