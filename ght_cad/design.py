@@ -787,7 +787,6 @@ def _make_composite(design: Design, shape: dict[str, float]) -> Any:
         comp = CompositeDevelopable(segs)
     except GHTError as exc:
         raise type(exc)(f"{design.source}: key 'surface.segments': {' '.join(str(exc).split())}") from None
-    comp.names = [g.name for g in spec.segments]  # type: ignore[attr-defined]
     return comp
 
 
@@ -1212,7 +1211,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
         from .unroll import unroll_composite
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                                units=d.units, labels=list(built.surface.names))
+                                units=d.units, labels=[g.name for g in d.surface.segments or []])
     best_effort = d.surface is not None and d.surface.type == "curves"
     return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                   units=d.units, label=d.name[:24])
