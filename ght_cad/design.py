@@ -1194,7 +1194,7 @@ def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bo
     shapes = [brep_shape(built)]
     if with_curves:
         shapes += curve_edges(built.curves)
-    write_step(shapes, path)
+    write_step(shapes, path, units=built.design.units)
     return Path(path)
 
 
@@ -1263,7 +1263,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
             else:
                 from .cad.occ import write_step
 
-                write_step(curve_edges(curves), f)
+                write_step(curve_edges(curves), f, units=design.units)
         elif suf in (".dxf", ".svg"):
             pattern = pattern or unroll_surface(built)
             (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(f)
@@ -1457,7 +1457,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if "step" in want_files:
                 from .cad.occ import write_step
 
-                write_step([face] + edges, stage.path(FILE_NAMES["step"]))
+                write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
             # 6. flat pattern
             step("flat pattern")
             pattern = unroll_surface(built)
@@ -1483,7 +1483,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if "step" in want_files and curves:
                 from .cad.occ import write_step
 
-                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]))
+                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]), units=design.units)
 
         # 7. figures
         step("figures")

@@ -98,16 +98,9 @@ def test_cone_step_is_annular_sector(r2: float, ratio: float, h: float, arc: flo
 
 def test_file_units_are_the_default(tmp_path: Path, capsys) -> None:
     """A STEP file that declares metres gives a pattern in metres (DXF $INSUNITS 6)."""
-    from OCP.Interface import Interface_Static
-
-    R, H, arc = 300.0, 500.0, 90.0  # mm in the model
+    R, H, arc = 300.0, 500.0, 90.0  # mm; the model is written in metres
     step = tmp_path / "cyl_m.step"
-    old = Interface_Static.CVal_s("write.step.unit")
-    Interface_Static.SetCVal_s("write.step.unit", "M")
-    try:
-        write_step(_face(bd.Solid.make_cylinder(R, H, angle=arc), bd.GeomType.CYLINDER), step)
-    finally:
-        Interface_Static.SetCVal_s("write.step.unit", old)
+    write_step(_face(bd.Solid.make_cylinder(R / 1e3, H / 1e3, angle=arc), bd.GeomType.CYLINDER), step, units="m")
     rc, out, err = _run(["unroll", str(step), "--dxf", str(tmp_path / "m.dxf"), "--svg", str(tmp_path / "m.svg")], capsys)
     assert rc == EXIT_OK, err
     assert out["file_units"] == "metre" and out["units"] == "m"

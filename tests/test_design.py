@@ -361,3 +361,18 @@ def test_unsolvable_strip_join_names_the_segment(tmp_path: Path, out_dir: Path, 
     assert rc == 2 and len(err.strip().splitlines()) == 1, err
     assert f"{path}: key 'surface.segments[1]' (second-quarter)" in err
     assert snapshot(out_dir) == before
+
+
+def test_step_declares_the_design_units(tmp_path) -> None:
+    """A design in metres writes a STEP file that declares metres (coordinates kept as designed)."""
+    import re
+    from pathlib import Path
+
+    from ght_cad.design import load_design, run_design
+
+    src = Path(__file__).resolve().parents[1] / "examples" / "design_duct_two_strips.toml"
+    design = load_design(src)
+    assert design.units == "m"
+    run_design(design, tmp_path / "out", progress=False)
+    text = (tmp_path / "out" / "model.step").read_text(errors="replace")
+    assert re.search(r"LENGTH_UNIT\(\) NAMED_UNIT\(\*\) SI_UNIT\(\$,\.METRE\.\)", text)

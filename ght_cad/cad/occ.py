@@ -135,12 +135,33 @@ def is_valid(shape: Any) -> bool:
     return bool(BRepCheck_Analyzer(unwrap(shape)).IsValid())
 
 
-def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True) -> str:
+#: length units a STEP file can declare: name -> (OCCT ``write.step.unit`` value, mm per unit)
+STEP_UNITS: dict[str, tuple[str, float]] = {
+    "mm": ("MM", 1.0),
+    "cm": ("CM", 10.0),
+    "m": ("M", 1000.0),
+    "in": ("INCH", 25.4),
+    "ft": ("FT", 304.8),
+}
+
+
+def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, units: str = "mm") -> str:
     """Write one shape or several (as a compound) to a STEP file, atomically.
 
+    Args:
+        shapes: a shape or a list of shapes (build123d, cadquery or OCP).
+        path: target file.
+        check: refuse shapes that ``BRepCheck_Analyzer`` finds invalid.
+        units: the length unit the shape coordinates are in; the file declares it and keeps the
+            coordinates as they are (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``).
+
     Raises:
-        GHTError: an invalid shape (when ``check``) or a failed write; the target is untouched.
+        GHTError: an invalid shape (when ``check``), an unknown unit or a failed write; the
+            target is untouched.
     """
+    if units not in STEP_UNITS:
+        raise GHTError(f"units={units!r} is not a STEP length unit; allowed: {', '.join(STEP_UNITS)}")
+    step_unit, mm_per_unit = STEP_UNITS[units]
     items = list(shapes) if isinstance(shapes, (list, tuple)) else [shapes]
     if not items:
         raise GHTError("nothing to export: the list of shapes is empty")
@@ -158,9 +179,18 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True) -> s
         for s in raw:
             bb.Add(comp, s)
         shape = comp
+    from OCP.Interface import Interface_Static
+
     with quiet_occt():
-        writer = STEPControl_Writer()
-        writer.Transfer(shape, STEPControl_AsIs)
+        STEPControl_Writer()  # registers the STEP statics before they are set
+        previous = Interface_Static.CVal_s("write.step.unit")
+        Interface_Static.SetCVal_s("write.step.unit", step_unit)
+        try:
+            writer = STEPControl_Writer()
+            writer.Model().SetLocalLengthUnit(mm_per_unit)  # the coordinates are in `units`
+            writer.Transfer(shape, STEPControl_AsIs)
+        finally:
+            Interface_Static.SetCVal_s("write.step.unit", previous)
         with atomic_path(path) as tmp:
             if writer.Write(str(tmp)) != IFSelect_RetDone:
                 raise GHTError(f"OCCT failed to write STEP file {path}")

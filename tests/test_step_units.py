@@ -1,0 +1,49 @@
+"""STEP files declare the length unit of the model, and keep its coordinates."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+pytest.importorskip("build123d")
+
+from build123d import Box  # noqa: E402
+from OCP.Bnd import Bnd_Box  # noqa: E402
+from OCP.BRepBndLib import BRepBndLib  # noqa: E402
+
+from ght_cad.cad.occ import read_step, write_step  # noqa: E402
+from ght_cad.errors import GHTError  # noqa: E402
+
+
+def _extent(shape) -> tuple[float, ...]:
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box)
+    x0, y0, z0, x1, y1, z1 = box.Get()
+    return (x1 - x0, y1 - y0, z1 - z0)
+
+
+@pytest.mark.parametrize(
+    "units, declared, mm",
+    [("mm", r"SI_UNIT\(\.MILLI\.,\.METRE\.\)", 1.0), ("m", r"SI_UNIT\(\$,\.METRE\.\)", 1000.0),
+     ("cm", r"SI_UNIT\(\.CENTI\.,\.METRE\.\)", 10.0), ("in", r"'INCH'", 25.4)],
+)
+def test_declared_unit_and_coordinates(tmp_path, units: str, declared: str, mm: float) -> None:
+    path = tmp_path / f"box_{units}.step"
+    write_step(Box(1, 2, 3), path, units=units)
+    text = path.read_text(errors="replace")
+    assert re.search(declared, text), f"{units}: unit not declared"
+    assert "CARTESIAN_POINT('',(-0.5,-1.,-1.5))" in text  # coordinates written as given
+    # OCCT reads into millimetres: the extent scales by mm per unit
+    ext = _extent(read_step(path))
+    for got, want in zip(ext, (1.0 * mm, 2.0 * mm, 3.0 * mm)):
+        assert got == pytest.approx(want, rel=1e-6)
+    # the session default is restored: the next plain write is in mm again
+    write_step(Box(1, 1, 1), tmp_path / "after.step")
+    assert re.search(r"SI_UNIT\(\.MILLI\.,\.METRE\.\)", (tmp_path / "after.step").read_text(errors="replace"))
+
+
+def test_unknown_unit_is_refused_and_nothing_written(tmp_path) -> None:
+    with pytest.raises(GHTError, match=r"units='furlong' is not a STEP length unit; allowed: mm, cm, m, in, ft"):
+        write_step(Box(1, 1, 1), tmp_path / "x.step", units="furlong")
+    assert not (tmp_path / "x.step").exists()
