@@ -1228,7 +1228,8 @@ def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None
 
     e = pattern.errors
     t = (title + ": " if title else "") + f"flat pattern, max rel. error {e['max']:.1e}"
-    return plot_flat_pattern(pattern.outlines, path, rulings=list(pattern.bend_lines), title=t)
+    return plot_flat_pattern(pattern.outlines, path, rulings=list(pattern.bend_lines), title=t,
+                             labels=list(pattern.labels), marks=list(pattern.marks))
 
 
 def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str, str]:

@@ -356,7 +356,8 @@ def plot_surface(
 
 
 def plot_flat_pattern(outlines: Sequence[np.ndarray], path: str | os.PathLike,
-                      rulings: Sequence[np.ndarray] = (), title: str | None = None) -> Path:
+                      rulings: Sequence[np.ndarray] = (), title: str | None = None,
+                      labels: Sequence[tuple] = (), marks: Sequence[np.ndarray] = ()) -> Path:
     """Flat pattern: closed outline polylines (N, 2) and optional ruling segments (2, 2).
 
     Args:
@@ -364,6 +365,8 @@ def plot_flat_pattern(outlines: Sequence[np.ndarray], path: str | os.PathLike,
         path: PNG file to write (900 x 700 pixels).
         rulings: line segments to draw thinly (the rulings in the plane).
         title: figure title.
+        labels: ``(x, y, text, ...)`` tuples: panel names and edge marks (``FlatPattern.labels``).
+        marks: polylines of the matching edge marks (``FlatPattern.marks``).
 
     Returns:
         The written path.
@@ -378,6 +381,12 @@ def plot_flat_pattern(outlines: Sequence[np.ndarray], path: str | os.PathLike,
         p = np.vstack([p, p[:1]])
         ax.plot(p[:, 0], p[:, 1], color="C0", lw=1.6)
         ax.fill(p[:, 0], p[:, 1], color="C0", alpha=0.12)
+    for mk in marks:
+        m = np.asarray(mk, dtype=float)
+        ax.plot(m[:, 0], m[:, 1], color="C3", lw=1.2)
+    for lab in labels:
+        ax.text(float(lab[0]), float(lab[1]), str(lab[2]), ha="center", va="center", fontsize=9,
+                color="C3" if str(lab[2]).startswith("E") else "k")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, lw=0.3)
     ax.set_xlabel("x")

@@ -83,6 +83,11 @@ def test_surface_pattern_convergence_sizes(tmp_path: Path) -> None:
     assert png_size(plot_surface(s, tmp_path / "s.png")) == SIZES["surface"]
     outline = np.array([[0, 0], [3, 0], [3, 1], [0, 1]], float)
     assert png_size(plot_flat_pattern([outline], tmp_path / "f.png", rulings=[outline[:2]])) == SIZES["flat_pattern"]
+    # panel names and edge marks are drawn too, and change the picture
+    plain = (tmp_path / "f.png").read_bytes()
+    marked = plot_flat_pattern([outline], tmp_path / "g.png", rulings=[outline[:2]],
+                               labels=[(0.5, 0.5, "P1"), (0.9, 0.1, "E1")], marks=[outline[:2] + 0.05])
+    assert png_size(marked) == SIZES["flat_pattern"] and marked.read_bytes() != plain
     assert png_size(plot_convergence({"pso": [3, 2, 1], "gwo": [3, 1, 0.5]}, tmp_path / "cv.png")) == SIZES["convergence"]
 
 
