@@ -11,8 +11,9 @@ Leibniz' rule, ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from math import comb, factorial
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -20,7 +21,17 @@ from ._validate import as_parameter_array, check_degree
 from .errors import GHTError
 from .seeds import MAX_DERIVATIVE, Seed, make_seed
 
-__all__ = ["basis", "seed_basis", "bernstein", "bernstein_recursive_basis"]
+__all__ = [
+    "basis",
+    "seed_basis",
+    "seed_basis_derivatives",
+    "evaluate_derivatives",
+    "basis_from_jets",
+    "bernstein",
+    "bernstein_recursive_basis",
+]
+
+_CHUNK = 1 << 15
 
 
 def _check_order(derivative: Any) -> int:
@@ -48,29 +59,73 @@ def bernstein(t: np.ndarray, n: int, derivative: int = 0) -> np.ndarray:
     """
     t = np.asarray(t, dtype=float)
     N = t.shape[0]
-    out = np.zeros((N, n + 1))
     if derivative > n:
-        return out
+        return np.zeros((N, n + 1))
     q = n - derivative
-    # powers of t and (1-t) for the degree-q polynomials
-    tp = np.empty((N, q + 1))
-    sp = np.empty((N, q + 1))
-    tp[:, 0] = 1.0
-    sp[:, 0] = 1.0
-    if q:
+    # degree-q values C(q,j) t^j (1-t)^(q-j) from the powers of t and (1-t)
+    if q == 0:
+        low = np.ones((N, 1))
+    elif q == 1:
+        low = np.stack([1.0 - t, t], axis=1)
+    else:
+        tp = np.empty((N, q + 1))
+        sp = np.empty((N, q + 1))
+        tp[:, 0] = 1.0
+        sp[:, 0] = 1.0
         s = 1.0 - t
         for j in range(1, q + 1):
             np.multiply(tp[:, j - 1], t, out=tp[:, j])
             np.multiply(sp[:, j - 1], s, out=sp[:, j])
-    low = tp * sp[:, ::-1]
-    low *= np.array([comb(q, j) for j in range(q + 1)], dtype=float)
+        low = tp * sp[:, ::-1]
+        low *= _binomials(q)
     if derivative == 0:
         return low
+    out = np.zeros((N, n + 1))
     scale = factorial(n) / factorial(q)
     for l in range(derivative + 1):
         coef = scale * (-1) ** (derivative - l) * comb(derivative, l)
         out[:, l : l + q + 1] += coef * low
     return out
+
+
+@lru_cache(maxsize=64)
+def _binomials(q: int) -> np.ndarray:
+    """``[C(q, 0), ..., C(q, q)]`` as a read-only float array."""
+    b = np.array([comb(q, j) for j in range(q + 1)], dtype=float)
+    b.setflags(write=False)
+    return b
+
+
+def basis_from_jets(bern: Sequence[np.ndarray], jets: Sequence[Sequence[np.ndarray]], derivative: int) -> np.ndarray:
+    r"""Leibniz' rule ``b^{(r)}_{i,m} = Σ_{s=0..r} C(r,s) Σ_{k=0..2} B^{(r-s)}_{i-k,n} f_k^{(s)}``.
+
+    The one implementation of the closed form (section 2), shared by :func:`seed_basis`,
+    :func:`seed_basis_derivatives` and the population-vectorized optimizer problems.
+
+    Args:
+        bern: ``bern[q]`` = Bernstein derivative matrices ``B^{(q)}_{j,n}(t)``, shape (N, n+1), q = 0..r.
+        jets: ``jets[s] = (f0^(s), f1^(s), f2^(s))``, each of shape (..., N, 1) (leading axes,
+            e.g. P parameter sets, broadcast), s = 0..r.
+        derivative: order r.
+
+    Returns:
+        Array of shape (..., N, n+3).
+    """
+    r = int(derivative)
+    n1 = bern[0].shape[1]
+    lead = np.broadcast_shapes(*(f.shape for f in jets[0]))[:-1]
+    out = np.zeros(lead + (n1 + 2,))
+    for s in range(r + 1):
+        B = bern[r - s]
+        c = comb(r, s)
+        for k in range(3):
+            fk = jets[s][k] if c == 1 else c * jets[s][k]
+            out[..., k : k + n1] += B * fk
+    return out
+
+
+def _columns(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return f[:, 0:1], f[:, 1:2], f[:, 2:3]
 
 
 def seed_basis(t: np.ndarray, degree: int, seed: Seed, derivative: int = 0) -> np.ndarray:
@@ -82,15 +137,95 @@ def seed_basis(t: np.ndarray, degree: int, seed: Seed, derivative: int = 0) -> n
         Array of shape (len(t), degree+1).
     """
     n = degree - 2
-    N = t.shape[0]
-    out = np.zeros((N, degree + 1))
-    for s in range(derivative + 1):
-        f = seed.jet(t, s)
-        B = bernstein(t, n, derivative - s)
-        c = comb(derivative, s)
-        for k in range(3):
-            fk = f[:, k : k + 1] if c == 1 else c * f[:, k : k + 1]
-            out[:, k : k + n + 1] += B * fk
+    jets = [_columns(seed.jet(t, s)) for s in range(derivative + 1)]
+    bern = [bernstein(t, n, q) for q in range(derivative + 1)]
+    return basis_from_jets(bern, jets, derivative)
+
+
+def seed_basis_derivatives(t: np.ndarray, degree: int, seed: Seed, max_order: int) -> list[np.ndarray]:
+    r"""``[b^{(0)}, ..., b^{(K)}]`` of :func:`seed_basis` in one pass (no validation of t).
+
+    One seed evaluation for all orders (:meth:`Seed.jets`: one sin/cos pass for the GHT family)
+    and one Bernstein matrix ``B^{(q)}_{j,n}`` per order, combined by Leibniz' rule
+    ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``. Orders above 3 need a seed that
+    provides them (the GHT family does, for every order).
+
+    Returns:
+        List of K+1 arrays of shape (len(t), degree+1).
+
+    Raises:
+        GHTError: an order the seed does not provide.
+    """
+    n = degree - 2
+    jets = [_columns(f) for f in seed.jets(t, max_order)]
+    bern = [bernstein(t, n, q) for q in range(max_order + 1)]
+    return [basis_from_jets(bern, jets, r) for r in range(max_order + 1)]
+
+
+def evaluate_derivatives(t: np.ndarray, control_points: np.ndarray, seed: Seed, max_order: int) -> list[np.ndarray]:
+    r"""``[P(t), P'(t), ..., P^(K)(t)]``, ``P^(r) = Σ_i b^{(r)}_{i,m}(t) P_i``, in one pass (no validation of t).
+
+    The fast path for several derivative orders at the same parameters, by the compact form
+    ``P = f0 Q0 + f1 Q1 + f2 Q2 = Q1 + f0 (Q0 - Q1) + f2 (Q2 - Q1)`` (``Q_k`` the degree-n Bézier
+    curve on ``P_k..P_{k+n}``, n = m-2, and ``f1 = 1 - f0 - f2``) and Leibniz' rule
+
+    ``P^(r) = Q1^(r) + Σ_s C(r,s) (f0^(s) (Q0 - Q1)^(r-s) + f2^(s) (Q2 - Q1)^(r-s))``,
+
+    where the q-th derivative of a degree-n Bézier curve is the degree-(n-q) curve on the scaled
+    differences ``n!/(n-q)! Δ^q``. One seed evaluation for all orders (:meth:`Seed.f0_f2_jets`:
+    one sin/cos pass for the GHT family) and one Bernstein matrix per order; equal to the
+    basis-matrix products ``seed_basis(t, m, seed, r) @ P`` up to rounding.
+
+    Args:
+        t: 1-D parameter array.
+        control_points: (m+1, dim) array, m >= 2.
+        seed: the curve's seed.
+        max_order: K >= 0 (above 3 only for seeds that provide it).
+
+    Returns:
+        List of K+1 arrays of shape (len(t), dim).
+
+    Raises:
+        GHTError: an order the seed does not provide.
+    """
+    P = np.asarray(control_points, dtype=float)
+    K = int(max_order)
+    if t.size > _CHUNK:
+        out = [np.empty((t.size, P.shape[1])) for _ in range(K + 1)]
+        for lo in range(0, t.size, _CHUNK):
+            sl = slice(lo, lo + _CHUNK)
+            for o, part in zip(out, evaluate_derivatives(t[sl], P, seed, K)):
+                o[sl] = part
+        return out
+    n = P.shape[0] - 3
+    N, dim = t.size, P.shape[1]
+    jets = seed.f0_f2_jets(t, K)
+    P0, P1, P2 = (P[k : k + n + 1] for k in range(3))
+    # column blocks: points of Q0 - Q1, Q2 - Q1, Q1, differenced and scaled per derivative order
+    D = np.concatenate([P0 - P1, P2 - P1, P1], axis=1)
+    Q: list[np.ndarray | None] = []
+    for q in range(K + 1):
+        if q > n:
+            Q.append(None)
+            continue
+        if q:
+            D = (n - q + 1) * np.diff(D, axis=0)
+        Q.append(bernstein(t, n - q) @ D)
+    out = []
+    for r in range(K + 1):
+        acc = Q[r][:, 2 * dim :].copy() if Q[r] is not None else np.zeros((N, dim))
+        for s in range(r + 1):
+            Qq = Q[r - s]
+            if Qq is None:
+                continue
+            f0, f2 = jets[s]
+            term = f0[:, None] * Qq[:, :dim]
+            term += f2[:, None] * Qq[:, dim : 2 * dim]
+            c = comb(r, s)
+            if c != 1:
+                term *= c
+            acc += term
+        out.append(acc)
     return out
 
 

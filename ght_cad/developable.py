@@ -32,14 +32,13 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_finite_array
-from .basis import bernstein
+from ._validate import as_parameter_array, check_finite_array, check_unit_interval
+from .basis import evaluate_derivatives
 from .bspline import BSplineSurfaceData, fit_function
 from .curve import GHTCurve
 from .errors import ConversionError, DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
-from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, normalize_planes
+from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
 from .ruled import Developability, RuledSurface
-from .seeds import GHTSeed, ReversedSeed
 
 __all__ = [
     "EnvelopeDevelopable",
@@ -57,6 +56,8 @@ __all__ = [
 ]
 
 _Jet = list  # list of arrays: value and derivatives 0..K
+_JET_CACHE_SIZE = 8  # dual-curve jets kept per EnvelopeDevelopable
+_JET_CACHE_MAX = 4096  # largest parameter array whose jet is kept
 _ZERO = np.array([0.0])
 _ONE = np.array([1.0])
 
@@ -122,26 +123,13 @@ def _check_derivative(derivative: Any, max_order: int = 2) -> int:
     return r
 
 
-def _seed_high_jet(seed: Any, t: np.ndarray, order: int) -> np.ndarray:
-    """``(f0, f1, f2)^(order)`` for orders above the seed's guaranteed 3 (GHT family only)."""
-    if order <= 3:
-        return seed.jet(t, order)
-    base = seed.base if isinstance(seed, ReversedSeed) else seed
-    if not isinstance(base, GHTSeed):
-        raise GHTError(
-            f"derivative order {order} of the seed {seed!r} is needed here but custom seeds only "
-            "guarantee orders 0..3; use the GHT/GBT/Bernstein seeds"
-        )
-    f0, f2 = seed.f0_f2(t, order)  # the GHT formulas hold for every order
-    return np.column_stack([f0, -(f0 + f2), f2])
-
-
 def curve_derivatives(curve: GHTCurve, t: Any, max_order: int) -> list[np.ndarray]:
     r"""``[C(t), C'(t), ..., C^(max_order)(t)]`` analytically, also beyond order 3.
 
     ``C^(r) = Σ_i b^{(r)}_{i,m} P_i`` with ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``;
     seed derivatives of order > 3 come from the GHT seed formulas (sin/cos and polynomials), which
-    hold for every order.
+    hold for every order. All orders share one seed evaluation and one Bernstein matrix per order
+    (:func:`ght_cad.basis.evaluate_derivatives`).
 
     Args:
         curve: a GHT curve (GHT/GBT/Bernstein seed, possibly reversed, for orders > 3).
@@ -149,21 +137,17 @@ def curve_derivatives(curve: GHTCurve, t: Any, max_order: int) -> list[np.ndarra
         max_order: highest order (0..6).
 
     Raises:
-        GHTError: a custom seed and ``max_order > 3``.
+        GHTError: a custom seed and ``max_order > 3``; t outside [0, 1].
     """
     tt, _ = as_parameter_array(t)
-    out = [curve.derivative(tt, r) for r in range(min(max_order, 3) + 1)]
-    n = curve.degree - 2
-    P = curve.control_points
-    for r in range(4, max_order + 1):
-        B = np.zeros((tt.size, curve.degree + 1))
-        for s in range(r + 1):
-            f = _seed_high_jet(curve.seed, tt, s)
-            Bn = bernstein(tt, n, r - s)
-            for k in range(3):
-                B[:, k : k + n + 1] += comb(r, s) * Bn * f[:, k : k + 1]
-        out.append(B @ P)
-    return out
+    check_unit_interval("t", tt, slack=1e-9)
+    seed = curve.seed
+    if max_order > seed.max_derivative:
+        raise GHTError(
+            f"derivative order {int(seed.max_derivative) + 1} of the seed {seed!r} is needed here but custom "
+            f"seeds only guarantee orders 0..{int(seed.max_derivative)}; use the GHT/GBT/Bernstein seeds"
+        )
+    return evaluate_derivatives(tt, curve.control_points, seed, max_order)
 
 
 def _fmt(v: Any) -> str:
@@ -280,16 +264,45 @@ class EnvelopeDevelopable(RuledSurface):
         return t0 + uu * (t1 - t0)
 
     def _U(self, u: Any, K: int) -> _Jet:
-        """``[d^r U(t(u)) / du^r for r = 0..K]`` (K <= 3)."""
+        """``[d^r U(t(u)) / du^r for r = 0..K]`` (K <= 3), read-only arrays.
+
+        ``d^r U / du^r = h^r U^(r)(t)``, ``h = t1 - t0``; all orders from one basis pass
+        (:func:`ght_cad.basis.evaluate_derivatives`). The last few jets of up to
+        ``_JET_CACHE_MAX`` parameters are kept: the checks and the B-spline fit ask for the same
+        parameters several times (a, b, ruling, edge of regression).
+        """
         t = self.dual_parameter(u)
-        h = self.t_range[1] - self.t_range[0]
-        return [self.dual_curve.derivative(t, r) * h**r for r in range(K + 1)]
+        t0, t1 = self.t_range
+        curve = self.dual_curve
+        cache = self.__dict__.get("_jet_cache")
+        if cache is None or cache[0] is not curve:
+            cache = (curve, {})
+            self._jet_cache = cache
+        store = cache[1]
+        key = (t.tobytes(), t0, t1) if t.size <= _JET_CACHE_MAX else None
+        hit = store.get(key) if key is not None else None
+        if hit is not None and len(hit) > K:
+            return hit[: K + 1]
+        check_unit_interval("t", t, slack=1e-9)
+        h = t1 - t0
+        out = [d * h**r for r, d in enumerate(evaluate_derivatives(t, curve.control_points, curve.seed, K))]
+        if key is not None:
+            for d in out:
+                d.setflags(write=False)
+            if len(store) >= _JET_CACHE_SIZE:
+                store.pop(next(iter(store)))
+            store[key] = out
+        return out
 
     def _boundary_h(self, u: Any, which: int, K: int) -> _Jet:
-        """Homogeneous jet of ``meet(U, U', E)`` (E = E_a for which=0, E_b for which=1)."""
+        """Homogeneous jet of ``meet(U, U', E)`` (E = E_a for which=0, E_b for which=1).
+
+        ``meet(A, B, E) = plucker(A, B) @ M(E)`` (linear in E); the product rule gives
+        ``X^(k) = Σ_s C(k,s) meet(U^(s), U^(k-s+1), E)``.
+        """
         U = self._U(u, K + 1)
-        E = self.boundary_planes[which]
-        return _jprod(lambda A, B: meet(A, B, E), U[: K + 1], U[1 : K + 2])
+        M = self._boundary_meet()[1][which]
+        return _jprod(lambda A, B: plucker(A, B) @ M, U[: K + 1], U[1 : K + 2])
 
     # -- RuledSurface interface ---------------------------------------------------------------
     def a(self, u: Any, derivative: int = 0) -> np.ndarray:
@@ -305,18 +318,27 @@ class EnvelopeDevelopable(RuledSurface):
     def boundary_values(self, u: Any) -> np.ndarray:
         """``(a(u), b(u))`` side by side, shape (len(u), 6), sharing one evaluation of ``U, U'``."""
         U = self._U(u, 1)
-        X = meet(U[0][:, None, :], U[1][:, None, :], self.boundary_planes[None, :, :])
+        X = (plucker(U[0], U[1]) @ self._boundary_meet()[0]).reshape(-1, 2, 4)
         with np.errstate(divide="ignore", invalid="ignore"):
             return (X[:, :, 1:] / X[:, :, :1]).reshape(-1, 6)
+
+    def _boundary_meet(self) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+        """``([M(E_a) | M(E_b)], (M(E_a), M(E_b)))``: ``meet(U, V, E) = plucker(U, V) @ M(E)`` is
+        linear in E, so one product cuts a line with a boundary plane, or with both (6 x 8).
+        Kept while the boundary planes are unchanged."""
+        E = self.boundary_planes
+        key = E.tobytes()
+        cached = self.__dict__.get("_meet_cache")
+        if cached is None or cached[0] != key:
+            Ms = (meet_matrix(E[0]), meet_matrix(E[1]))
+            cached = (key, (np.hstack(Ms), Ms))
+            self._meet_cache = cached
+        return cached[1]
 
     def boundary_jet(self, u: Any, order: int = 2) -> list[np.ndarray]:
         """``[(a, b), (a', b'), ...]`` up to ``order`` (<= 2), each (len(u), 6), from one ``U`` jet."""
         r = _check_derivative(order)
-        U = self._U(u, r + 1)
-        sides = [
-            _jcartesian(_jprod(lambda A, B, E=E: meet(A, B, E), U[: r + 1], U[1 : r + 2]))
-            for E in self.boundary_planes
-        ]
+        sides = [_jcartesian(self._boundary_h(u, which, r)) for which in (0, 1)]
         return [np.hstack([sides[0][k], sides[1][k]]) for k in range(r + 1)]
 
     # -- geometry -------------------------------------------------------------------------------
@@ -357,14 +379,20 @@ class EnvelopeDevelopable(RuledSurface):
         with np.errstate(divide="ignore", invalid="ignore"):
             return h / R0
 
-    def _regression_hr(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
+    def _regression_hr(
+        self, u: Any, A: np.ndarray | None = None, g: np.ndarray | None = None, *, with_norm: bool = False
+    ) -> Any:
+        """``(h, R0)`` of :meth:`regression_parameter` for unit ``R``, and ``|R|`` if ``with_norm``;
+        ``A = a(u)``, ``g = b(u) - a(u)`` may be passed when already known."""
         U = self._U(u, 2)
         R = meet(U[0], U[1], U[2])
-        R = R / np.maximum(np.linalg.norm(R, axis=1, keepdims=True), 1e-300)
-        A = self.a(u)
-        g = self.b(u) - A
+        Rn = np.linalg.norm(R, axis=1, keepdims=True)
+        R = R / np.maximum(Rn, 1e-300)
+        if A is None or g is None:
+            A = self.a(u)
+            g = self.b(u) - A
         h = np.sum((R[:, 1:] - R[:, :1] * A) * g, axis=1) / np.sum(g * g, axis=1)
-        return h, R[:, 0]
+        return (h, R[:, 0], Rn[:, 0]) if with_norm else (h, R[:, 0])
 
     # -- validation -----------------------------------------------------------------------------
     def check(self, samples: int = 513) -> None:
@@ -411,7 +439,8 @@ class EnvelopeDevelopable(RuledSurface):
             nE = E[1:] / np.linalg.norm(E[1:])
             sin = dunit @ nE
             hits = [float(x) for x in u[np.abs(sin) <= PARALLEL_TOL]]
-            hits += _sign_change_roots(lambda x, nE=nE: _ruling_sin(self, x, nE), u, _ruling_sin(self, u, nE))
+            # sampled values: _ruling_sin(self, u, nE) from the d, |d| above
+            hits += _sign_change_roots(lambda x, nE=nE: _ruling_sin(self, x, nE), u, (d @ nE) / dn)
             if hits:
                 x = hits[0]
                 Ux = self._U(np.array([x]), 1)
@@ -445,17 +474,16 @@ class EnvelopeDevelopable(RuledSurface):
                 + self._orientation_hint()
             )
         # edge of regression inside the strip: phi = h (R0 - h) >= 0  <=>  0 <= v_R <= 1
-        self._check_regression(u)
+        self._check_regression(u, A, G)
 
-    def _check_regression(self, u: np.ndarray) -> None:
+    def _check_regression(self, u: np.ndarray, A: np.ndarray | None = None, G: np.ndarray | None = None) -> None:
         from scipy.optimize import minimize_scalar
 
-        h, R0 = self._regression_hr(u)
+        h, R0, Rn = self._regression_hr(u, A, G, with_norm=True)
         phi = h * (R0 - h)
         # where U, U', U'' are dependent (an inflection of the dual curve) R vanishes and the edge
         # of regression is undefined at that single t: not a point of the strip
         U = self._U(u, 2)
-        Rn = np.linalg.norm(meet(U[0], U[1], U[2]), axis=1)
         ref = np.prod([np.linalg.norm(x, axis=1) for x in U], axis=0)
         phi = np.where(Rn > 1e-12 * ref, phi, -np.inf)
         best_u, best_phi = float(u[int(np.argmax(phi))]), float(np.max(phi))

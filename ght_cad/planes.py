@@ -35,6 +35,8 @@ __all__ = [
     "plane_point",
     "signed_distance",
     "meet",
+    "meet_matrix",
+    "plucker",
     "meet_point",
     "line_of_planes",
     "PARALLEL_TOL",
@@ -212,23 +214,52 @@ def meet(A: Any, B: Any, C: Any) -> np.ndarray:
         Array of shape (..., 4); ``X0 = 0`` for a point at infinity, ``X = 0`` when the three
         planes share a line.
     """
+    C = np.asarray(C, dtype=float)
+    p = plucker(A, B)
+    # x0 = c3 p12 - c2 p13 + c1 p23, x1 = -(c3 p02 - c2 p03 + c0 p23),
+    # x2 = c3 p01 - c1 p03 + c0 p13, x3 = -(c2 p01 - c1 p02 + c0 p12)
+    terms = C[..., _MEET_C] * p[..., _MEET_P]
+    x = terms[..., 0] - terms[..., 1]
+    x += terms[..., 2]
+    x[..., 1::2] *= -1.0
+    return x
+
+
+def plucker(A: Any, B: Any) -> np.ndarray:
+    r"""Plücker coordinates ``p_ij = A_i B_j - A_j B_i`` of the line ``A ∧ B`` of two planes.
+
+    Order ``(p01, p02, p03, p12, p13, p23)``; ``A, B`` broadcast over leading dimensions.
+
+    Returns:
+        Array of shape (..., 6).
+    """
     A = np.asarray(A, dtype=float)
     B = np.asarray(B, dtype=float)
-    C = np.asarray(C, dtype=float)
-    a0, a1, a2, a3 = (A[..., i] for i in range(4))
-    b0, b1, b2, b3 = (B[..., i] for i in range(4))
-    c0, c1, c2, c3 = (C[..., i] for i in range(4))
-    p01 = a0 * b1 - a1 * b0
-    p02 = a0 * b2 - a2 * b0
-    p03 = a0 * b3 - a3 * b0
-    p12 = a1 * b2 - a2 * b1
-    p13 = a1 * b3 - a3 * b1
-    p23 = a2 * b3 - a3 * b2
-    x0 = c3 * p12 - c2 * p13 + c1 * p23
-    x1 = -(c3 * p02 - c2 * p03 + c0 * p23)
-    x2 = c3 * p01 - c1 * p03 + c0 * p13
-    x3 = -(c2 * p01 - c1 * p02 + c0 * p12)
-    return np.stack(np.broadcast_arrays(x0, x1, x2, x3), axis=-1)
+    return A[..., _PL_I] * B[..., _PL_J] - A[..., _PL_J] * B[..., _PL_I]
+
+
+def meet_matrix(C: Any) -> np.ndarray:
+    r"""The (6, 4) matrix ``M(C)`` with ``meet(A, B, C) = plucker(A, B) @ M(C)`` for one plane ``C``.
+
+    ``meet`` is linear in ``C`` for a fixed line: ``X_j = Σ ±C_k p_..`` (see :func:`meet`); with
+    several planes stack the matrices side by side to cut one line with all of them in one product.
+    Equal to :func:`meet` up to rounding (the products are summed in BLAS order).
+
+    Raises:
+        GHTError: ``C`` is not 4 finite numbers.
+    """
+    c = _vec("C", C, 4)
+    M = np.zeros((6, 4))
+    M[_MEET_P, np.arange(4)[:, None]] = _MEET_SIGN * c[_MEET_C]
+    return M
+
+
+# index tables of meet(): Plücker pairs (i, j), and per output j the (C index, Plücker index) triples
+_PL_I = np.array([0, 0, 0, 1, 1, 2])
+_PL_J = np.array([1, 2, 3, 2, 3, 3])
+_MEET_C = np.array([[3, 2, 1], [3, 2, 0], [3, 1, 0], [2, 1, 0]])
+_MEET_P = np.array([[3, 4, 5], [1, 2, 5], [0, 2, 4], [0, 1, 3]])
+_MEET_SIGN = np.array([[1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, 1.0], [-1.0, 1.0, -1.0]])
 
 
 def meet_point(A: Any, B: Any, C: Any, *, names: Sequence[str] = ("A", "B", "C")) -> np.ndarray:

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -41,6 +41,8 @@ __all__ = [
     "make_seed",
     "seed_names",
     "MAX_DERIVATIVE",
+    "ght_seed_jet",
+    "ght_seed_derivatives",
 ]
 
 #: Highest derivative order every seed provides analytically.
@@ -73,6 +75,9 @@ class Seed(ABC):
         """Return ``(f0^(order)(t), f2^(order)(t))`` for a 1-D array ``t``, order 0..3."""
 
     # -- derived -----------------------------------------------------------------------------
+    #: Highest derivative order :meth:`f0_f2` provides (custom seeds: 3; the GHT family: any).
+    max_derivative: float = MAX_DERIVATIVE
+
     def jet(self, t: np.ndarray | float, order: int = 0) -> np.ndarray:
         """Values of ``(f0, f1, f2)^(order)`` at ``t`` as an array of shape (len(t), 3).
 
@@ -81,12 +86,29 @@ class Seed(ABC):
         if not 0 <= int(order) <= MAX_DERIVATIVE:
             raise GHTError(f"derivative order {order} is not available; seeds provide orders 0..{MAX_DERIVATIVE}")
         tt = np.atleast_1d(np.asarray(t, dtype=float))
-        f0, f2 = self.f0_f2(tt, int(order))
-        out = np.empty((tt.size, 3))
-        out[:, 0] = f0
-        out[:, 2] = f2
-        out[:, 1] = (1.0 if order == 0 else 0.0) - f0 - f2
-        return out
+        return _pack(*self.f0_f2(tt, int(order)), int(order), tt.size)
+
+    def f0_f2_jets(self, t: np.ndarray | float, max_order: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """``[f0_f2(t, 0), ..., f0_f2(t, max_order)]`` for a 1-D ``t``; subclasses share work between orders.
+
+        Orders above 3 exist only for seeds whose :attr:`max_derivative` allows them (the GHT
+        family, whose sin/cos and polynomial formulas hold for every order).
+
+        Raises:
+            GHTError: ``max_order`` outside ``0..max_derivative``.
+        """
+        K = _check_jet_order(self, max_order)
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        return [self.f0_f2(tt, r) for r in range(K + 1)]
+
+    def jets(self, t: np.ndarray | float, max_order: int) -> list[np.ndarray]:
+        """``[jet(t, 0), ..., jet(t, max_order)]``, each (len(t), 3), from :meth:`f0_f2_jets`.
+
+        Raises:
+            GHTError: ``max_order`` outside ``0..max_derivative``.
+        """
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        return [_pack(f0, f2, r, tt.size) for r, (f0, f2) in enumerate(self.f0_f2_jets(tt, max_order))]
 
     def end_jets(self) -> tuple[np.ndarray, np.ndarray]:
         """End jets ``a[r, k] = f_k^(r)(0)`` and ``e[r, k] = f_k^(r)(1)`` for r = 0..3.
@@ -123,22 +145,105 @@ class Seed(ABC):
         return f"{type(self).__name__}(mu={self.mu:g}, nu={self.nu:g}, gamma={self.gamma:g})"
 
 
-def _trig_parts(t: np.ndarray, order: int, *, ccw: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Derivative of order ``order`` of ``(x, x^2)`` where x = sin(πt/2) (ccw) or cos(πt/2).
+def _pack(f0: np.ndarray, f2: np.ndarray, order: int, size: int) -> np.ndarray:
+    """``(f0, f1, f2)^(order)`` as a (size, 3) array, ``f1^(r) = δ_r0 - f0^(r) - f2^(r)``."""
+    out = np.empty((size, 3))
+    out[:, 0] = f0
+    out[:, 2] = f2
+    out[:, 1] = (1.0 if order == 0 else 0.0) - f0 - f2
+    return out
 
-    Uses ``sin^2(πt/2) = (1 - cos πt)/2`` and ``cos^2(πt/2) = (1 + cos πt)/2``.
-    """
-    h = _HALF_PI
-    a = h * t
+
+def _check_jet_order(seed: "Seed", max_order: Any) -> int:
+    try:
+        K = int(max_order)
+    except (TypeError, ValueError):
+        raise GHTError(f"max_order={max_order!r} is not an integer") from None
+    if K != max_order or not 0 <= K <= seed.max_derivative:
+        top = seed.max_derivative
+        allowed = "0, 1, 2, ..." if math.isinf(top) else f"0..{int(top)}"
+        raise GHTError(f"derivative order {max_order!r} of the seed {seed!r} is not available; it provides orders {allowed}")
+    return K
+
+
+def _trig_values(t: np.ndarray, higher: bool) -> tuple[np.ndarray, ...]:
+    """``sin(πt/2), cos(πt/2)`` and, for derivatives (``higher``), ``sin(πt) = 2 sin cos`` and
+    ``cos(πt) = (cos - sin)(cos + sin)`` of the half angle: one sin/cos pass."""
+    a = _HALF_PI * t
+    sa, ca = np.sin(a), np.cos(a)
+    if not higher:
+        return sa, ca
+    return sa, ca, 2.0 * (sa * ca), (ca - sa) * (ca + sa)
+
+
+# r-th derivative of sin(x), cos(x) as (sign, use_cos) for r mod 4
+_SIN_D = ((1.0, False), (1.0, True), (-1.0, False), (-1.0, True))
+_COS_D = ((1.0, True), (-1.0, False), (-1.0, True), (1.0, False))
+
+
+def _ght_from_trig(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int, trig: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The GHT seed formula at one derivative order from precomputed :func:`_trig_values`."""
+    w = 0.5 * (1.0 + gamma)
+    sa, ca = trig[0], trig[1]
     if order == 0:
-        x = np.sin(a) if ccw else np.cos(a)
-        return x, x * x
-    # r-th derivative of sin(h t) is h^r sin(h t + r π/2); of cos likewise with cos.
-    x = h**order * (np.sin(a + order * h) if ccw else np.cos(a + order * h))
-    # r-th derivative of cos(πt) is π^r cos(πt + r π/2)
-    dcos = math.pi**order * np.cos(math.pi * t + order * h)
-    x2 = -0.5 * dcos if ccw else 0.5 * dcos
-    return x, x2
+        # (1-x)(1-λx) = 1 - (1+λ)x + λx^2
+        g0 = 1.0 - (1.0 + mu) * sa + mu * (sa * sa)
+        g2 = 1.0 - (1.0 + nu) * ca + nu * (ca * ca)
+        return (1.0 - w) * g0 + w * (1.0 - t) ** 2, (1.0 - w) * g2 + w * (t * t)
+    # f0^(r) = (1-w)(-(1+μ) s^(r) + μ (s²)^(r)) + w p0^(r), f2^(r) likewise with c, ν; with
+    # s^(r) = (π/2)^r sin^(r)(πt/2), c^(r) = (π/2)^r cos^(r)(πt/2), (s²)^(r) = -(c²)^(r) = -π^r cos^(r)(πt)/2
+    v = 1.0 - w
+    hr, pr = _HALF_PI**order, math.pi**order
+    sg_s, cos_s = _SIN_D[order % 4]
+    sg_c, cos_c = _COS_D[order % 4]
+    x_s = ca if cos_s else sa
+    x_c = ca if cos_c else sa
+    x_d = trig[3] if cos_c else trig[2]
+    half_d = 0.5 * pr * sg_c  # (c²)^(r) = half_d * x_d
+    f0 = (-(v * (1.0 + mu)) * (hr * sg_s)) * x_s - (v * mu * half_d) * x_d
+    f2 = (-(v * (1.0 + nu)) * (hr * sg_c)) * x_c + (v * nu * half_d) * x_d
+    # polynomial part w p^(r): p0 = (1-t)², p2 = t²
+    if order == 1:
+        wt = (2.0 * w) * t
+        f0 = f0 + (wt - 2.0 * w)
+        f2 = f2 + wt
+    elif order == 2:
+        f0 = f0 + 2.0 * w
+        f2 = f2 + 2.0 * w
+    return f0, f2
+
+
+def ght_seed_jet(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    r"""GHT seed derivatives ``(f0^(r)(t), f2^(r)(t))``, broadcasting ``mu, nu, gamma`` against ``t``.
+
+    ``f0 = (1-w)(1-s)(1-μs) + w(1-t)²``, ``f2 = (1-w)(1-c)(1-νc) + w t²``, ``w = (1+γ)/2``,
+    ``s = sin(πt/2)``, ``c = cos(πt/2)``; for ``r >= 1`` with ``s^(r) = (π/2)^r sin(πt/2 + rπ/2)``,
+    ``c^(r) = (π/2)^r cos(πt/2 + rπ/2)`` and ``(s²)^(r) = -(c²)^(r) = -π^r cos(πt + rπ/2) / 2``.
+    The formulas hold for every order r >= 0. This is the one implementation of the GHT seed:
+    :meth:`GHTSeed.f0_f2` and the population-vectorized optimizer problems call it.
+
+    Args:
+        t: parameters, 1-D array (N,).
+        mu, nu, gamma: shape parameters, scalars or arrays broadcasting against ``t`` (e.g. shape
+            (P, 1) for P parameter sets: the result is then (P, N)).
+        order: derivative order r >= 0.
+
+    Returns:
+        ``(f0^(r), f2^(r))``, each of the broadcast shape of ``t`` and the parameters.
+    """
+    t = np.asarray(t, dtype=float)
+    return _ght_from_trig(t, mu, nu, gamma, int(order), _trig_values(t, int(order) > 0))
+
+
+def ght_seed_derivatives(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``[ght_seed_jet(t, mu, nu, gamma, r) for r = 0..max_order]`` sharing one sin/cos pass.
+
+    Returns exactly the arrays of :func:`ght_seed_jet` (same formulas, same operations).
+    """
+    t = np.asarray(t, dtype=float)
+    K = int(max_order)
+    trig = _trig_values(t, K > 0)
+    return [_ght_from_trig(t, mu, nu, gamma, r, trig) for r in range(K + 1)]
 
 
 class GHTSeed(Seed):
@@ -155,24 +260,16 @@ class GHTSeed(Seed):
         """Blend weight ``w = (1+γ)/2`` between the GBT (w=0) and Bernstein (w=1) seeds."""
         return 0.5 * (1.0 + self.gamma)
 
+    max_derivative = math.inf
+
     def f0_f2(self, t: np.ndarray, order: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        w = self.w
-        mu, nu = self.mu, self.nu
-        s, s2 = _trig_parts(t, order, ccw=True)
-        c, c2 = _trig_parts(t, order, ccw=False)
-        # (1-x)(1-λx) = 1 - (1+λ)x + λx^2
-        const = 1.0 if order == 0 else 0.0
-        g0 = const - (1.0 + mu) * s + mu * s2
-        g2 = const - (1.0 + nu) * c + nu * c2
-        if order == 0:
-            p0, p2 = (1.0 - t) ** 2, t * t
-        elif order == 1:
-            p0, p2 = -2.0 * (1.0 - t), 2.0 * t
-        elif order == 2:
-            p0 = p2 = np.full_like(t, 2.0)
-        else:
-            p0 = p2 = np.zeros_like(t)
-        return (1.0 - w) * g0 + w * p0, (1.0 - w) * g2 + w * p2
+        return ght_seed_jet(t, self.mu, self.nu, self.gamma, order)
+
+    def f0_f2_jets(self, t: np.ndarray | float, max_order: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """All orders ``0..max_order`` (any order) from one sin/cos pass (:func:`ght_seed_derivatives`)."""
+        K = _check_jet_order(self, max_order)
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        return ght_seed_derivatives(tt, self.mu, self.nu, self.gamma, K)
 
     def reversed(self) -> "Seed":
         """Symmetry ``f2(t; μ,ν,γ) = f0(1-t; ν,μ,γ)``: the reversed seed swaps μ and ν."""
@@ -215,6 +312,8 @@ class BernsteinSeed(GHTSeed):
             return np.full_like(t, 2.0), np.full_like(t, 2.0)
         return np.zeros_like(t), np.zeros_like(t)
 
+    f0_f2_jets = Seed.f0_f2_jets  # its own polynomial f0_f2 (every order), not the GHT formula at gamma = 1
+
     def reversed(self) -> "Seed":
         return BernsteinSeed()
 
@@ -229,6 +328,11 @@ class ReversedSeed(Seed):
         self.base = base
         self.mu, self.nu, self.gamma = base.nu, base.mu, base.gamma
         self.name = f"reversed-{base.name}"
+
+    @property
+    def max_derivative(self) -> float:  # type: ignore[override]
+        """Orders available: those of the base seed."""
+        return self.base.max_derivative
 
     def f0_f2(self, t: np.ndarray, order: int = 0) -> tuple[np.ndarray, np.ndarray]:
         f0, f2 = self.base.f0_f2(1.0 - t, order)

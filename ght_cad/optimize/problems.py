@@ -25,15 +25,15 @@ Problems:
 from __future__ import annotations
 
 import math
-from math import comb
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..basis import bernstein
+from ..basis import basis_from_jets, bernstein
 from ..curve import GHTCurve, gauss_legendre
 from ..errors import GHTError
 from ..ruled import CurvePairRuledSurface, RuledSurface
+from ..seeds import ght_seed_derivatives, ght_seed_jet
 
 __all__ = [
     "ght_seed_jets",
@@ -54,28 +54,17 @@ __all__ = [
 
 SHAPE_NAMES = ("mu", "nu", "gamma")
 FAIRNESS_MEASURES = ("AL", "En", "CVEn")
-_HALF_PI = 0.5 * math.pi
 
 
 # --------------------------------------------------------------------------------------------
 # vectorized GHT basis for many parameter sets
 # --------------------------------------------------------------------------------------------
-def _trig(t: np.ndarray, order: int, ccw: bool) -> tuple[np.ndarray, np.ndarray]:
-    """r-th derivatives of ``x`` and ``x²`` for ``x = sin(πt/2)`` (ccw) or ``cos(πt/2)``."""
-    a = _HALF_PI * t
-    if order == 0:
-        x = np.sin(a) if ccw else np.cos(a)
-        return x, x * x
-    x = _HALF_PI**order * (np.sin(a + order * _HALF_PI) if ccw else np.cos(a + order * _HALF_PI))
-    dcos = math.pi**order * np.cos(math.pi * t + order * _HALF_PI)
-    return x, (-0.5 * dcos if ccw else 0.5 * dcos)
-
-
 def ght_seed_jets(t: np.ndarray, mu: np.ndarray, nu: np.ndarray, gamma: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     r"""GHT seed derivatives ``f0^(r)(t), f2^(r)(t)`` for P parameter sets at once.
 
     ``f0 = (1-w)(1-s)(1-μs) + w(1-t)²``, ``f2 = (1-w)(1-c)(1-νc) + w t²``, ``w = (1+γ)/2``,
-    ``s = sin(πt/2)``, ``c = cos(πt/2)`` (spec section 1), differentiated analytically.
+    ``s = sin(πt/2)``, ``c = cos(πt/2)`` (spec section 1), differentiated analytically by
+    :func:`ght_cad.seeds.ght_seed_jet` (the same formula as :class:`ght_cad.seeds.GHTSeed`).
 
     Args:
         t: nodes, shape (N,).
@@ -85,23 +74,12 @@ def ght_seed_jets(t: np.ndarray, mu: np.ndarray, nu: np.ndarray, gamma: np.ndarr
     Returns:
         ``(f0, f2)`` each of shape (P, N).
     """
-    mu = np.asarray(mu, dtype=float)[:, None]
-    nu = np.asarray(nu, dtype=float)[:, None]
-    w = 0.5 * (1.0 + np.asarray(gamma, dtype=float))[:, None]
-    s, s2 = _trig(t, order, True)
-    c, c2 = _trig(t, order, False)
-    const = 1.0 if order == 0 else 0.0
-    g0 = const - (1.0 + mu) * s + mu * s2
-    g2 = const - (1.0 + nu) * c + nu * c2
-    if order == 0:
-        p0, p2 = (1.0 - t) ** 2, t * t
-    elif order == 1:
-        p0, p2 = -2.0 * (1.0 - t), 2.0 * t
-    elif order == 2:
-        p0 = p2 = np.full_like(t, 2.0)
-    else:
-        p0 = p2 = np.zeros_like(t)
-    return (1.0 - w) * g0 + w * p0, (1.0 - w) * g2 + w * p2
+    return ght_seed_jet(np.asarray(t, dtype=float), *_columns(mu, nu, gamma), order)
+
+
+def _columns(mu: Any, nu: Any, gamma: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Shape parameters (P,) as columns (P, 1) that broadcast against nodes (N,)."""
+    return tuple(np.asarray(x, dtype=float)[:, None] for x in (mu, nu, gamma))  # type: ignore[return-value]
 
 
 def population_basis(
@@ -131,24 +109,16 @@ class PopulationBasis:
         self._bern = [bernstein(self.t, n, q) for q in range(4)]
 
     def __call__(self, mu: Any, nu: Any, gamma: Any, orders: Sequence[int]) -> dict[int, np.ndarray]:
-        """``{r: b^{(r)}}`` for the requested orders, each (P, N, m+1)."""
+        """``{r: b^{(r)}}`` for the requested orders, each (P, N, m+1).
+
+        One sin/cos pass for all orders (:func:`ght_cad.seeds.ght_seed_derivatives`), combined
+        with the cached Bernstein matrices by :func:`ght_cad.basis.basis_from_jets`.
+        """
         top = max(orders)
-        n = self.degree - 2
         jets = []
-        for s in range(top + 1):
-            f0, f2 = ght_seed_jets(self.t, mu, nu, gamma, s)
-            jets.append((f0, (1.0 if s == 0 else 0.0) - f0 - f2, f2))
-        P = jets[0][0].shape[0]
-        out = {}
-        for r in orders:
-            b = np.zeros((P, self.t.size, self.degree + 1))
-            for s in range(r + 1):
-                B = self._bern[r - s][None, :, :]
-                c = float(comb(r, s))
-                for k, fk in enumerate(jets[s]):
-                    b[:, :, k : k + n + 1] += (c * fk)[:, :, None] * B
-            out[r] = b
-        return out
+        for s, (f0, f2) in enumerate(ght_seed_derivatives(self.t, *_columns(mu, nu, gamma), top)):
+            jets.append((f0[:, :, None], ((1.0 if s == 0 else 0.0) - f0 - f2)[:, :, None], f2[:, :, None]))
+        return {r: basis_from_jets(self._bern, jets, r) for r in orders}
 
 
 # --------------------------------------------------------------------------------------------
