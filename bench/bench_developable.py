@@ -15,17 +15,8 @@ Run: ``python bench/bench_developable.py [--repeat R]``
 from __future__ import annotations
 
 import argparse
-import time
 
-
-
-def _best(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+from bench_basis import _best  # best-of-R wall time, shared by the bench scripts
 
 
 def main(repeat: int = 5) -> dict[str, float]:

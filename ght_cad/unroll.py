@@ -231,7 +231,7 @@ class RuledDevelopment:
 
     def map(self, u: Any, v: Any) -> np.ndarray:
         """Flat image ``Y(u, v) = A(u) + v L(u) D(u)`` of ``X(u, v)``; u, v broadcast, shape (n, 2)."""
-        uu, vv = np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
+        uu, vv = broadcast_uv(u, v)
         L = self.surface.ruling_lengths(uu)
         return self.directrix(uu) + (vv * L)[:, None] * self.ruling_direction(uu)
 
@@ -289,37 +289,51 @@ def ruled_area(surface: RuledSurface, rtol: float = 1e-14) -> float:
     return integrate(f, 0.0, 1.0, rtol=rtol)
 
 
-def _metric_samples(surface: RuledSurface, dev: RuledDevelopment, n: int = 24) -> dict[str, np.ndarray]:
-    """First-fundamental-form check on an n × 5 grid: angles between X_u, X_v vs Y_u, Y_v.
+def broadcast_uv(u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``u, v`` as float arrays of at least one dimension, broadcast to a common shape."""
+    return np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
 
-    Flat partials by a 5-point central difference of the development map (step 1e-3 · panel
-    width, O(h⁴)), independent of the construction; 3-D partials analytic.
+
+def _fd5(fun: Callable[[float], np.ndarray], h: float) -> np.ndarray:
+    """5-point central difference ``(-f(2h) + 8 f(h) - 8 f(-h) + f(-2h)) / 12h`` (O(h⁴))."""
+    return (-fun(2 * h) + 8 * fun(h) - 8 * fun(-h) + fun(-2 * h)) / (12 * h)
+
+
+def metric_angles(
+    xu: np.ndarray, xv: np.ndarray, flat_map: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    u: np.ndarray, v: np.ndarray, hu: float, hv: float,
+) -> dict[str, np.ndarray]:
+    r"""First-fundamental-form check: angle of the 3-D partials ``X_u, X_v`` against the flat ``Y_u, Y_v``.
+
+    ``angle = atan2(|p × q|, p·q)``; the flat partials come from a 5-point central difference of
+    ``flat_map(u, v)`` with steps ``hu``, ``hv`` (O(h⁴)), independent of how the map was built.
+    Shared by the ruled-surface and the face unrolling.
+
+    Args:
+        xu, xv: 3-D partials at the sample points, shape (n, 3).
+        flat_map: the development map ``(u, v) -> (n, 2)``.
+        u, v: the sample parameters (n,).
+        hu, hv: finite-difference steps.
+
+    Returns:
+        ``{"angle_3d", "angle_flat", "xu_len", "yu_len"}``, each (n,).
     """
+    yu = _fd5(lambda s: flat_map(u + s, v), hu)
+    yv = _fd5(lambda s: flat_map(u, v + s), hv)
+    a3 = np.arctan2(np.linalg.norm(np.cross(xu, xv), axis=1), np.einsum("ij,ij->i", xu, xv))
+    a2 = np.arctan2(np.abs(yu[:, 0] * yv[:, 1] - yu[:, 1] * yv[:, 0]), np.einsum("ij,ij->i", yu, yv))
+    return {"angle_3d": a3, "angle_flat": a2, "xu_len": np.linalg.norm(xu, axis=1), "yu_len": np.linalg.norm(yu, axis=1)}
+
+
+def _metric_samples(surface: RuledSurface, dev: RuledDevelopment, n: int = 24) -> dict[str, np.ndarray]:
+    """First-fundamental-form check on an n × 5 grid (:func:`metric_angles`): 3-D partials
+    analytic, flat partials with step 1e-3 (in the unit parameter square)."""
     u = np.linspace(0.02, 0.98, n)
     v = np.linspace(0.0, 1.0, 5)
     U, Vv = np.meshgrid(u, v, indexing="ij")
     U, Vv = U.ravel(), Vv.ravel()
     xu, xv = surface.partials(U, Vv)
-    h = 1e-3
-
-    def fd(fun: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        return (-fun(2 * h) + 8 * fun(h) - 8 * fun(-h) + fun(-2 * h)) / (12 * h)
-
-    yu = fd(lambda s: dev.map(U + s, Vv))
-    yv = fd(lambda s: dev.map(U, Vv + s))
-
-    def ang3(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        return np.arctan2(np.linalg.norm(np.cross(p, q), axis=1), np.einsum("ij,ij->i", p, q))
-
-    def ang2(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        return np.arctan2(np.abs(p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]), np.einsum("ij,ij->i", p, q))
-
-    return {
-        "angle_3d": ang3(xu, xv),
-        "angle_flat": ang2(yu, yv),
-        "xu_len": np.linalg.norm(xu, axis=1),
-        "yu_len": np.linalg.norm(yu, axis=1),
-    }
+    return metric_angles(xu, xv, dev.map, U, Vv, 1e-3, 1e-3)
 
 
 def _check_developable(surface: RuledSurface, tol_deg: float, best_effort: bool, what: str) -> Any:

@@ -49,7 +49,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 from ..errors import GHTError, NotDevelopableError
 from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from ..ruled import RuledSurface
-from ..unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable
+from ..unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
 
 __all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "shape_faces"]
 
@@ -76,22 +76,20 @@ def shape_faces(shape: Any) -> list[TopoDS_Face]:
 
 
 def _topods_face(face: Any) -> TopoDS_Face:
-    shape = face.wrapped if hasattr(face, "wrapped") else face
-    if not isinstance(shape, TopoDS_Shape) or shape.IsNull():
-        raise GHTError(f"cannot unroll a {type(face).__name__}; expected a build123d/cadquery Face or TopoDS_Face")
-    if shape.ShapeType() == TopAbs_FACE:
-        return TopoDS.Face_s(shape)
-    exp = TopExp_Explorer(shape, TopAbs_FACE)
-    faces = []
-    while exp.More():
-        faces.append(TopoDS.Face_s(exp.Current()))
-        exp.Next()
+    faces = shape_faces(face)
     if len(faces) == 1:
         return faces[0]
     raise GHTError(
         f"the shape has {len(faces)} faces; unroll takes one face (use unroll_composite(list_of_faces) "
         "for several)"
     )
+
+
+def _open_face(face: Any) -> tuple[TopoDS_Face, BRepAdaptor_Surface, tuple[float, float, float, float], "_SurfEval"]:
+    """The face, its surface adaptor, its (u0, u1, v0, v1) parameter bounds and an evaluator."""
+    f = _topods_face(face)
+    ad = BRepAdaptor_Surface(f)
+    return f, ad, BRepTools.UVBounds_s(f), _SurfEval(ad)
 
 
 class _SurfEval:
@@ -239,10 +237,7 @@ def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
     < 1e-9), ``"u"`` likewise, ``None`` when neither; the dict holds both measured deviations.
     Planes return ``"v"``.
     """
-    f = _topods_face(face)
-    ad = BRepAdaptor_Surface(f)
-    bounds = BRepTools.UVBounds_s(f)
-    ev = _SurfEval(ad)
+    f, ad, bounds, ev = _open_face(face)
     dv = _straightness(ev, bounds, "v")
     du = _straightness(ev, bounds, "u")
     info = {"deviation_v": dv, "deviation_u": du}
@@ -351,23 +346,13 @@ def _wires(face: TopoDS_Face) -> list[Any]:
 
 
 def _metric(ev: _SurfEval, fmap: Callable, bounds: tuple[float, float, float, float]) -> dict[str, np.ndarray]:
-    """Angles between S_u, S_v (OCCT D1) and F_u, F_v (5-point central differences) on a grid."""
+    """Angles between S_u, S_v (OCCT D1) and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
     u0, u1, v0, v1 = bounds
     uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
     vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
     U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
     d = ev.d2(U, V)
-    su, sv = d[1], d[2]
-    hu, hv = 1e-3 * (u1 - u0), 1e-3 * (v1 - v0)
-
-    def fd(fun: Callable[[float], np.ndarray], h: float) -> np.ndarray:
-        return (-fun(2 * h) + 8 * fun(h) - 8 * fun(-h) + fun(-2 * h)) / (12 * h)
-
-    fu = fd(lambda s: fmap(U + s, V), hu)
-    fv = fd(lambda s: fmap(U, V + s), hv)
-    a3 = np.arctan2(np.linalg.norm(np.cross(su, sv), axis=1), np.einsum("ij,ij->i", su, sv))
-    a2 = np.arctan2(np.abs(fu[:, 0] * fv[:, 1] - fu[:, 1] * fv[:, 0]), np.einsum("ij,ij->i", fu, fv))
-    return {"angle_3d": a3, "angle_flat": a2, "xu_len": np.linalg.norm(su, axis=1), "yu_len": np.linalg.norm(fu, axis=1)}
+    return metric_angles(d[1], d[2], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
 
 
 class _ClosedFormMap:
@@ -377,7 +362,7 @@ class _ClosedFormMap:
         self.kind, self.R, self.s = kind, R, s
 
     def map(self, u: Any, v: Any) -> np.ndarray:
-        u, v = np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
+        u, v = broadcast_uv(u, v)
         if self.kind == "plane":
             return np.stack([u, v], axis=1)
         if self.kind == "cylinder":
@@ -419,10 +404,7 @@ def unroll_face(
             and DD), and best_effort is False.
         GHTError: not a face, or a shape with several faces.
     """
-    f = _topods_face(face)
-    ad = BRepAdaptor_Surface(f)
-    bounds = BRepTools.UVBounds_s(f)
-    ev = _SurfEval(ad)
+    f, ad, bounds, ev = _open_face(face)
     kind = ad.GetType()
     info: dict[str, Any] = {"best_effort": bool(best_effort)}
     ruled_surface: FaceRuledSurface | None = None
@@ -463,7 +445,7 @@ def unroll_face(
 
         class _FaceMap:
             def map(self, u: Any, v: Any) -> np.ndarray:
-                u, v = np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
+                u, v = broadcast_uv(u, v)
                 t, s = rs.ts(u, v)
                 if straight_ok:  # exact ruled face: project the true point onto its ruling
                     return dev.map_points(t, ev.value(u, v))
