@@ -189,3 +189,118 @@ def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
     np.testing.assert_allclose(c.evaluate(1.0), [3, 1], atol=1e-15)
     # its reversal goes through the generic ReversedSeed
     np.testing.assert_allclose(c.reversed().evaluate(T), c.evaluate(1 - T), atol=1e-14)
+
+
+# -- one-pass jets and derivatives (seeds.ght_seed_jet / Seed.jets / basis.evaluate_derivatives) --
+class _CubicSeed:
+    """A custom seed (orders 0..3 only), defined inside tests to exercise the generic paths."""
+
+    @staticmethod
+    def make():
+        from ght_cad import Seed
+
+        class CubicSeed(Seed):
+            name = "cubic-jets-test"
+
+            def f0_f2(self, t, order=0):
+                if order == 0:
+                    return (1 - t) ** 3, t**3
+                if order == 1:
+                    return -3 * (1 - t) ** 2, 3 * t**2
+                if order == 2:
+                    return 6 * (1 - t), 6 * t
+                return np.full_like(t, -6.0), np.full_like(t, 6.0)
+
+        return CubicSeed()
+
+
+def _seeds(mu: float, nu: float, gamma: float) -> list:
+    from ght_cad.seeds import BernsteinSeed, ReversedSeed
+
+    ght = GHTSeed(mu, nu, gamma)
+    return [ght, GBTSeed(mu, nu), BernsteinSeed(), ReversedSeed(ght), _CubicSeed.make(), ReversedSeed(_CubicSeed.make())]
+
+
+@given(params, params, params)
+def test_seed_jets_equal_single_order_jets_exactly(mu: float, nu: float, gamma: float) -> None:
+    """``Seed.jets(t, K)[r]`` is bit for bit ``Seed.jet(t, r)`` (same formula, shared sin/cos pass)."""
+    for seed in _seeds(mu, nu, gamma):
+        J = seed.jets(T, 3)
+        assert len(J) == 4
+        for r in range(4):
+            np.testing.assert_array_equal(J[r], seed.jet(T, r))
+
+
+@given(st.lists(st.tuples(params, params, params), min_size=1, max_size=6), st.integers(0, 6))
+def test_ght_seed_jet_broadcasts_over_parameter_sets(P: list, r: int) -> None:
+    """``ght_seed_jet`` on (P, 1) parameter columns gives, row by row, exactly ``GHTSeed.f0_f2``."""
+    from ght_cad.seeds import ght_seed_derivatives, ght_seed_jet
+
+    arr = np.array(P)
+    f0, f2 = ght_seed_jet(T, arr[:, :1], arr[:, 1:2], arr[:, 2:3], r)
+    assert f0.shape == f2.shape == (len(P), T.size)
+    for i, (mu, nu, gamma) in enumerate(P):
+        g0, g2 = GHTSeed(mu, nu, gamma).f0_f2(T, r)
+        np.testing.assert_array_equal(f0[i], g0)
+        np.testing.assert_array_equal(f2[i], g2)
+    # all orders at once: the same arrays
+    for q, (a0, a2) in enumerate(ght_seed_derivatives(T, arr[:, :1], arr[:, 1:2], arr[:, 2:3], r)):
+        b0, b2 = ght_seed_jet(T, arr[:, :1], arr[:, 1:2], arr[:, 2:3], q)
+        np.testing.assert_array_equal(a0, b0)
+        np.testing.assert_array_equal(a2, b2)
+
+
+@given(params, params, params, st.integers(1, 6))
+def test_ght_seed_high_orders_are_derivatives(mu: float, nu: float, gamma: float, r: int) -> None:
+    """Order r of the GHT seed is the derivative of order r-1 (4th-order central differences, h=1e-3):
+    relative 1e-6 of the order-r scale (which grows like (π)^r)."""
+    from ght_cad.seeds import ght_seed_jet
+
+    t = np.linspace(0.05, 0.95, 37)
+    h = 1e-3
+    hi = np.array(ght_seed_jet(t, mu, nu, gamma, r))
+    lo = [np.array(ght_seed_jet(t + k * h, mu, nu, gamma, r - 1)) for k in (-2, -1, 1, 2)]
+    fd = (lo[0] - 8 * lo[1] + 8 * lo[2] - lo[3]) / (12 * h)
+    assert np.abs(fd - hi).max() <= 1e-6 * max(1.0, math.pi**r)
+
+
+def test_jets_reject_orders_a_seed_does_not_provide() -> None:
+    from ght_cad.errors import GHTError
+
+    cubic = _CubicSeed.make()
+    with pytest.raises(GHTError, match="derivative order 4 .* provides orders 0..3"):
+        cubic.jets(T, 4)
+    with pytest.raises(GHTError, match="derivative order -1 .* provides orders 0, 1, 2"):
+        GHTSeed().jets(T, -1)
+    assert len(GHTSeed(0.2, 0.1, -0.4).jets(T, 6)) == 7  # the GHT family: every order
+
+
+@given(st.integers(2, 9), params, params, params, st.integers(0, 5))
+def test_evaluate_derivatives_equals_basis_matrix_products(m: int, mu: float, nu: float, gamma: float, which: int) -> None:
+    """``evaluate_derivatives`` (compact form, one pass) = ``seed_basis(t, m, seed, r) @ P`` for r = 0..3,
+    to 1e-13 relative to the size of the control points times (m+1) π^r (the scale of b^(r))."""
+    from ght_cad.basis import evaluate_derivatives, seed_basis_derivatives
+
+    seed = _seeds(mu, nu, gamma)[which]
+    P = np.random.default_rng(m).normal(size=(m + 1, 4))
+    D = evaluate_derivatives(T, P, seed, 3)
+    B = seed_basis_derivatives(T, m, seed, 3)
+    for r in range(4):
+        ref = seed_basis(T, m, seed, r)
+        np.testing.assert_array_equal(B[r], ref)  # the same Leibniz combination
+        scale = np.abs(P).max() * (m + 1) * math.pi**r * max(1, m) ** r
+        np.testing.assert_allclose(D[r], ref @ P, rtol=0, atol=1e-13 * scale)
+
+
+def test_evaluate_derivatives_chunks_long_inputs() -> None:
+    """Parameters beyond one chunk (32768) give the same values as evaluating the pieces."""
+    from ght_cad.basis import evaluate_derivatives
+
+    t = np.linspace(0.0, 1.0, 70001)
+    P = np.random.default_rng(3).normal(size=(6, 3))
+    seed = GHTSeed(0.3, -0.5, 0.2)
+    whole = evaluate_derivatives(t, P, seed, 2)
+    for lo, hi in ((0, 1000), (40000, 41000), (69000, 70001)):
+        part = evaluate_derivatives(t[lo:hi], P, seed, 2)
+        for r in range(3):
+            np.testing.assert_array_equal(whole[r][lo:hi], part[r])

@@ -503,3 +503,58 @@ def test_bspline_data_meets_a_theta_tolerance():
     assert developable_bspline(twisted).info["theta_max_deg"] > 10
     with pytest.raises(GHTError, match=r"theta_tol_deg=0.0 must be > 0"):
         developable_bspline(s, theta_tol_deg=0.0)
+
+
+# -- one-pass dual-curve jets and their cache ------------------------------------------------------
+def test_dual_jets_are_the_curve_derivatives_and_the_cache_is_transparent():
+    """``_U(u, K)[r] = h^r U^(r)(t(u))`` to 1e-13 of its scale, repeated calls give the same (read-only)
+    values, and trimming or replacing the dual curve never returns stale jets."""
+    s = ship()
+    u = np.linspace(0.0, 1.0, 65)
+    U = s._U(u, 3)
+    for r in range(4):
+        ref = s.dual_curve.derivative(u, r)
+        np.testing.assert_allclose(U[r], ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+        assert not U[r].flags.writeable  # cached arrays cannot be changed behind the cache's back
+    again = s._U(u.copy(), 2)
+    for r in range(3):
+        np.testing.assert_array_equal(again[r], U[r])
+    # the surface quantities do not depend on what was asked before
+    first = (s.a(u, 1), s.b(u, 2), s.boundary_values(u), s.edge_of_regression(u))
+    fresh = ship()
+    second = (fresh.edge_of_regression(u), fresh.boundary_values(u), fresh.b(u, 2), fresh.a(u, 1))
+    for x, y in zip(first, second[::-1]):
+        np.testing.assert_array_equal(x, y)
+    # a trimmed surface maps u to another t: its jets are h^r U^(r)(t0 + u h)
+    tr = s.trimmed((0.25, 0.75))
+    Ut = tr._U(u, 1)
+    np.testing.assert_allclose(Ut[0], s.dual_curve.derivative(0.25 + 0.5 * u, 0), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(Ut[1], 0.5 * s.dual_curve.derivative(0.25 + 0.5 * u, 1), rtol=0, atol=1e-12)
+    # replacing the dual curve (same object, new curve) drops the old jets
+    other = GHTCurve(s.planes, 0.9, -0.9, -0.5)
+    s.dual_curve = other
+    np.testing.assert_allclose(s._U(u, 0)[0], other.evaluate(u), rtol=0, atol=1e-13 * np.abs(s.planes).max())
+    # long parameter arrays are evaluated (not kept) and still agree with the curve
+    big = np.linspace(0.0, 1.0, 5001)
+    np.testing.assert_allclose(s._U(big, 1)[1], other.derivative(big, 1), rtol=0, atol=1e-12 * np.abs(s.planes).max())
+    with pytest.raises(GHTError, match="outside the parameter domain"):
+        s._U(np.array([1.5]), 1)
+
+
+def test_curve_derivatives_of_a_custom_seed_stop_at_order_three():
+    from ght_cad import Seed
+
+    class Cubic(Seed):
+        name = "cubic-dev-test"
+
+        def f0_f2(self, t, order=0):
+            return [((1 - t) ** 3, t**3), (-3 * (1 - t) ** 2, 3 * t**2), (6 * (1 - t), 6 * t),
+                    (np.full_like(t, -6.0), np.full_like(t, 6.0))][order]
+
+    c = GHTCurve([(0, 0, 0), (1, 1, 0), (2, 0, 1), (3, 1, 1)], seed=Cubic())
+    u = np.linspace(0, 1, 11)
+    d = curve_derivatives(c, u, 3)
+    for r in range(4):
+        np.testing.assert_allclose(d[r], c.derivative(u, r), rtol=0, atol=1e-13 * max(1.0, np.abs(d[r]).max()))
+    with pytest.raises(GHTError, match="derivative order 4 of the seed .* only guarantee orders 0..3"):
+        curve_derivatives(c, u, 4)

@@ -17,6 +17,7 @@ from ght_cad.optimize.problems import (
     default_dual_problem,
     default_interpolation_problem,
     default_strip_problem,
+    ght_seed_jets,
     population_basis,
 )
 
@@ -32,6 +33,26 @@ def test_population_basis_equals_core_basis(mu, nu, gamma, degree, r):
     for k in range(2):
         ref = basis(t, degree, *P[k], derivative=r)
         assert np.max(np.abs(B[k] - ref)) <= 1e-12 * max(1.0, np.max(np.abs(ref)))
+
+
+@settings(max_examples=30)
+@given(st.lists(st.tuples(box, box, box), min_size=1, max_size=5), st.integers(0, 3))
+def test_population_seed_jets_are_the_core_seed_formula(P, r):
+    """One GHT seed formula: the population jets equal ``GHTSeed.f0_f2`` row by row, bit for bit,
+    and the population basis equals the core ``seed_basis`` row by row, bit for bit."""
+    from ght_cad.basis import seed_basis
+    from ght_cad.seeds import GHTSeed
+
+    t = np.linspace(0.0, 1.0, 17)
+    arr = np.array(P)
+    f0, f2 = ght_seed_jets(t, arr[:, 0], arr[:, 1], arr[:, 2], r)
+    B = population_basis(t, 5, arr[:, 0], arr[:, 1], arr[:, 2], r)
+    for k, (mu, nu, gamma) in enumerate(P):
+        seed = GHTSeed(mu, nu, gamma)
+        g0, g2 = seed.f0_f2(t, r)
+        np.testing.assert_array_equal(f0[k], g0)
+        np.testing.assert_array_equal(f2[k], g2)
+        np.testing.assert_array_equal(B[k], seed_basis(t, 5, seed, r))
 
 
 @settings(max_examples=20)

@@ -13,6 +13,7 @@ from ght_cad.planes import (
     check_control_planes,
     line_of_planes,
     meet,
+    meet_matrix,
     meet_point,
     normalize_plane,
     normalize_planes,
@@ -20,6 +21,7 @@ from ght_cad.planes import (
     plane_from_points,
     plane_normal,
     plane_point,
+    plucker,
     signed_distance,
 )
 
@@ -79,6 +81,33 @@ def test_meet_vectorized_matches_single():
     X = meet(A, B, C)
     for i in range(7):
         np.testing.assert_allclose(X[i], meet(A[i], B[i], C[i]), rtol=1e-14)
+
+
+@given(plane4, plane4, plane4)
+def test_meet_is_plucker_times_meet_matrix(A, B, C):
+    """``meet(A, B, C) = plucker(A, B) @ meet_matrix(C)`` (linear in C), to rounding: 1e-13 of the
+    largest product |C| |A| |B|; ``p_ij = A_i B_j - A_j B_i`` in the order 01, 02, 03, 12, 13, 23."""
+    p = plucker(A, B)
+    pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    np.testing.assert_array_equal(p, [A[i] * B[j] - A[j] * B[i] for i, j in pairs])
+    scale = 1e-13 * (1 + np.abs(A).max() * np.abs(B).max() * np.abs(C).max())
+    np.testing.assert_allclose(p @ meet_matrix(C), meet(A, B, C), rtol=0, atol=scale)
+
+
+def test_meet_broadcasts_like_its_operands():
+    """One line cut with two planes (the boundary-curve case): shapes (n,1,4), (n,1,4), (1,2,4)."""
+    rng = np.random.default_rng(2)
+    A, B = rng.normal(size=(2, 5, 4))
+    E = rng.normal(size=(2, 4))
+    X = meet(A[:, None, :], B[:, None, :], E[None, :, :])
+    assert X.shape == (5, 2, 4)
+    for i in range(5):
+        for k in range(2):
+            np.testing.assert_array_equal(X[i, k], meet(A[i], B[i], E[k]))
+    M = np.hstack([meet_matrix(e) for e in E])
+    np.testing.assert_allclose((plucker(A, B) @ M).reshape(5, 2, 4), X, rtol=0, atol=1e-13 * np.abs(X).max())
+    with pytest.raises(GHTError, match="C has 3 components"):
+        meet_matrix([1.0, 2.0, 3.0])
 
 
 def test_normalization_keeps_the_plane_and_sign():

@@ -334,3 +334,30 @@ def test_pattern_invariant_under_rigid_motion(angles, shift) -> None:
     D1 = np.linalg.norm(Y1[:, None] - Y1[None], axis=2)
     D2 = np.linalg.norm(Y2[:, None] - Y2[None], axis=2)
     np.testing.assert_allclose(D2, D1, atol=1e-10 * D1.max())
+
+
+@settings(max_examples=25)
+@given(st.floats(0.2, 3.0), st.floats(-1.0, 1.0), st.floats(0.3, 2.0))
+def test_metric_angles_of_an_isometry_and_of_a_shear(R: float, skew: float, height: float):
+    """``metric_angles``: the cylinder ``X = (R cos u, R sin u, h v)`` rolled out by ``(R u, h v)``
+    keeps every angle (to the O(h⁴) difference error, 1e-9 rad); a shear of the flat map
+    ``(R u + skew h v, h v)`` changes the angle from π/2 to ``atan2(1, skew)``."""
+    from ght_cad.unroll import metric_angles
+
+    u = np.linspace(0.1, 1.4, 9)
+    v = np.linspace(0.0, 1.0, 9)
+    xu = np.stack([-R * np.sin(u), R * np.cos(u), np.zeros_like(u)], axis=1)
+    xv = np.tile([0.0, 0.0, height], (u.size, 1))
+
+    def rolled(uu, vv):
+        return np.stack([R * uu, height * vv], axis=1)
+
+    def sheared(uu, vv):
+        return np.stack([R * uu + skew * height * vv, height * vv], axis=1)
+
+    m = metric_angles(xu, xv, rolled, u, v, 1e-3, 1e-3)
+    np.testing.assert_allclose(m["angle_3d"], math.pi / 2, atol=1e-12)
+    np.testing.assert_allclose(m["angle_flat"], m["angle_3d"], atol=1e-9)
+    np.testing.assert_allclose(m["yu_len"], m["xu_len"], rtol=1e-9)
+    s = metric_angles(xu, xv, sheared, u, v, 1e-3, 1e-3)
+    np.testing.assert_allclose(s["angle_flat"], math.atan2(1.0, skew), atol=1e-9)
