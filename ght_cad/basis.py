@@ -200,27 +200,28 @@ def evaluate_derivatives(t: np.ndarray, control_points: np.ndarray, seed: Seed, 
     n = P.shape[0] - 3
     N, dim = t.size, P.shape[1]
     jets = seed.f0_f2_jets(t, K)
-    P0, P1, P2 = (P[k : k + n + 1] for k in range(3))
-    # column blocks: points of Q0 - Q1, Q2 - Q1, Q1, differenced and scaled per derivative order
-    D = np.concatenate([P0 - P1, P2 - P1, P1], axis=1)
+    P1 = P[1 : n + 2]
+    # D[0], D[1], D[2]: points of Q0 - Q1, Q2 - Q1, Q1, differenced and scaled per derivative order
+    D = np.stack([P[: n + 1] - P1, P[2 : n + 3] - P1, P1])
     Q: list[np.ndarray | None] = []
     for q in range(K + 1):
         if q > n:
             Q.append(None)
             continue
         if q:
-            D = (n - q + 1) * np.diff(D, axis=0)
-        Q.append(bernstein(t, n - q) @ D)
+            D = (n - q + 1) * np.diff(D, axis=1)
+        Q.append(np.matmul(bernstein(t, n - q), D))  # (3, N, dim)
     out = []
     for r in range(K + 1):
-        acc = Q[r][:, 2 * dim :].copy() if Q[r] is not None else np.zeros((N, dim))
+        Qr = Q[r]
+        acc = Qr[2].copy() if Qr is not None else np.zeros((N, dim))
         for s in range(r + 1):
             Qq = Q[r - s]
             if Qq is None:
                 continue
             f0, f2 = jets[s]
-            term = f0[:, None] * Qq[:, :dim]
-            term += f2[:, None] * Qq[:, dim : 2 * dim]
+            term = f0[:, None] * Qq[0]
+            term += f2[:, None] * Qq[1]
             c = comb(r, s)
             if c != 1:
                 term *= c

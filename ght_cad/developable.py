@@ -294,51 +294,60 @@ class EnvelopeDevelopable(RuledSurface):
             store[key] = out
         return out
 
-    def _boundary_h(self, u: Any, which: int, K: int) -> _Jet:
-        """Homogeneous jet of ``meet(U, U', E)`` (E = E_a for which=0, E_b for which=1).
+    def _boundary_h(self, u: Any, K: int) -> _Jet:
+        """Homogeneous jets of ``meet(U, U', E_a)`` and ``meet(U, U', E_b)`` side by side, (len(u), 8).
 
         ``meet(A, B, E) = plucker(A, B) @ M(E)`` (linear in E); the product rule gives
-        ``X^(k) = Σ_s C(k,s) meet(U^(s), U^(k-s+1), E)``.
+        ``X^(k) = Σ_s C(k,s) meet(U^(s), U^(k-s+1), E)``. Columns 0..3 belong to E_a, 4..7 to E_b;
+        :meth:`a`, :meth:`b` and :meth:`boundary_jet` share this one computation.
         """
         U = self._U(u, K + 1)
-        M = self._boundary_meet()[1][which]
+        M = self._boundary_meet()
         return _jprod(lambda A, B: plucker(A, B) @ M, U[: K + 1], U[1 : K + 2])
+
+    def _ab(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
+        """``(a(u), b(u))`` from one :meth:`_boundary_h` (the same values as :meth:`a`, :meth:`b`)."""
+        H = self._boundary_h(u, 0)
+        return tuple(_jcartesian([h[:, 4 * w : 4 * w + 4] for h in H])[0] for w in (0, 1))  # type: ignore[return-value]
+
+    def _boundary_point_jet(self, u: Any, which: int, K: int) -> _Jet:
+        """Cartesian jet ``[x, x', ..]`` of the boundary curve on ``E_a`` (which=0) or ``E_b`` (which=1)."""
+        return _jcartesian([h[:, 4 * which : 4 * which + 4] for h in self._boundary_h(u, K)])
 
     # -- RuledSurface interface ---------------------------------------------------------------
     def a(self, u: Any, derivative: int = 0) -> np.ndarray:
         r"""``a^(r)(u)``, ``a = U ∩ U' ∩ E_a`` (analytic, r = 0..2)."""
         r = _check_derivative(derivative)
-        return _jcartesian(self._boundary_h(u, 0, r))[r]
+        return self._boundary_point_jet(u, 0, r)[r]
 
     def b(self, u: Any, derivative: int = 0) -> np.ndarray:
         r"""``b^(r)(u)``, ``b = U ∩ U' ∩ E_b`` (analytic, r = 0..2)."""
         r = _check_derivative(derivative)
-        return _jcartesian(self._boundary_h(u, 1, r))[r]
+        return self._boundary_point_jet(u, 1, r)[r]
 
     def boundary_values(self, u: Any) -> np.ndarray:
         """``(a(u), b(u))`` side by side, shape (len(u), 6), sharing one evaluation of ``U, U'``."""
         U = self._U(u, 1)
-        X = (plucker(U[0], U[1]) @ self._boundary_meet()[0]).reshape(-1, 2, 4)
+        X = (plucker(U[0], U[1]) @ self._boundary_meet()).reshape(-1, 2, 4)
         with np.errstate(divide="ignore", invalid="ignore"):
             return (X[:, :, 1:] / X[:, :, :1]).reshape(-1, 6)
 
-    def _boundary_meet(self) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-        """``([M(E_a) | M(E_b)], (M(E_a), M(E_b)))``: ``meet(U, V, E) = plucker(U, V) @ M(E)`` is
-        linear in E, so one product cuts a line with a boundary plane, or with both (6 x 8).
-        Kept while the boundary planes are unchanged."""
+    def _boundary_meet(self) -> np.ndarray:
+        """``[M(E_a) | M(E_b)]`` (6, 8): ``meet(U, V, E) = plucker(U, V) @ M(E)`` is linear in E, so
+        one product cuts a line with both boundary planes. Kept while the boundary planes are unchanged."""
         E = self.boundary_planes
         key = E.tobytes()
         cached = self.__dict__.get("_meet_cache")
         if cached is None or cached[0] != key:
-            Ms = (meet_matrix(E[0]), meet_matrix(E[1]))
-            cached = (key, (np.hstack(Ms), Ms))
+            cached = (key, np.hstack([meet_matrix(E[0]), meet_matrix(E[1])]))
             self._meet_cache = cached
         return cached[1]
 
     def boundary_jet(self, u: Any, order: int = 2) -> list[np.ndarray]:
         """``[(a, b), (a', b'), ...]`` up to ``order`` (<= 2), each (len(u), 6), from one ``U`` jet."""
         r = _check_derivative(order)
-        sides = [_jcartesian(self._boundary_h(u, which, r)) for which in (0, 1)]
+        H = self._boundary_h(u, r)
+        sides = [_jcartesian([h[:, 4 * which : 4 * which + 4] for h in H]) for which in (0, 1)]
         return [np.hstack([sides[0][k], sides[1][k]]) for k in range(r + 1)]
 
     # -- geometry -------------------------------------------------------------------------------
@@ -389,8 +398,8 @@ class EnvelopeDevelopable(RuledSurface):
         Rn = np.linalg.norm(R, axis=1, keepdims=True)
         R = R / np.maximum(Rn, 1e-300)
         if A is None or g is None:
-            A = self.a(u)
-            g = self.b(u) - A
+            A, B = self._ab(u)
+            g = B - A
         h = np.sum((R[:, 1:] - R[:, :1] * A) * g, axis=1) / np.sum(g * g, axis=1)
         return (h, R[:, 0], Rn[:, 0]) if with_norm else (h, R[:, 0])
 
@@ -456,8 +465,8 @@ class EnvelopeDevelopable(RuledSurface):
                     "boundary planes must cut every ruling of the strip in one point" + self._orientation_hint()
                 )
         # strip width: E_a and E_b must not cross on a ruling
-        A = self.a(u)
-        G = self.b(u) - A
+        A, B = self._ab(u)
+        G = B - A
         w = np.sum(G * dunit, axis=1)
         scale = np.maximum(np.linalg.norm(A, axis=1), 1.0)
         zero = np.abs(w) <= 1e-12 * scale
@@ -635,7 +644,11 @@ def developable_from_planes(
 # B-spline data (compatible directrix poles)
 # ----------------------------------------------------------------------------------------------
 def _size(surface: RuledSurface) -> float:
-    g = surface.grid(33, 3).reshape(-1, 3)
+    """Diagonal of the bounding box of the strip, from the boundary curves at 33 parameters (a
+    ruling segment lies in the box of its end points)."""
+    fast = getattr(surface, "boundary_values", None)
+    u = np.linspace(0.0, 1.0, 33)
+    g = fast(u).reshape(-1, 3) if fast is not None else np.vstack([surface.a(u), surface.b(u)])
     return float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
 
 
