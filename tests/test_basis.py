@@ -159,19 +159,11 @@ def test_first_end_derivative_closed_form() -> None:
     np.testing.assert_allclose(c.derivative(1.0), (n + e[1, 2]) * (pts[-1] - pts[-2]), atol=1e-13)
 
 
-def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A user-registered seed plugs into the basis and curves."""
-    import ght_cad.seeds
-    from ght_cad import Seed, make_seed, register_seed, seed_names
-
-    # keep the global registry as it was after this test
-    monkeypatch.setattr(ght_cad.seeds, "_REGISTRY", dict(ght_cad.seeds._REGISTRY))
+def _cubic_seed_class(name: str) -> type:
+    """A custom seed ``f0 = (1-t)^3, f2 = t^3`` (admissible: f2'(0) = f0'(1) = 0), orders 0..3 only."""
+    from ght_cad import Seed
 
     class CubicSeed(Seed):
-        """f0 = (1-t)^3, f2 = t^3 (admissible: f2'(0) = f0'(1) = 0)."""
-
-        name = "cubic-test"
-
         def f0_f2(self, t, order=0):
             if order == 0:
                 return (1 - t) ** 3, t**3
@@ -181,6 +173,20 @@ def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
                 return 6 * (1 - t), 6 * t
             return np.full_like(t, -6.0), np.full_like(t, 6.0)
 
+    CubicSeed.name = name
+    return CubicSeed
+
+
+def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A user-registered seed plugs into the basis and curves."""
+    import ght_cad.seeds
+    from ght_cad import Seed, make_seed, register_seed, seed_names
+
+    # keep the global registry as it was after this test
+    monkeypatch.setattr(ght_cad.seeds, "_REGISTRY", dict(ght_cad.seeds._REGISTRY))
+
+    CubicSeed = _cubic_seed_class("cubic-test")
+    assert issubclass(CubicSeed, Seed)
     register_seed("cubic-test", CubicSeed)
     assert "cubic-test" in seed_names()
     b = basis(T, 5, seed="cubic-test")
@@ -192,33 +198,11 @@ def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 # -- one-pass jets and derivatives (seeds.ght_seed_jet / Seed.jets / basis.evaluate_derivatives) --
-class _CubicSeed:
-    """A custom seed (orders 0..3 only), defined inside tests to exercise the generic paths."""
-
-    @staticmethod
-    def make():
-        from ght_cad import Seed
-
-        class CubicSeed(Seed):
-            name = "cubic-jets-test"
-
-            def f0_f2(self, t, order=0):
-                if order == 0:
-                    return (1 - t) ** 3, t**3
-                if order == 1:
-                    return -3 * (1 - t) ** 2, 3 * t**2
-                if order == 2:
-                    return 6 * (1 - t), 6 * t
-                return np.full_like(t, -6.0), np.full_like(t, 6.0)
-
-        return CubicSeed()
-
-
 def _seeds(mu: float, nu: float, gamma: float) -> list:
     from ght_cad.seeds import BernsteinSeed, ReversedSeed
 
     ght = GHTSeed(mu, nu, gamma)
-    return [ght, GBTSeed(mu, nu), BernsteinSeed(), ReversedSeed(ght), _CubicSeed.make(), ReversedSeed(_CubicSeed.make())]
+    return [ght, GBTSeed(mu, nu), BernsteinSeed(), ReversedSeed(ght), _cubic_seed_class("cubic-jets-test")(), ReversedSeed(_cubic_seed_class("cubic-jets-test")())]
 
 
 @given(params, params, params)
@@ -267,7 +251,7 @@ def test_ght_seed_high_orders_are_derivatives(mu: float, nu: float, gamma: float
 def test_jets_reject_orders_a_seed_does_not_provide() -> None:
     from ght_cad.errors import GHTError
 
-    cubic = _CubicSeed.make()
+    cubic = _cubic_seed_class("cubic-jets-test")()
     with pytest.raises(GHTError, match="derivative order 4 .* provides orders 0..3"):
         cubic.jets(T, 4)
     with pytest.raises(GHTError, match="derivative order -1 .* provides orders 0, 1, 2"):
