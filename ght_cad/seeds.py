@@ -167,13 +167,14 @@ def _check_jet_order(seed: "Seed", max_order: Any) -> int:
 
 
 def _trig_values(t: np.ndarray, higher: bool) -> tuple[np.ndarray, ...]:
-    """``sin(πt/2), cos(πt/2)`` and, for derivatives (``higher``), ``sin(πt) = 2 sin cos`` and
-    ``cos(πt) = (cos - sin)(cos + sin)`` of the half angle: one sin/cos pass."""
+    """``sin(πt/2), cos(πt/2)`` and, for derivatives (``higher``), ``sin(πt), cos(πt)``, shared by
+    all orders. ``cos(πt)`` is evaluated directly (not as ``cos² - sin²`` of the half angle) so that
+    it is exactly ±1 at the ends, where the derivative terms must cancel exactly (e.g. f0''(1) = 0 at μ = 1)."""
     a = _HALF_PI * t
-    sa, ca = np.sin(a), np.cos(a)
     if not higher:
-        return sa, ca
-    return sa, ca, 2.0 * (sa * ca), (ca - sa) * (ca + sa)
+        return np.sin(a), np.cos(a)
+    pt = math.pi * t
+    return np.sin(a), np.cos(a), np.sin(pt), np.cos(pt)
 
 
 # r-th derivative of sin(x), cos(x) as (sign, use_cos) for r mod 4

@@ -288,3 +288,15 @@ def test_evaluate_derivatives_chunks_long_inputs() -> None:
         part = evaluate_derivatives(t[lo:hi], P, seed, 2)
         for r in range(3):
             np.testing.assert_array_equal(whole[r][lo:hi], part[r])
+
+
+@given(params, params)
+def test_second_derivative_cancels_exactly_at_the_ends(other: float, gamma: float) -> None:
+    """f0''(1) = (1-w) π²/4 (1-μ) + 2w and f2''(0) = (1-w) π²/4 (1-ν) + 2w: at μ = 1 (ν = 1) the
+    trigonometric part cancels to exactly 0 in floating point (cos(πt) is exactly -1 at t = 1), so
+    degenerate ends are recognised (a boundary tangent that vanishes, not one of size 1e-15)."""
+    w = 0.5 * (1.0 + gamma)
+    f0, _ = GHTSeed(1.0, other, gamma).f0_f2(np.array([1.0]), 2)
+    _, f2 = GHTSeed(other, 1.0, gamma).f0_f2(np.array([0.0]), 2)
+    assert f0[0] == 2.0 * w and f2[0] == 2.0 * w
+    assert GHTSeed(1.0, other, gamma).jets(np.array([1.0]), 3)[2][0, 0] == 2.0 * w
