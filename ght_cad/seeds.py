@@ -166,15 +166,16 @@ def _check_jet_order(seed: "Seed", max_order: Any) -> int:
     return K
 
 
-def _trig_values(t: np.ndarray, higher: bool) -> tuple[np.ndarray, ...]:
-    """``sin(πt/2), cos(πt/2)`` and, for derivatives (``higher``), ``sin(πt), cos(πt)``, shared by
-    all orders. ``cos(πt)`` is evaluated directly (not as ``cos² - sin²`` of the half angle) so that
-    it is exactly ±1 at the ends, where the derivative terms must cancel exactly (e.g. f0''(1) = 0 at μ = 1)."""
+def _trig_values(t: np.ndarray, orders: range) -> tuple[np.ndarray | None, ...]:
+    """``sin(πt/2), cos(πt/2)`` and those of ``sin(πt)`` (odd orders) and ``cos(πt)`` (even orders
+    >= 2) that ``orders`` need, shared by all orders. ``cos(πt)`` is evaluated directly (not as
+    ``cos² - sin²`` of the half angle) so that it is exactly ±1 at the ends, where the derivative
+    terms must cancel exactly (e.g. f0''(1) = 0 at μ = 1)."""
     a = _HALF_PI * t
-    if not higher:
-        return np.sin(a), np.cos(a)
-    pt = math.pi * t
-    return np.sin(a), np.cos(a), np.sin(pt), np.cos(pt)
+    pt = math.pi * t if orders.stop > 1 else None
+    odd = any(r % 2 for r in orders)
+    even = any(r and not r % 2 for r in orders)
+    return np.sin(a), np.cos(a), np.sin(pt) if odd else None, np.cos(pt) if even else None
 
 
 # r-th derivative of sin(x), cos(x) as (sign, use_cos) for r mod 4
@@ -182,7 +183,7 @@ _SIN_D = ((1.0, False), (1.0, True), (-1.0, False), (-1.0, True))
 _COS_D = ((1.0, True), (-1.0, False), (-1.0, True), (1.0, False))
 
 
-def _ght_from_trig(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int, trig: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+def _ght_from_trig(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int, trig: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
     """The GHT seed formula at one derivative order from precomputed :func:`_trig_values`."""
     w = 0.5 * (1.0 + gamma)
     sa, ca = trig[0], trig[1]
@@ -233,7 +234,8 @@ def ght_seed_jet(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int = 0) ->
         ``(f0^(r), f2^(r))``, each of the broadcast shape of ``t`` and the parameters.
     """
     t = np.asarray(t, dtype=float)
-    return _ght_from_trig(t, mu, nu, gamma, int(order), _trig_values(t, int(order) > 0))
+    order = int(order)
+    return _ght_from_trig(t, mu, nu, gamma, order, _trig_values(t, range(order, order + 1)))
 
 
 def ght_seed_derivatives(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order: int) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -243,7 +245,7 @@ def ght_seed_derivatives(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order:
     """
     t = np.asarray(t, dtype=float)
     K = int(max_order)
-    trig = _trig_values(t, K > 0)
+    trig = _trig_values(t, range(K + 1))
     return [_ght_from_trig(t, mu, nu, gamma, r, trig) for r in range(K + 1)]
 
 
