@@ -34,13 +34,14 @@ __all__ = [
 _CHUNK = 1 << 15
 
 
-def _check_order(derivative: Any) -> int:
+def _check_order(derivative: Any, max_order: int = MAX_DERIVATIVE) -> int:
+    """``derivative`` as an int in ``0..max_order``; GHTError naming the value otherwise."""
     try:
         r = int(derivative)
     except (TypeError, ValueError):
-        raise GHTError(f"derivative={derivative!r} is not an integer; allowed orders are 0..{MAX_DERIVATIVE}") from None
-    if r != derivative or not 0 <= r <= MAX_DERIVATIVE:
-        raise GHTError(f"derivative={derivative!r} is not allowed; analytic derivatives exist for orders 0..{MAX_DERIVATIVE}")
+        raise GHTError(f"derivative={derivative!r} is not an integer; allowed orders are 0..{max_order}") from None
+    if r != derivative or not 0 <= r <= max_order:
+        raise GHTError(f"derivative={derivative!r} is not allowed; analytic derivatives exist for orders 0..{max_order}")
     return r
 
 

@@ -33,7 +33,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ._validate import as_parameter_array, check_finite_array, check_unit_interval
-from .basis import evaluate_derivatives
+from .basis import _check_order, evaluate_derivatives
 from .bspline import BSplineSurfaceData, fit_function
 from .curve import GHTCurve
 from .errors import ConversionError, DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
@@ -114,13 +114,8 @@ def _jcartesian(X: _Jet) -> _Jet:
 
 
 def _check_derivative(derivative: Any, max_order: int = 2) -> int:
-    try:
-        r = int(derivative)
-    except (TypeError, ValueError):
-        raise GHTError(f"derivative={derivative!r} is not an integer; allowed orders are 0..{max_order}") from None
-    if r != derivative or not 0 <= r <= max_order:
-        raise GHTError(f"derivative={derivative!r} is not allowed; analytic derivatives exist for orders 0..{max_order}")
-    return r
+    """Derivative order in ``0..max_order`` (surfaces here give analytic orders 0..2)."""
+    return _check_order(derivative, max_order)
 
 
 def curve_derivatives(curve: GHTCurve, t: Any, max_order: int) -> list[np.ndarray]:
