@@ -151,6 +151,12 @@ def seed_basis_derivatives(t: np.ndarray, degree: int, seed: Seed, max_order: in
     ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``. Orders above 3 need a seed that
     provides them (the GHT family does, for every order).
 
+    Args:
+        t: 1-D parameter array.
+        degree: basis degree m >= 2.
+        seed: the seed.
+        max_order: K >= 0.
+
     Returns:
         List of K+1 arrays of shape (len(t), degree+1).
 

@@ -228,10 +228,11 @@ def meet(A: Any, B: Any, C: Any) -> np.ndarray:
 def plucker(A: Any, B: Any) -> np.ndarray:
     r"""Plücker coordinates ``p_ij = A_i B_j - A_j B_i`` of the line ``A ∧ B`` of two planes.
 
-    Order ``(p01, p02, p03, p12, p13, p23)``; ``A, B`` broadcast over leading dimensions.
+    Args:
+        A, B: plane 4-vectors, shape (..., 4); leading dimensions broadcast.
 
     Returns:
-        Array of shape (..., 6).
+        Array of shape (..., 6) in the order ``(p01, p02, p03, p12, p13, p23)``.
     """
     A = np.asarray(A, dtype=float)
     B = np.asarray(B, dtype=float)
@@ -244,6 +245,12 @@ def meet_matrix(C: Any) -> np.ndarray:
     ``meet`` is linear in ``C`` for a fixed line: ``X_j = Σ ±C_k p_..`` (see :func:`meet`); with
     several planes stack the matrices side by side to cut one line with all of them in one product.
     Equal to :func:`meet` up to rounding (the products are summed in BLAS order).
+
+    Args:
+        C: one plane 4-vector.
+
+    Returns:
+        The (6, 4) matrix.
 
     Raises:
         GHTError: ``C`` is not 4 finite numbers.

@@ -241,7 +241,14 @@ def ght_seed_jet(t: np.ndarray, mu: Any, nu: Any, gamma: Any, order: int = 0) ->
 def ght_seed_derivatives(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """``[ght_seed_jet(t, mu, nu, gamma, r) for r = 0..max_order]`` sharing one sin/cos pass.
 
-    Returns exactly the arrays of :func:`ght_seed_jet` (same formulas, same operations).
+    Args:
+        t: parameters, 1-D array (N,).
+        mu, nu, gamma: shape parameters, scalars or arrays broadcasting against ``t``.
+        max_order: highest derivative order K >= 0.
+
+    Returns:
+        K+1 pairs ``(f0^(r), f2^(r))``: exactly the arrays of :func:`ght_seed_jet` (same
+        formulas, same operations).
     """
     t = np.asarray(t, dtype=float)
     K = int(max_order)

@@ -290,7 +290,14 @@ def ruled_area(surface: RuledSurface, rtol: float = 1e-14) -> float:
 
 
 def broadcast_uv(u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
-    """``u, v`` as float arrays of at least one dimension, broadcast to a common shape."""
+    """Surface parameters for a development map, shared by ruled surfaces and faces.
+
+    Args:
+        u, v: scalars or arrays.
+
+    Returns:
+        ``(u, v)`` as float arrays of at least one dimension, broadcast to a common shape.
+    """
     return np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
 
 
