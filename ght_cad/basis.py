@@ -207,17 +207,10 @@ def evaluate_derivatives(t: np.ndarray, control_points: np.ndarray, seed: Seed, 
     n = P.shape[0] - 3
     N, dim = t.size, P.shape[1]
     jets = seed.f0_f2_jets(t, K)
-    P1 = P[1 : n + 2]
-    # D[0], D[1], D[2]: points of Q0 - Q1, Q2 - Q1, Q1, differenced and scaled per derivative order
-    D = np.stack([P[: n + 1] - P1, P[2 : n + 3] - P1, P1])
-    Q: list[np.ndarray | None] = []
-    for q in range(K + 1):
-        if q > n:
-            Q.append(None)
-            continue
-        if q:
-            D = (n - q + 1) * np.diff(D, axis=1)
-        Q.append(np.matmul(bernstein(t, n - q), D))  # (3, N, dim)
+    Q: list[np.ndarray | None] = [
+        np.matmul(bernstein(t, n - q), Dq) if Dq is not None else None  # (3, N, dim)
+        for q, Dq in enumerate(_compact_differences(P, K))
+    ]
     out = []
     for r in range(K + 1):
         Qr = Q[r]
@@ -234,6 +227,34 @@ def evaluate_derivatives(t: np.ndarray, control_points: np.ndarray, seed: Seed, 
                 term *= c
             acc += term
         out.append(acc)
+    return out
+
+
+_DIFF_CACHE: dict[tuple, list[np.ndarray | None]] = {}
+
+
+def _compact_differences(P: np.ndarray, K: int) -> list[np.ndarray | None]:
+    """Control points of ``(Q0 - Q1)^(q)``, ``(Q2 - Q1)^(q)``, ``Q1^(q)`` for q = 0..K, each (3, n-q+1, dim)
+    (``n!/(n-q)! Δ^q`` of the blocks; None for q > n). Kept for the last few control polygons."""
+    key = (P.shape, K, P.tobytes())
+    hit = _DIFF_CACHE.get(key)
+    if hit is not None:
+        return hit
+    n = P.shape[0] - 3
+    P1 = P[1 : n + 2]
+    D = np.stack([P[: n + 1] - P1, P[2 : n + 3] - P1, P1])
+    out: list[np.ndarray | None] = []
+    for q in range(K + 1):
+        if q > n:
+            out.append(None)
+            continue
+        if q:
+            D = (n - q + 1) * np.diff(D, axis=1)
+        D.setflags(write=False)
+        out.append(D)
+    if len(_DIFF_CACHE) >= 32:
+        _DIFF_CACHE.pop(next(iter(_DIFF_CACHE)))
+    _DIFF_CACHE[key] = out
     return out
 
 

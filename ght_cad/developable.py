@@ -280,7 +280,9 @@ class EnvelopeDevelopable(RuledSurface):
             return hit[: K + 1]
         check_unit_interval("t", t, slack=1e-9)
         h = t1 - t0
-        out = [d * h**r for r, d in enumerate(evaluate_derivatives(t, curve.control_points, curve.seed, K))]
+        out = evaluate_derivatives(t, curve.control_points, curve.seed, K)
+        if h != 1.0:
+            out = [d * h**r for r, d in enumerate(out)]
         if key is not None:
             for d in out:
                 d.setflags(write=False)
