@@ -212,8 +212,14 @@ class GHTCurve:
         return self._eval(t, _check_order(order))
 
     def derivatives(self, t: Any, max_order: int = 3) -> list[np.ndarray]:
-        """``[P(t), P'(t), ..., P^(max_order)(t)]``."""
-        return [self._eval(t, r) for r in range(_check_order(max_order) + 1)]
+        """``[P(t), P'(t), ..., P^(max_order)(t)]`` in one pass (one seed evaluation for all orders)."""
+        from .basis import evaluate_derivatives
+
+        K = _check_order(max_order)
+        tt, scalar = as_parameter_array(t)
+        check_unit_interval("t", tt, slack=1e-9)
+        out = evaluate_derivatives(tt, self._points, self._seed, K)
+        return [o[0] for o in out] if scalar else out
 
     # -- differential geometry -----------------------------------------------------------
     def speed(self, t: Any) -> np.ndarray:

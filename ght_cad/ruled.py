@@ -72,16 +72,24 @@ SINGULAR_NORMAL_TOL = 1e-10
 def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(θ in degrees, n_a·n_b) with ``n_a = a'×g/|a'×g|`` and ``n_b = b'×g/|b'×g|``.
 
-    Where a normal is undefined (``|a'×g| <= SINGULAR_NORMAL_TOL |a'||g|`` or the same for b, or
-    a zero ruling) θ and the dot product are NaN; callers ignore those parameters.
+    Where a normal is undefined (``|a'×g| <= SINGULAR_NORMAL_TOL |a'||g|``, or ``|a'| <=
+    SINGULAR_NORMAL_TOL |g|`` (a vanishing tangent is rounding noise of random direction), the
+    same for b, or a zero ruling) θ and the dot product are NaN; callers ignore those parameters.
     """
     ca = np.cross(a1, g)
     cb = np.cross(b1, g)
     la, lb = np.linalg.norm(ca, axis=-1), np.linalg.norm(cb, axis=-1)
     gl = np.linalg.norm(g, axis=-1)
-    ok = (la > SINGULAR_NORMAL_TOL * np.linalg.norm(a1, axis=-1) * gl) & (
-        lb > SINGULAR_NORMAL_TOL * np.linalg.norm(b1, axis=-1) * gl
-    ) & (gl > 0)
+    a1l, b1l = np.linalg.norm(a1, axis=-1), np.linalg.norm(b1, axis=-1)
+    # relative test: a' along g; absolute test against the ruling length: a' that vanishes
+    # analytically (a singular end) is rounding noise whose direction is random
+    ok = (
+        (la > SINGULAR_NORMAL_TOL * a1l * gl)
+        & (lb > SINGULAR_NORMAL_TOL * b1l * gl)
+        & (a1l > SINGULAR_NORMAL_TOL * gl)
+        & (b1l > SINGULAR_NORMAL_TOL * gl)
+        & (gl > 0)
+    )
     with np.errstate(divide="ignore", invalid="ignore"):
         na = ca / la[..., None]
         nb = cb / lb[..., None]

@@ -78,3 +78,29 @@ def test_stationary_dual_curve_is_refused() -> None:
 
     with pytest.raises(DegenerateGeometryError, match=r"at u=1 \(t=1\).*vanishes \(the dual curve is stationary.*nu = gamma = -1"):
         developable_from_planes([(-2, 1, 0, 0), (-2, 1, 1, 0), (-2, 0, 1, 0)], [(0, 0, 0, 1), (-5, 0, 0, 1)], 0.3, -1, -1)
+
+
+def test_noise_tangent_at_a_singular_end_is_ignored() -> None:
+    """a'(1) = 0 analytically but 1e-15 of rounding noise in a random direction: still skipped."""
+    rng = np.random.default_rng(4)
+
+    def a(u, r=0):
+        u = np.asarray(u, float)
+        base = np.column_stack([u - u**3 / 3, (1 - u) ** 3, np.zeros_like(u)]) if r == 0 else (
+            np.column_stack([1 - u**2, -3 * (1 - u) ** 2, np.zeros_like(u)]))
+        if r == 1:
+            end = np.isclose(u, 1.0)
+            base[end] = 1e-15 * rng.normal(size=(int(end.sum()), 3))
+        return base
+
+    def b(u, r=0):
+        out = a(u, r).copy()
+        if r == 0:
+            out[:, 2] += 1.0
+        else:
+            out[np.isclose(np.asarray(u, float), 1.0)] = 1e-15 * rng.normal(size=(int(np.isclose(np.asarray(u, float), 1.0).sum()), 3))
+        return out
+
+    s = FunctionRuledSurface(a, b)
+    assert np.isnan(s.theta([1.0])).all()
+    assert s.developability().theta_max <= 1e-10
