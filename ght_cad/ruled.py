@@ -11,6 +11,7 @@ analytic derivatives; measures, sampling and conversion are shared.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import asdict, dataclass
 from typing import Any, Callable
@@ -72,22 +73,31 @@ SINGULAR_NORMAL_TOL = 1e-10
 def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(θ in degrees, n_a·n_b) with ``n_a = a'×g/|a'×g|`` and ``n_b = b'×g/|b'×g|``.
 
-    Where a normal is undefined (``|a'×g| <= SINGULAR_NORMAL_TOL |a'||g|``, or ``|a'| <=
-    SINGULAR_NORMAL_TOL |g|`` (a vanishing tangent is rounding noise of random direction), the
-    same for b, or a zero ruling) θ and the dot product are NaN; callers ignore those parameters.
+    Where the tangent of a boundary vanishes (``|a'| <= SINGULAR_NORMAL_TOL |g|``: an apex, a
+    collapsed edge, a stationary end; what is left there is rounding noise of random direction),
+    the normal at that end is the limit of the surface normal along the ruling: ``X_u × X_v =
+    (a' + v g') × g → v (g' × g)``, so ``n_a = g'×g/|g'×g|`` and likewise ``n_b = -g'×g/|g'×g|``
+    with ``g' = b' - a'``. Where a normal is still undefined (``|a'×g| <= SINGULAR_NORMAL_TOL
+    |a'||g|``, both tangents vanish, or a zero ruling) θ and the dot product are NaN; callers
+    ignore those parameters.
     """
-    ca = np.cross(a1, g)
-    cb = np.cross(b1, g)
-    la, lb = np.linalg.norm(ca, axis=-1), np.linalg.norm(cb, axis=-1)
     gl = np.linalg.norm(g, axis=-1)
-    a1l, b1l = np.linalg.norm(a1, axis=-1), np.linalg.norm(b1, axis=-1)
-    # relative test: a' along g; absolute test against the ruling length: a' that vanishes
-    # analytically (a singular end) is rounding noise whose direction is random
+    g1 = b1 - a1
+    a1l = np.linalg.norm(a1, axis=-1)
+    b1l = np.linalg.norm(b1, axis=-1)
+    lim = np.cross(g1, g)
+    a_sing = (a1l <= SINGULAR_NORMAL_TOL * gl)[..., None]
+    b_sing = (b1l <= SINGULAR_NORMAL_TOL * gl)[..., None]
+    ca = np.where(a_sing, lim, np.cross(a1, g))
+    cb = np.where(b_sing, -lim, np.cross(b1, g))
+    la, lb = np.linalg.norm(ca, axis=-1), np.linalg.norm(cb, axis=-1)
+    ta = np.where(a_sing[..., 0], np.linalg.norm(g1, axis=-1), a1l)
+    tb = np.where(b_sing[..., 0], np.linalg.norm(g1, axis=-1), b1l)
+    g1_ok = np.linalg.norm(g1, axis=-1) > SINGULAR_NORMAL_TOL * gl  # the limit needs a turning ruling
     ok = (
-        (la > SINGULAR_NORMAL_TOL * a1l * gl)
-        & (lb > SINGULAR_NORMAL_TOL * b1l * gl)
-        & (a1l > SINGULAR_NORMAL_TOL * gl)
-        & (b1l > SINGULAR_NORMAL_TOL * gl)
+        (la > SINGULAR_NORMAL_TOL * ta * gl)
+        & (lb > SINGULAR_NORMAL_TOL * tb * gl)
+        & ~((a_sing[..., 0] | b_sing[..., 0]) & ~g1_ok)
         & (gl > 0)
     )
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -107,8 +117,8 @@ def developability_from_jets(
     g = b0 - a0
     th, dot = _theta(a1, b1, g)
     ok = np.isfinite(th)
-    if not ok.any():
-        raise GHTError("the surface normal is undefined at every sample: the rulings or boundary tangents vanish")
+    if not ok.any():  # no normal anywhere (e.g. both edges collapsed to points): undefined, NaN
+        return math.nan, math.nan, math.nan, math.nan
     w = weights[ok]
     th, dot = th[ok], dot[ok]
     theta_rms = float(np.sqrt(np.sum(w * th**2) / np.sum(w)))
@@ -213,7 +223,8 @@ class RuledSurface(ABC):
         t, w = gauss_legendre(nodes)
         _, theta_rms, dd, R = developability_from_jets(self.a(t), self.a(t, 1), self.b(t), self.b(t, 1), w)
         uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
-        theta_max = float(np.nanmax(self.theta(uu)))  # singular points (undefined normal) skipped
+        th = self.theta(uu)
+        theta_max = float(np.nanmax(th)) if np.isfinite(th).any() else math.nan  # undefined normals skipped
         res = float(np.max(np.abs(self.developability_residual(uu))))
         return Developability(theta_max, theta_rms, dd, R, res)
 

@@ -104,3 +104,17 @@ def test_noise_tangent_at_a_singular_end_is_ignored() -> None:
     s = FunctionRuledSurface(a, b)
     assert np.isnan(s.theta([1.0])).all()
     assert s.developability().theta_max <= 1e-10
+
+
+def test_cone_to_its_apex_has_defined_normals() -> None:
+    """A strip whose a-edge collapses to the apex: n_a is the limit of the surface normal."""
+    apex = GHTCurve([(0, 0, 2), (0, 0, 2), (0, 0, 2)])
+    s = CurvePairRuledSurface(apex, _circle(1.5, 0.0))
+    th = s.theta(np.linspace(0, 1, 33))
+    assert np.isfinite(th).all() and th.max() <= 1e-12
+    d = s.developability()
+    assert d.theta_max <= 1e-12 and d.dd == pytest.approx(1.0, abs=1e-15)
+    # every ruled surface through one point is a (general) cone, hence developable: a wavy base
+    # curve is measured developable too
+    wavy = CurvePairRuledSurface(apex, GHTCurve([(1, 0, 0), (1, 1, 1.5), (0, 1, 0)], gamma=-1))
+    assert wavy.developability().theta_max <= 1e-12
