@@ -136,7 +136,8 @@ def main(argv: list[str] | None = None) -> int:
                 dev = _matched_deviation(curve, bs, t_check)
                 if dev > tol:
                     raise AssertionError(f"ours (degree {p}) exceeded tol: {dev:.3g} > {tol:.3g}")
-                ours[p] = {"poles": bs.poles.shape[0], "time": secs, "dev": dev}
+                ours[p] = {"poles": bs.poles.shape[0], "time": secs, "dev": dev, "fits": bs.info["fits"],
+                           "samples": bs.info["samples_checked"]}
             occ_m = _occt_search(curve, tol, True, t_check)
             occ_c = _occt_search(curve, tol, False, t_check)
             occ_5 = _occt_search(curve, tol, True, t_check, deg_max=5)
@@ -149,6 +150,12 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{degree:>3} {o5['poles']:>11} {1e3 * o5['time']:>6.2f} {o5['dev'] / tol:>7.3f} "
                   f"{o8['poles']:>11} {1e3 * o8['time']:>6.2f} | {cell(occ_m)} | {cell(occ_c, 11)} | "
                   f"{cell(occ_5, 14)}")
+    for p in (5, 8):
+        ms = np.array([r[0][p]["time"] for r in rows]) * 1e3
+        print(f"ours degree {p}: {ms.mean():.2f} ms per curve (median {np.median(ms):.2f}), "
+              f"{np.mean([r[0][p]['poles'] for r in rows]):.2f} poles, "
+              f"{np.mean([r[0][p]['fits'] for r in rows]):.2f} least-squares fits, "
+              f"{np.mean([r[0][p]['samples'] for r in rows]):.0f} evaluations of P per curve")
     for label, k in (("matched parameters", 1), ("chord length + projection", 2), ("matched, DegMax 5", 3)):
         ok = [r for r in rows if r[k] is not None]
         if not ok:
