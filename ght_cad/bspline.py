@@ -282,7 +282,9 @@ def fit_function(
     Algorithm: least squares ``min Σ_s |f(t_s) - C(t_s)|²`` over ``p + 2`` Gauss–Legendre nodes per
     span with the end poles fixed by ``end_derivatives`` (a clamped B-spline's first ``r+1``
     poles fix ``C(0), ..., C^(r)(0)``: ``D P_{0..r} = [f(0), ..., f^(r)(0)]`` with the triangular
-    matrix ``D[k, j] = N_j^(k)(0)``; likewise at t = 1). The error ``e_i`` of span ``i`` is sampled
+    matrix ``D[k, j] = N_j^(k)(0)``; likewise at t = 1), solved by the semi-normal equations
+    ``AᵀA P = Aᵀ F`` (Cholesky, banded beyond 40 poles: ``O(n p²)``) with one refinement step on
+    the residual (SVD least squares if AᵀA is numerically singular). The error ``e_i`` of span ``i`` is sampled
     at ``max(16, 4(p+1))`` Chebyshev–Lobatto points per span plus 257 uniform points (f there is
     evaluated once; each round calls ``func`` once, on the Gauss and check nodes of the spans not
     seen before). Refinement: from ``max(7, r0 + r1 - p)`` equal spans, up to 3 rounds re-place
@@ -410,7 +412,7 @@ def fit_function(
                 vals, first = _nonzero_basis(ts, knots, p)
                 try:
                     poles = _banded_least_squares(vals, first, F, fixed, r0, n - r1)
-                except np.linalg.LinAlgError:  # numerically singular: dense QR/SVD below
+                except np.linalg.LinAlgError:  # numerically singular: the dense solve below
                     poles = None
             if poles is None:
                 A = BSpline.construct_fast(knots, np.eye(n), p)(ts)  # dense collocation N_j(t_s)
