@@ -45,7 +45,10 @@ def test_build123d_algebra(tmp_path: Path) -> None:
     res = load("build123d_algebra").main(tmp_path)
     step_ok(res["step"])
     assert res["valid"] and res["solids"] == 4
-    assert res["face_area_rel_error"] < 1e-8
+    # the face's boundary curves are certified to 1e-7 x size (B-spline fit tolerance); a boundary
+    # moved by at most d changes the area by at most about d * perimeter, i.e. <= ~2e-7 relative
+    # here (the value itself, ~8e-9, depends on where the fit puts its knots)
+    assert res["face_area_rel_error"] < 2e-7
     assert res["pattern_area_rel_error"] < 1e-12 and res["pattern_errors"]["max"] < 1e-12
     assert res["theta_max_deg"] < 1e-9
     # offset volume of a sheet: T*A (1 + O(T * curvature)); here T * max curvature < 0.01
