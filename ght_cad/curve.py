@@ -118,14 +118,17 @@ class GHTCurve:
 
     @property
     def mu(self) -> float:
+        """Shape parameter μ ∈ [-1, 1] (start-end shape of the seed's f0)."""
         return self._seed.mu
 
     @property
     def nu(self) -> float:
+        """Shape parameter ν ∈ [-1, 1] (end shape of the seed's f2)."""
         return self._seed.nu
 
     @property
     def gamma(self) -> float:
+        """Shape parameter γ ∈ [-1, 1] (γ = 1 classical Bézier, γ = -1 GBT)."""
         return self._seed.gamma
 
     @property

@@ -50,6 +50,7 @@ class Developability:
     residual_max: float
 
     def as_dict(self) -> dict[str, float]:
+        """The measures as a plain dict of floats (for JSON reports)."""
         return {k: float(v) for k, v in asdict(self).items()}
 
     def __str__(self) -> str:
