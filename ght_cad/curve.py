@@ -118,12 +118,12 @@ class GHTCurve:
 
     @property
     def mu(self) -> float:
-        """Shape parameter μ ∈ [-1, 1] (start-end shape of the seed's f0)."""
+        """Shape parameter μ ∈ [-1, 1], in the seed's f0 (shapes the start of the curve)."""
         return self._seed.mu
 
     @property
     def nu(self) -> float:
-        """Shape parameter ν ∈ [-1, 1] (end shape of the seed's f2)."""
+        """Shape parameter ν ∈ [-1, 1], in the seed's f2 (shapes the end of the curve)."""
         return self._seed.nu
 
     @property
