@@ -1,0 +1,197 @@
+"""Joined developable feature inside FreeCAD (headless): G1/G2/G3 joins of enveloping developables.
+
+Checks: the measured ``JointOrder`` equals the requested continuity (and not more), the Part face
+normals of both strips agree along the shared edge of the sewn shell (< 1e-6 deg), the shell's
+shared edge is one edge, recompute follows the previous strip, save/reopen, STEP round trip and
+the flat pattern of the joined strip.
+
+Run: ``PYTHONPATH=<repo>/freecad_workbench:<repo> freecadcmd -t freecad.ght_workbench.tests.fc_joined``
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import unittest
+
+import numpy as np
+
+import FreeCAD as App
+import Part
+
+from freecad.ght_workbench import developable, export, flat_pattern, joined_developable
+
+OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_joined_")
+NORMAL_TOL_DEG = 1e-6
+
+
+def _shared_edge_normal_angle(shell: "Part.Shape", n: int = 11) -> tuple[float, float]:
+    """(max angle (deg) between the two faces' normals, max point distance) along the one shared edge.
+
+    The shared edge is found topologically (an edge of both faces); each sample point on it is
+    projected into both faces' surfaces (``Surface.parameter``) and ``Face.normalAt`` compared.
+    """
+    f1, f2 = shell.Faces[-2], shell.Faces[-1]
+    shared = [e for e in f2.Edges if any(e.isSame(g) for g in f1.Edges)]
+    if len(shared) != 1:
+        raise AssertionError(f"{len(shared)} shared edges between the last two faces (need exactly 1)")
+    edge = shared[0]
+    worst, gap = 0.0, 0.0
+    for p in edge.discretize(n):
+        normals = []
+        for f in (f1, f2):
+            u, v = f.Surface.parameter(p)
+            gap = max(gap, f.valueAt(u, v).distanceToPoint(p))
+            normals.append(f.normalAt(u, v))
+        worst = max(worst, math.degrees(normals[0].getAngle(normals[1])))
+    return worst, gap
+
+
+def _bad(obj) -> bool:
+    """True if the object is in error after a recompute (its execute raised)."""
+    return "Invalid" in obj.State or "Error" in obj.State
+
+
+def _samples(face: "Part.Face", n: int = 9) -> np.ndarray:
+    """Points of the face on an n x n grid of its parameter range."""
+    u0, u1, v0, v1 = face.ParameterRange
+    return np.array([[p.x, p.y, p.z] for p in (face.valueAt(u, v) for u in np.linspace(u0, u1, n) for v in np.linspace(v0, v1, n))])
+
+
+def _poles(face: "Part.Face") -> np.ndarray:
+    return np.array([[[p.x, p.y, p.z] for p in row] for row in face.Surface.getPoles()])
+
+
+class JoinedDevelopableTest(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("joined")
+        # exact quarter cylinder r = 10, H = 20 (γ = -1): ends at the plane y = 10
+        self.first = developable.make_developable(gamma=-1.0, doc=self.doc)
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def test_g1_g2_g3_measured_order_and_normals(self):
+        for r, cont in enumerate(("G1", "G2", "G3"), 1):
+            with self.subTest(cont):
+                j = joined_developable.make_joined_developable(self.first, cont, fuse=True, doc=self.doc)
+                self.assertFalse(_bad(j), j.State)
+                self.assertEqual(j.JointOrder, r)
+                # exactly r: the next contact condition fails clearly (not a lucky higher order)
+                if r < 3:
+                    self.assertGreater(j.JointResiduals[r + 1], 1e-6)
+                self.assertLess(max(j.JointResiduals[: r + 1]), 1e-9)
+                self.assertEqual(j.Degree, r + len(joined_developable.DEFAULT_FREE_PLANES))
+                self.assertLess(float(j.ThetaMax), 1e-9)
+                shape = j.Shape
+                self.assertTrue(shape.isValid())
+                self.assertEqual(shape.ShapeType, "Shell")
+                self.assertEqual(len(shape.Faces), 2)
+                self.assertEqual(len(shape.Edges), 7)  # 4 + 4 edges, the joint ruling shared
+                angle, gap = _shared_edge_normal_angle(shape)
+                self.assertLess(angle, NORMAL_TOL_DEG, f"{cont}: normals differ by {angle:.3g} deg")
+                self.assertLess(gap, 1e-7)
+                print(f"{cont}: JointOrder={j.JointOrder} residuals={list(j.JointResiduals)} normal angle={angle:.3g} deg")
+                # without Fuse: the single new face; its start ruling is the first strip's end ruling
+                j.Fuse = False
+                self.doc.recompute()
+                self.assertEqual(len(j.Shape.Faces), 1)
+                P, Q = _poles(j.Shape.Faces[0]), _poles(self.first.Shape.Faces[0])
+                self.assertLess(float(np.max(np.abs(P[0] - Q[-1]))), 1e-9)
+
+    def test_previous_change_recomputes_and_keeps_order(self):
+        j = joined_developable.make_joined_developable(self.first, "G3", fuse=True, doc=self.doc)
+        before = _samples(j.Shape.Faces[-1])
+        self.first.Mu = 0.5
+        self.first.Nu = -0.3
+        self.doc.recompute()
+        self.assertFalse(_bad(j), j.State)
+        self.assertEqual(j.JointOrder, 3)
+        after = _samples(j.Shape.Faces[-1])
+        self.assertGreater(float(np.max(np.abs(after - before))), 1e-2)
+        self.assertTrue(j.Shape.isValid())
+        angle, _ = _shared_edge_normal_angle(j.Shape)
+        self.assertLess(angle, NORMAL_TOL_DEG)
+        # a chain: a joined developable after a joined developable; the shell holds all three strips
+        j2 = joined_developable.make_joined_developable(j, "G1", [(-30.0, -1.0, -1.0, 0.0), (-12.0, 0.0, -1.0, 0.0)], fuse=True, doc=self.doc)
+        self.assertEqual(j2.JointOrder, 1)
+        self.assertEqual(len(j2.Shape.Faces), 3)
+        self.assertEqual(len(j2.Shape.Edges), 10)
+        self.assertTrue(j2.Shape.isValid())
+        angle2, _ = _shared_edge_normal_angle(j2.Shape)
+        self.assertLess(angle2, NORMAL_TOL_DEG)
+        # own shape parameters and G parameters change the new strip but not the measured order
+        j.Mu, j.Beta2 = 0.4, 0.3
+        self.doc.recompute()
+        self.assertEqual((j.JointOrder, j2.JointOrder), (3, 1))
+        self.assertGreater(float(np.max(np.abs(_samples(j.Shape.Faces[-1]) - after))), 1e-2)
+        self.assertEqual(j.Mu, 0.4)
+        j.Mu = 3.0  # App::PropertyFloatConstraint clamps to [-1, 1]
+        self.assertEqual(j.Mu, 1.0)
+
+    def test_save_reopen_step_and_flat_pattern(self):
+        self.first.Mu = 0.2
+        j = joined_developable.make_joined_developable(self.first, "G2", fuse=True, doc=self.doc)
+        area, name, order = j.Shape.Area, j.Name, j.JointOrder
+        path = os.path.join(OUT, "joined.FCStd")
+        self.doc.saveAs(path)
+        App.closeDocument(self.doc.Name)
+        doc2 = App.openDocument(path)
+        for o in doc2.Objects:
+            o.touch()
+        doc2.recompute()
+        self.assertEqual([o.Name for o in doc2.Objects if _bad(o)], [])
+        j2 = doc2.getObject(name)
+        self.assertEqual(j2.JointOrder, order)
+        self.assertAlmostEqual(j2.Shape.Area, area, delta=1e-9 * area)
+        self.assertEqual(j2.Continuity, "G2")
+        j2.Gamma = 2.0  # the [-1, 1] constraint survives the reload
+        self.assertEqual(j2.Gamma, 1.0)
+        j2.Gamma = -1.0
+        doc2.recompute()
+        self.assertEqual(j2.JointOrder, 2)
+        # STEP round trip keeps the shell topology (shared edge) and the area
+        step = os.path.join(OUT, "joined.step")
+        export.export_step([j2], step)
+        back = export.read_step(step)
+        self.assertEqual(len(back.Faces), 2)
+        self.assertEqual(len(back.Edges), 7)
+        self.assertAlmostEqual(back.Area, j2.Shape.Area, delta=1e-6 * area)
+        self.assertTrue(back.isValid())
+        # flat pattern of the joined strip: vertical rulings of length 20 -> a rectangle L x 20
+        fp = flat_pattern.make_flat_pattern(j2, doc=doc2)
+        self.assertFalse(_bad(fp), fp.State)
+        self.assertTrue(fp.Shape.isValid())
+        face = j2.Shape.Faces[-1]
+        bottom = [e for e in face.Edges if abs(e.BoundBox.ZMax) < 1e-9 and e.Length > 1e-6][0]
+        self.assertAlmostEqual(fp.AreaFlat, 20.0 * bottom.Length, delta=1e-6 * fp.AreaFlat)
+        self.assertAlmostEqual(fp.AreaFlat, fp.Area3D, delta=1e-9 * fp.AreaFlat)
+        # OCC's Shape.Area integrates B-spline faces with a fixed Gauss rule (~5e-5 relative here)
+        self.assertAlmostEqual(fp.AreaFlat, face.Area, delta=2e-4 * face.Area)
+        self.assertLess(fp.MaxRelativeError, 1e-6)
+        print(f"flat pattern of the joined strip: AreaFlat={fp.AreaFlat:.9f} face area={face.Area:.9f} MaxRelativeError={fp.MaxRelativeError:.3g}")
+
+    def test_bad_input(self):
+        with self.assertRaisesRegex(ValueError, "G0"):
+            joined_developable.make_joined_developable(self.first, "G0", doc=self.doc)
+        from ght_cad.errors import ShapeParameterError
+
+        with self.assertRaisesRegex(ShapeParameterError, "nu"):
+            joined_developable.make_joined_developable(self.first, "G1", nu=1.5, doc=self.doc)
+        j = joined_developable.make_joined_developable(self.first, "G1", doc=self.doc)
+        j.PlaneCoordinates = [1.0, 2.0, 3.0]
+        self.doc.recompute()
+        self.assertIn("Invalid", j.State)
+        # a non-enveloping previous feature is refused with its name in the message
+        plain = self.doc.addObject("Part::Feature", "Plain")
+        plain.Shape = Part.makePlane(1, 1)
+        j.PlaneCoordinates = [float(x) for x in np.ravel(joined_developable.DEFAULT_FREE_PLANES)]
+        j.Previous = plain
+        with self.assertRaisesRegex(ValueError, "Plain"):
+            j.Proxy.surface(j)
+
+
+if __name__ == "__main__":
+    unittest.main()
