@@ -44,7 +44,9 @@ def _shared_edge_normal_angle(shell: "Part.Shape", n: int = 11) -> tuple[float, 
             u, v = f.Surface.parameter(p)
             gap = max(gap, f.valueAt(u, v).distanceToPoint(p))
             normals.append(f.normalAt(u, v))
-        worst = max(worst, math.degrees(normals[0].getAngle(normals[1])))
+        a, b = normals
+        # atan2(|a x b|, a·b): accurate for tiny angles too (acos is not)
+        worst = max(worst, math.degrees(math.atan2(a.cross(b).Length, a.dot(b))))
     return worst, gap
 
 
@@ -100,6 +102,30 @@ class JoinedDevelopableTest(unittest.TestCase):
                 self.assertEqual(len(j.Shape.Faces), 1)
                 P, Q = _poles(j.Shape.Faces[0]), _poles(self.first.Shape.Faces[0])
                 self.assertLess(float(np.max(np.abs(P[0] - Q[-1]))), 1e-9)
+
+    def test_cone_joints_generic_normals(self):
+        """Conical strips (all planes through the apex (0, 0, -20)), γ = -0.5, tilted normals."""
+
+        def plane(phi_deg: float, w: float = 1.0) -> list:
+            n = np.array([math.cos(math.radians(phi_deg)), math.sin(math.radians(phi_deg)), -0.3])
+            return list(w * np.array([20.0 * n[2], *n]))  # u0 = -n·apex
+
+        first = developable.make_developable([plane(0), plane(45, 1.2), plane(90)], mu=0.1, gamma=-0.5, doc=self.doc)
+        for r, cont in enumerate(("G1", "G2", "G3"), 1):
+            with self.subTest(cont):
+                j = joined_developable.make_joined_developable(first, cont, [plane(150), plane(180)], nu=0.2, fuse=True, doc=self.doc)
+                self.assertFalse(_bad(j), j.State)
+                self.assertEqual(j.JointOrder, r)
+                self.assertTrue(j.Shape.isValid())
+                self.assertEqual(len(j.Shape.Edges), 7)
+                angle, gap = _shared_edge_normal_angle(j.Shape)
+                self.assertLess(angle, NORMAL_TOL_DEG, f"{cont}: normals differ by {angle:.3g} deg")
+                self.assertLess(gap, 1e-7)
+                # the joint normal is tilted (not a trivially exact axis direction)
+                f = j.Shape.Faces[-1]
+                u0, _, v0, _ = f.ParameterRange
+                self.assertGreater(abs(f.normalAt(u0, v0).z), 0.1)
+                print(f"cone {cont}: JointOrder={j.JointOrder} normal angle={angle:.3g} deg gap={gap:.3g}")
 
     def test_previous_change_recomputes_and_keeps_order(self):
         j = joined_developable.make_joined_developable(self.first, "G3", fuse=True, doc=self.doc)

@@ -1,0 +1,89 @@
+"""The workbench's Joined developable feature tested inside Debian's FreeCAD (separate process).
+
+``freecadcmd -t freecad.ght_workbench.tests.fc_joined``: G1/G2/G3 joins of a quarter cylinder and
+of a cone; the measured ``JointOrder`` equals the requested order, the Part face normals of both
+strips agree along the shared (single) edge of the sewn shell within 1e-6 deg, changing the
+previous strip's μ recomputes the joined strip with the order kept, save/reopen, STEP round trip
+and the flat pattern of the joined strip.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from conftest import freecadcmd_or_skip
+
+REPO = Path(__file__).resolve().parents[1]
+WB = REPO / "freecad_workbench"
+
+pytestmark = pytest.mark.freecad
+
+
+def _env(tmp_path: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    home = tmp_path / "home"
+    home.mkdir(exist_ok=True)
+    env["HOME"] = str(home)  # FreeCAD's user config goes here, not into the real home
+    env["GHT_FC_OUT"] = str(tmp_path)
+    env.pop("PYTHONHOME", None)
+    env.pop("VIRTUAL_ENV", None)
+    import ght_cad  # the very core this pytest process imports
+
+    core = Path(ght_cad.__file__).resolve().parents[1]
+    env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys([str(WB), str(core), str(REPO)]))
+    return env
+
+
+def _run(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
+    """Run in a new session; on timeout kill the whole process group and fail."""
+    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        pytest.fail(f"{cmd[0]} timed out after {timeout} s:\n{(out + err)[-4000:]}")
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
+def _summary(proc: subprocess.CompletedProcess) -> str:
+    lines = [l for l in (proc.stdout + proc.stderr).splitlines() if l.strip() and not l.startswith("  #")]
+    return "\n".join(lines[-80:])
+
+
+def test_joined_developable_inside_freecadcmd(tmp_path: Path) -> None:
+    exe = freecadcmd_or_skip()
+    proc = _run([exe, "-t", "freecad.ght_workbench.tests.fc_joined"], _env(tmp_path), tmp_path, 120)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, _summary(proc)
+    ran = re.search(r"Ran (\d+) tests?", out)
+    assert ran and int(ran.group(1)) >= 5, _summary(proc)
+    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), _summary(proc)
+    assert "skipped=" not in out, _summary(proc)
+    # every requested order was measured, on both geometries
+    for cont, r in (("G1", 1), ("G2", 2), ("G3", 3)):
+        assert re.search(rf"^.*\b{cont}: JointOrder={r} ", out, re.M), _summary(proc)
+        assert f"cone {cont}: JointOrder={r} " in out, _summary(proc)
+    angles = [float(a) for a in re.findall(r"normal angle=([\deE.+-]+) deg", out)]
+    assert len(angles) == 6 and max(angles) < 1e-6, angles
+    assert (tmp_path / "joined.step").stat().st_size > 0
+    # the STEP file FreeCAD wrote is a valid two-face shell for OCP 7.9 too
+    from ght_cad.cad.occ import is_valid, read_step
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopTools import TopTools_IndexedMapOfShape
+    from OCP.TopExp import TopExp
+
+    shape = read_step(tmp_path / "joined.step")
+    assert is_valid(shape)
+    counts = []
+    for kind in (TopAbs_FACE, TopAbs_EDGE):
+        m = TopTools_IndexedMapOfShape()
+        TopExp.MapShapes_s(shape, kind, m)
+        counts.append(m.Extent())
+    assert counts == [2, 7], counts  # the joint ruling is one shared edge
