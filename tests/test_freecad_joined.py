@@ -9,8 +9,10 @@ and the flat pattern of the joined strip.
 
 from __future__ import annotations
 
+import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 from pathlib import Path
@@ -87,3 +89,31 @@ def test_joined_developable_inside_freecadcmd(tmp_path: Path) -> None:
         TopExp.MapShapes_s(shape, kind, m)
         counts.append(m.Extent())
     assert counts == [2, 7], counts  # the joint ruling is one shared edge
+
+
+def test_joined_command_in_gui_under_xvfb(tmp_path: Path) -> None:
+    freecadcmd_or_skip()
+    exe = shutil.which("freecad") or shutil.which("FreeCAD")
+    if exe is None or shutil.which("xvfb-run") is None:
+        if os.environ.get("CI") == "true":
+            pytest.fail("the FreeCAD GUI (freecad-python3) or xvfb-run (xvfb, xauth) is missing but CI=true")
+        pytest.skip("FreeCAD GUI or xvfb-run not installed")
+    env = _env(tmp_path)
+    env.pop("PYTHONPATH", None)  # installed as a user would: the addon linked into the user's Mod folder
+    mod = Path(env["HOME"]) / ".local" / "share" / "FreeCAD" / "Mod"
+    mod.mkdir(parents=True)
+    (mod / "ght_workbench").symlink_to(WB, target_is_directory=True)
+    env["QTWEBENGINE_DISABLE_SANDBOX"] = "1"
+    env["QT_QPA_PLATFORM"] = "xcb"
+    env["GHT_JOINED_GUI"] = "1"
+    script = WB / "freecad" / "ght_workbench" / "tests" / "fc_joined.py"
+    proc = _run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(script)], env, tmp_path, 180)
+    result = tmp_path / "joined_gui.json"
+    assert result.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{_summary(proc)}"
+    res = json.loads(result.read_text())
+    assert "error" not in res, res["error"]
+    assert res["registered"] and res["pixmap"], res
+    assert res["toolbar"] == ["GHT surfaces"], res
+    assert res["created"] == ["GHT::JoinedDevelopable"], res
+    assert res["joint_order"] == 2 and res["faces"] == 2 and res["valid"], res
+    assert res["panel_open"] and res["icon"], res

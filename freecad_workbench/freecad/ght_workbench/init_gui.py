@@ -19,9 +19,12 @@ FEATURE_MODULES = (
     "optimization",
     "export",
 )
+# modules whose commands are registered with FreeCADGui directly (not in _base.COMMANDS, which the
+# GUI check enumerates); their commands join the toolbars below when registered
+EXTRA_MODULES = ("joined_developable",)
 TOOLBARS = {
     "GHT curves": ["GHT_Curve", "GHT_CompositeCurve"],
-    "GHT surfaces": ["GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern"],
+    "GHT surfaces": ["GHT_Developable", "GHT_SpineDevelopable", "GHT_JoinedDevelopable", "GHT_FlatPattern"],
     "GHT optimization": ["GHT_Optimization", "GHT_RunOptimization"],
     "GHT export": ["GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"],
 }
@@ -35,6 +38,11 @@ def load_commands() -> list[str]:
         try:
             importlib.import_module(f"{__package__}.{mod}")
         except Exception as exc:  # a missing core module must not break the whole workbench
+            App.Console.PrintWarning(f"GHT workbench: {mod} not loaded: {type(exc).__name__}: {exc}\n")
+    for mod in EXTRA_MODULES:
+        try:
+            importlib.import_module(f"{__package__}.{mod}")
+        except Exception as exc:
             App.Console.PrintWarning(f"GHT workbench: {mod} not loaded: {type(exc).__name__}: {exc}\n")
     return list(COMMANDS)
 
@@ -50,7 +58,7 @@ class GHTWorkbench(Gui.Workbench):
         return "Gui::PythonWorkbench"
 
     def Initialize(self) -> None:
-        available = set(load_commands())
+        available = set(load_commands()) | set(Gui.listCommands())
         for bar, cmds in TOOLBARS.items():
             present = [c for c in cmds if c in available]
             if present:

@@ -219,5 +219,56 @@ class JoinedDevelopableTest(unittest.TestCase):
             j.Proxy.surface(j)
 
 
-if __name__ == "__main__":
+def gui_check() -> dict:
+    """Inside the FreeCAD GUI (``GHT_JOINED_GUI=1 xvfb-run freecad fc_joined.py``): the workbench
+    shows the command in its toolbar, the command joins a strip to the selected developable and
+    opens its task panel. Returns the findings (also written to ``$GHT_FC_OUT/joined_gui.json``)."""
+    import FreeCADGui as Gui
+
+    res: dict = {}
+    Gui.activateWorkbench("GHTWorkbench")
+    res["registered"] = "GHT_JoinedDevelopable" in Gui.listCommands()
+    items = Gui.activeWorkbench().getToolbarItems() if hasattr(Gui.activeWorkbench(), "getToolbarItems") else {}
+    res["toolbar"] = [bar for bar, cmds in items.items() if "GHT_JoinedDevelopable" in cmds]
+    pixmap = joined_developable.COMMAND.GetResources()["Pixmap"]
+    res["pixmap"] = os.path.isfile(pixmap) and pixmap.endswith("GHT_JoinedDevelopable.svg")
+    doc = App.newDocument("JoinedGui")
+    dev = developable.make_developable(gamma=-1.0, doc=doc)
+    before = {o.Name for o in doc.Objects}
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(dev)
+    Gui.runCommand("GHT_JoinedDevelopable", 0)
+    doc.recompute()
+    new = [o for o in doc.Objects if o.Name not in before]
+    res["created"] = [o.Proxy.Type for o in new if hasattr(o, "Proxy")]
+    if new:
+        j = new[0]
+        res["joint_order"] = j.JointOrder
+        res["faces"] = len(j.Shape.Faces)
+        res["valid"] = j.Shape.isValid()
+        res["panel_open"] = bool(Gui.Control.activeDialog())
+        res["icon"] = os.path.isfile(j.ViewObject.Proxy.getIcon())
+        if Gui.Control.activeDialog():
+            Gui.Control.closeDialog()
+    return res
+
+
+def _gui_main() -> None:  # pragma: no cover - runs in the GUI process only
+    import json
+    import traceback
+
+    try:
+        res = gui_check()
+    except Exception:
+        res = {"error": traceback.format_exc()}
+    with open(os.path.join(OUT, "joined_gui.json"), "w") as fh:
+        json.dump(res, fh, indent=1, default=str)
+    os._exit(0)
+
+
+if App.GuiUp and os.environ.get("GHT_JOINED_GUI") == "1":
+    from PySide2 import QtCore
+
+    QtCore.QTimer.singleShot(200, _gui_main)
+elif __name__ == "__main__":
     unittest.main()
