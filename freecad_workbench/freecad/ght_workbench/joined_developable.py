@@ -74,6 +74,19 @@ def _surface_of(prev: Any) -> Any:
     return surf
 
 
+def core_frame(obj: Any) -> "App.Placement":
+    """Placement that maps the core surface's coordinates of ``obj`` to the model.
+
+    A developable-from-planes feature shows its core surface moved by its own ``Placement``; a
+    joined strip's core surface lives in the frame of its ``Previous`` and is moved by its own
+    ``Placement`` on top: ``frame(joined) = joined.Placement * frame(joined.Previous)``.
+    """
+    pl = App.Placement(obj.Placement) if hasattr(obj, "Placement") else App.Placement()
+    if getattr(getattr(obj, "Proxy", None), "Type", "") == JoinedDevelopableFeature.Type and obj.Previous is not None:
+        return pl.multiply(core_frame(obj.Previous))
+    return pl
+
+
 class JoinedDevelopableFeature(FeatureProxy):
     """Proxy of a developable strip joined to ``Previous`` with G1, G2 or G3 (``Part::FeaturePython``)."""
 
@@ -153,13 +166,18 @@ class JoinedDevelopableFeature(FeatureProxy):
         data = developable_bspline(surf)
         obj.MaxDeviation = float(data.max_deviation or 0.0)
         face = face_from_data(data)
+        frame = core_frame(obj.Previous)
+        if not frame.isIdentity():  # follow a moved previous strip (geometry, not Placement, moves)
+            face = face.transformGeometry(frame.toMatrix())
         if obj.Fuse and obj.Previous is not None and obj.Previous.Shape.Faces:
-            shell = Part.Shell([f.copy() for f in obj.Previous.Shape.Faces] + [face])
-            tol = max(1e-7, 10.0 * obj.MaxDeviation)
-            shell.sewShape(tol)
-            shells = shell.Shells
+            # sew a compound (Part.Shell() drops faces that carry a Location, e.g. of a moved Previous)
+            sewn = Part.makeCompound([f.copy() for f in obj.Previous.Shape.Faces] + [face])
+            sewn.sewShape(max(1e-7, 10.0 * obj.MaxDeviation))
+            shells = [sewn] if sewn.ShapeType == "Shell" else sewn.Shells
+            if len(shells) == 1 and len(shells[0].Faces) != len(obj.Previous.Shape.Faces) + 1:
+                shells = []
             if len(shells) != 1:
-                raise ValueError(f"sewing with Previous gave {len(shells)} shells; the strips do not share their joint ruling (own BoundaryCoordinates?)")
+                raise ValueError(f"sewing with Previous gave {len(shells)} shells of all faces; the strips do not share their joint ruling (own BoundaryCoordinates?)")
             obj.Shape = shells[0]
         else:
             obj.Shape = face

@@ -157,6 +157,50 @@ class JoinedDevelopableTest(unittest.TestCase):
         j.Mu = 3.0  # App::PropertyFloatConstraint clamps to [-1, 1]
         self.assertEqual(j.Mu, 1.0)
 
+    def test_parameter_box(self):
+        """24 seeded samples of the box |μ|, |ν| <= 0.5 (both strips), γ ∈ [-1, 1], k ∈ [0.75, 1.25],
+        |β2|, |β3| <= 0.2, G1/G2/G3 in turn: measured order = requested, normals agree, valid shell."""
+        rng = np.random.default_rng(20261122)
+        j = joined_developable.make_joined_developable(self.first, "G1", fuse=True, doc=self.doc)
+        worst = 0.0
+        for i in range(24):
+            fm, fn, m, nu = rng.uniform(-0.5, 0.5, 4)
+            g, k = rng.uniform(-1.0, 1.0), rng.uniform(0.75, 1.25)
+            b2, b3 = rng.uniform(-0.2, 0.2, 2)
+            r = 1 + i % 3
+            self.first.Mu, self.first.Nu = float(fm), float(fn)
+            j.Continuity = f"G{r}"
+            j.Mu, j.Nu, j.Gamma, j.K, j.Beta2, j.Beta3 = float(m), float(nu), float(g), float(k), float(b2), float(b3)
+            self.doc.recompute()
+            case = f"sample {i}: mu0={fm:.3f} nu0={fn:.3f} mu={m:.3f} nu={nu:.3f} gamma={g:.3f} k={k:.3f} b2={b2:.3f} b3={b3:.3f} G{r}"
+            self.assertFalse(_bad(j), case)
+            self.assertEqual(j.JointOrder, r, case)
+            self.assertTrue(j.Shape.isValid(), case)
+            self.assertEqual(len(j.Shape.Edges), 7, case)
+            angle, gap = _shared_edge_normal_angle(j.Shape, 5)
+            self.assertLess(angle, NORMAL_TOL_DEG, case)
+            self.assertLess(gap, 1e-7, case)
+            worst = max(worst, angle)
+        print(f"parameter box: 24 samples, worst joint normal angle {worst:.3g} deg")
+
+    def test_follows_moved_previous(self):
+        j = joined_developable.make_joined_developable(self.first, "G2", fuse=True, doc=self.doc)
+        before = _samples(j.Shape.Faces[-1])
+        pl = App.Placement(App.Vector(5, -3, 2), App.Rotation(App.Vector(1, 1, 0), 30))
+        self.first.Placement = pl
+        self.doc.recompute()
+        self.assertFalse(_bad(j), j.State)
+        self.assertTrue(j.Shape.isValid())
+        self.assertEqual(len(j.Shape.Edges), 7)  # still sewn: the moved strips share their ruling
+        moved = np.array([list(pl.multVec(App.Vector(*p))) for p in before])
+        self.assertLess(float(np.max(np.abs(_samples(j.Shape.Faces[-1]) - moved))), 1e-9)
+        angle, _ = _shared_edge_normal_angle(j.Shape)
+        self.assertLess(angle, NORMAL_TOL_DEG)
+        # a second joined strip follows the chain of placements
+        j2 = joined_developable.make_joined_developable(j, "G1", [(-30.0, -1.0, -1.0, 0.0), (-12.0, 0.0, -1.0, 0.0)], fuse=True, doc=self.doc)
+        self.assertEqual(len(j2.Shape.Edges), 10)
+        self.assertTrue(j2.Shape.isValid())
+
     def test_save_reopen_step_and_flat_pattern(self):
         self.first.Mu = 0.2
         j = joined_developable.make_joined_developable(self.first, "G2", fuse=True, doc=self.doc)
