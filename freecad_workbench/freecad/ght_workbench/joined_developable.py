@@ -174,10 +174,12 @@ class JoinedDevelopableFeature(FeatureProxy):
             sewn = Part.makeCompound([f.copy() for f in obj.Previous.Shape.Faces] + [face])
             sewn.sewShape(max(1e-7, 10.0 * obj.MaxDeviation))
             shells = [sewn] if sewn.ShapeType == "Shell" else sewn.Shells
-            if len(shells) == 1 and len(shells[0].Faces) != len(obj.Previous.Shape.Faces) + 1:
+            # one shell of all faces whose new face shares exactly its start ruling edge
+            expected_edges = len(obj.Previous.Shape.Edges) + len(face.Edges) - 1
+            if len(shells) == 1 and (len(shells[0].Faces) != len(obj.Previous.Shape.Faces) + 1 or len(shells[0].Edges) != expected_edges):
                 shells = []
             if len(shells) != 1:
-                raise ValueError(f"sewing with Previous gave {len(shells)} shells of all faces; the strips do not share their joint ruling (own BoundaryCoordinates?)")
+                raise ValueError("sewing with Previous did not give one shell in which the new face shares its start ruling edge; the strips do not share their joint ruling segment (own BoundaryCoordinates?) — set Fuse to False")
             obj.Shape = shells[0]
         else:
             obj.Shape = face

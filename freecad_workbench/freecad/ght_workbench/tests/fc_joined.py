@@ -243,6 +243,17 @@ class JoinedDevelopableTest(unittest.TestCase):
         self.assertLess(fp.MaxRelativeError, 1e-6)
         print(f"flat pattern of the joined strip: AreaFlat={fp.AreaFlat:.9f} face area={face.Area:.9f} MaxRelativeError={fp.MaxRelativeError:.3g}")
 
+    def test_normal_check_detects_a_kink(self):
+        """The shared-edge normal check is not vacuous: two planar faces with a 10° kink."""
+        a = Part.Face(Part.makePolygon([App.Vector(0, 0, 0), App.Vector(0, 0, 5), App.Vector(-4, 0, 5), App.Vector(-4, 0, 0), App.Vector(0, 0, 0)]))
+        c, s_ = math.cos(math.radians(10)), math.sin(math.radians(10))
+        b = Part.Face(Part.makePolygon([App.Vector(0, 0, 0), App.Vector(4 * c, 4 * s_, 0), App.Vector(4 * c, 4 * s_, 5), App.Vector(0, 0, 5), App.Vector(0, 0, 0)]))
+        shell = Part.makeCompound([a, b])
+        shell.sewShape(1e-7)
+        angle, gap = _shared_edge_normal_angle(shell)
+        self.assertAlmostEqual(min(angle, 180.0 - angle), 10.0, delta=1e-9)
+        self.assertLess(gap, 1e-12)
+
     def test_bad_input(self):
         with self.assertRaisesRegex(ValueError, "G0"):
             joined_developable.make_joined_developable(self.first, "G0", doc=self.doc)
@@ -254,6 +265,17 @@ class JoinedDevelopableTest(unittest.TestCase):
         j.PlaneCoordinates = [1.0, 2.0, 3.0]
         self.doc.recompute()
         self.assertIn("Invalid", j.State)
+        # own boundary planes: the joint ruling segments differ, so Fuse cannot sew one shell
+        j.PlaneCoordinates = [float(x) for x in np.ravel(joined_developable.DEFAULT_FREE_PLANES)]
+        j.BoundaryCoordinates = [-2.0, 0.0, 0.0, 1.0, -15.0, 0.0, 0.0, 1.0]
+        j.Fuse = True
+        self.doc.recompute()
+        self.assertIn("Invalid", j.State)
+        j.Fuse = False  # the single face is fine and the (dual-curve) joint order is unchanged
+        self.doc.recompute()
+        self.assertFalse(_bad(j), j.State)
+        self.assertEqual(j.JointOrder, 1)
+        self.assertAlmostEqual(j.Shape.BoundBox.ZLength, 13.0, delta=1e-9)
         # a non-enveloping previous feature is refused with its name in the message
         plain = self.doc.addObject("Part::Feature", "Plain")
         plain.Shape = Part.makePlane(1, 1)
