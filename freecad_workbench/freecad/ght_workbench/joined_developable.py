@@ -23,7 +23,7 @@ copied from ``Continuity``.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -113,7 +113,7 @@ class JoinedDevelopableFeature(FeatureProxy):
         obj.JointTolerance = 1e-9
         obj.addProperty("App::PropertyInteger", "Degree", "Output", "Degree n of the new strip's dual curve")
         obj.addProperty("App::PropertyInteger", "JointOrder", "Joint", "Measured geometric order of the joint (measure_developable_joint)")
-        obj.addProperty("App::PropertyFloatList", "JointResiduals", "Joint", "Relative residuals of the order-0..3 contact conditions")
+        obj.addProperty("App::PropertyFloatList", "JointResiduals", "Joint", "Relative residuals of the order-0..3 contact conditions (-1: not applicable, the reparametrization would reverse)")
         obj.addProperty("App::PropertyAngle", "PlaneAngle", "Joint", "Angle between the tangent planes at the joint")
         obj.addProperty("App::PropertyAngle", "ThetaMax", "Developability", "max θ(u) = angle(n_a, n_b) along the rulings of the new strip (0 for a developable)")
         obj.addProperty("App::PropertyFloat", "DD", "Developability", "degree of developability ∫ cos θ(u) du of the new strip (1 = developable)")

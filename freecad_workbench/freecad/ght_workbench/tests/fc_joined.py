@@ -254,6 +254,11 @@ class JoinedDevelopableTest(unittest.TestCase):
         self.assertAlmostEqual(min(angle, 180.0 - angle), 10.0, delta=1e-9)
         self.assertLess(gap, 1e-12)
 
+    def test_no_cad_kernel_import(self):
+        import sys
+
+        self.assertFalse([m for m in sys.modules if m.split(".")[0] in ("OCP", "build123d", "cadquery")])
+
     def test_bad_input(self):
         with self.assertRaisesRegex(ValueError, "G0"):
             joined_developable.make_joined_developable(self.first, "G0", doc=self.doc)
