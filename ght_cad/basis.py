@@ -17,7 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_degree
+from ._validate import as_parameter_array, check_degree, check_unit_interval
 from .errors import GHTError
 from .seeds import MAX_DERIVATIVE, Seed, make_seed
 
@@ -286,12 +286,14 @@ def basis(
         Array of shape (len(t), degree+1); for scalar ``t`` shape (degree+1,).
 
     Raises:
-        GHTError: degree < 2, shape parameter outside [-1, 1], NaN/inf in t, bad derivative order.
+        GHTError: degree < 2, shape parameter outside [-1, 1], NaN/inf or t outside [0, 1], bad
+            derivative order.
     """
     m = check_degree(degree)
     r = _check_order(derivative)
     sd = make_seed(seed, mu, nu, gamma)
     tt, scalar = as_parameter_array(t)
+    check_unit_interval("t", tt, slack=1e-9)  # outside [0, 1] the basis is not a partition of non-negative functions
     out = seed_basis(tt, m, sd, r)
     return out[0] if scalar else out
 

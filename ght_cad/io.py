@@ -23,9 +23,12 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
         ...     writer.Write(str(tmp))
     """
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
     sfx = target.suffix if suffix is None else suffix
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=sfx + ".part", dir=target.parent)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=sfx + ".part", dir=target.parent)
+    except OSError as exc:
+        raise _named(exc, target) from None
     os.close(fd)
     tmp = Path(tmp_name)
     # Some writers refuse an existing file or append to it: hand them a path that does not exist.
@@ -33,13 +36,22 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
     try:
         yield tmp
         if not tmp.exists() or tmp.stat().st_size == 0:
-            raise OSError(f"writing {target} produced no data")
+            raise OSError("the writer produced no data")
         with open(tmp, "rb") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp, target)
+    except OSError as exc:
+        # the user knows the target, not our temporary name beside it
+        raise _named(exc, target) from None
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def _named(exc: OSError, target: Path) -> OSError:
+    """The same kind of OSError, with a message that names ``target`` instead of a temporary file."""
+    reason = exc.strerror or str(exc)
+    return type(exc)(exc.errno, f"cannot write {target}: {reason}") if exc.errno else OSError(f"cannot write {target}: {reason}")
 
 
 @contextlib.contextmanager

@@ -41,7 +41,8 @@ def test_curve_deviation_below_default_tolerance(degree, mu, nu, gamma, dim, see
     # independent check on 24001 fresh parameters: the reported figure is the true maximum
     dev = _independent_deviation(curve, bs)
     assert dev <= tol * (1 + 1e-6)
-    assert dev <= bs.max_deviation * (1 + 1e-3) + 1e-15
+    # plus rounding: evaluating points of size |P| costs a few ulps of |P|
+    assert dev <= bs.max_deviation * (1 + 1e-3) + 8 * np.finfo(float).eps * float(np.abs(curve.control_points).max())
 
 
 @settings(max_examples=20)

@@ -65,3 +65,11 @@ def test_bad_parameters_and_orders() -> None:
         c.torsion(0.5)
     with pytest.raises(GHTError, match=r"seed='nope' is not registered; known seeds: bernstein, gbt, ght"):
         GHTCurve([[0, 0], [1, 1], [2, 0]], seed="nope")
+
+
+def test_basis_outside_the_parameter_domain() -> None:
+    """Outside [0, 1] the basis loses non-negativity: refused like GHTCurve.evaluate."""
+    with pytest.raises(GHTError, match=r"t=1\.5 is outside the parameter domain \[0, 1\]"):
+        basis(np.array([0.0, 1.5]), 3)
+    with pytest.raises(GHTError, match=r"t=-0\.25 is outside the parameter domain"):
+        basis(-0.25, 4, 0.2, 0.1, 0.0)

@@ -307,7 +307,12 @@ def test_tangent_developable_errors():
 @settings(max_examples=10)
 def test_rectifying_developable_is_developable_and_keeps_the_geodesic(mu, nu, gamma):
     C = SPACE.with_shape(mu, nu, gamma)
-    s = RectifyingDevelopable(C, -0.15, 0.25)
+    try:
+        s = RectifyingDevelopable(C, -0.15, 0.25)
+    except EdgeOfRegressionError:
+        # near the box corners (e.g. mu = nu = 1, gamma = 0) the fixed strip [-0.15, 0.25] reaches
+        # its edge of regression: the refusal is right, and the properties below need a regular strip
+        assume(False)
     dev = s.developability()
     assert dev.theta_max <= ROUND_OFF_DEG and dev.residual_max <= ROUND_OFF_RES
     u = np.linspace(0, 1, 13)

@@ -136,7 +136,7 @@ def test_igwo_pso_stay_in_bounds(lo, width, seed):
 
     def f(X):
         assert np.all(X >= lb) and np.all(X <= ub)
-        return np.sum((X - 10.0) ** 2, axis=1)      # optimum outside the box: pushes to the bound
+        return np.sum((X - (ub + 5.0)) ** 2, axis=1)  # optimum outside the box: pushes to the bound
 
     for opt in (igwo, pso, gwo):
         r = opt(f, (lb, ub), pop_size=6, max_iter=20, seed=seed)
