@@ -299,7 +299,11 @@ def _tangent_developable(P: np.ndarray, v0: float, v1: float) -> FunctionRuledSu
     width=st.floats(0.1, 1.0),
 )
 def test_random_tangent_developables_preserve_lengths_and_area(P, v0, width) -> None:
-    """Over a box of cubic spines: boundary, ruling lengths and area preserved to 1e-10."""
+    """Over a box of cubic spines: boundary, ruling lengths and area preserved to 1e-9.
+
+    (Issue 5 asks for 1e-7; strongly curved spines bring the sampled flat boundary length, measured
+    on polylines with Richardson extrapolation, to a few 1e-10.)
+    """
     from hypothesis import assume
 
     P = np.asarray(P, dtype=float)
@@ -312,7 +316,7 @@ def test_random_tangent_developables_preserve_lengths_and_area(P, v0, width) -> 
     assume((np.linalg.norm(np.cross(d1, d2), axis=1) / sp**3).min() > 0.05)
     pat = unroll(_tangent_developable(P, v0, v0 + width), rulings=0)
     e = pat.errors
-    assert e["boundary_length"] < 1e-10 and e["ruling_length"] < 1e-10 and e["area"] < 1e-10, e
+    assert e["boundary_length"] < 1e-9 and e["ruling_length"] < 1e-10 and e["area"] < 1e-10, e
 
 
 @settings(max_examples=10)
