@@ -265,3 +265,82 @@ def test_cadquery_face() -> None:
     face = next(f for f in cq.Workplane().cylinder(5.0, 2.0).val().Faces() if f.geomType() == "CYLINDER")
     pat = unroll(face)
     assert pat.area == pytest.approx(2 * math.pi * 2.0 * 5.0, rel=RTOL)
+
+
+def _torus_face(major_angle: float = 360.0):
+    return _face(bd.Torus(10.0, 2.0, major_angle=major_angle), bd.GeomType.TORUS)
+
+
+def _vase_face():
+    """A revolved spline profile: a closed surface of revolution that is not ruled."""
+    with bd.BuildPart() as p:
+        with bd.BuildSketch(bd.Plane.XZ):
+            with bd.BuildLine():
+                bd.Spline((2, 0), (4, 5), (3, 10))
+                bd.Polyline((3, 10), (0, 10), (0, 0), (2, 0))
+            bd.make_face()
+        bd.revolve(axis=bd.Axis.Z)
+    return _face(p.part, bd.GeomType.REVOLUTION)
+
+
+# 33 samples of a closed circle: the best-fitting line is a diameter, max distance R, polygon
+# length 64 R sin(π/32), so the relative deviation is 1/(64 sin(π/32)) = 0.15941 (→ 1/(2π)).
+CLOSED_DEV = 1.0 / (64.0 * math.sin(math.pi / 32.0))
+
+
+@pytest.mark.parametrize("phi_deg", [20.0, 90.0, 180.0, 300.0, 359.9])
+def test_isoline_deviation_is_sagitta_over_arc_length(phi_deg: float) -> None:
+    """A torus sector's u-isolines are circular arcs of angle φ: distance of the arc from its chord
+    line relative to its length is (1 - cos(φ/2)) / φ (to the 32-segment sampling, 2e-3); its
+    v-isolines are closed circles: finite 0.159, never 0 (a closed isoline is not straight)."""
+    d, info = face_ruling_direction(_torus_face(phi_deg))
+    phi = math.radians(phi_deg)
+    assert d is None
+    assert info["deviation_u"] == pytest.approx((1.0 - math.cos(phi / 2.0)) / phi, rel=2e-3)
+    assert info["deviation_v"] == pytest.approx(CLOSED_DEV, rel=1e-9)
+    assert info["openness_v"] < 1e-12 < info["openness_u"]
+
+
+@pytest.mark.parametrize("which", ["torus", "sphere", "vase"])
+def test_closed_faces_are_not_ruled_with_finite_deviation(which: str) -> None:
+    face = {"torus": _torus_face, "sphere": lambda: bd.Sphere(5.0).faces()[0], "vase": _vase_face}[which]()
+    d, info = face_ruling_direction(face)
+    assert d is None
+    devs = [info["deviation_u"], info["deviation_v"]]
+    assert all(math.isfinite(x) and 0.05 < x < 0.5 for x in devs), devs
+    with pytest.raises(NotDevelopableError, match="not ruled") as exc:
+        unroll(face)
+    msg = str(exc.value)
+    assert "nan" not in msg and "e+" not in msg
+    assert f"{info['deviation_u']:.3g} (u-isolines)" in msg and f"{info['deviation_v']:.3g} (v-isolines)" in msg
+    assert "relative to their lengths" in msg
+
+
+def test_sphere_deviations_are_circle_and_half_circle() -> None:
+    _, info = face_ruling_direction(bd.Sphere(5.0).faces()[0])
+    assert info["deviation_u"] == pytest.approx(CLOSED_DEV, rel=1e-9)  # latitude circles (closed)
+    assert info["deviation_v"] == pytest.approx(1.0 / (64.0 * math.sin(math.pi / 64.0)), rel=1e-9)  # meridians
+
+
+def test_full_torus_best_effort_names_why() -> None:
+    from ght_cad.errors import DegenerateGeometryError
+
+    with pytest.raises(DegenerateGeometryError, match="closed in both directions") as exc:
+        unroll(_torus_face(), best_effort=True)
+    assert "ruling length" not in str(exc.value) and "nan" not in str(exc.value)
+
+
+@pytest.mark.parametrize("which", ["torus90", "sphere", "vase"])
+def test_best_effort_uses_open_boundary_isolines(which: str) -> None:
+    """best_effort spans rulings between the open boundary isolines (never two copies of one
+    closed isoline) and reports the distortion; the ruled surface's rulings have length > 0."""
+    face = {"torus90": lambda: _torus_face(90.0), "sphere": lambda: bd.Sphere(5.0).faces()[0], "vase": _vase_face}[which]()
+    _, info = face_ruling_direction(face)
+    pat = unroll(face, best_effort=True)
+    panel = pat.panels[0]
+    assert panel.ruling_lengths_3d.min() > 1e-6
+    assert np.isfinite(pat.errors["max"]) and pat.errors["max"] > 1e-3  # distortion is reported
+    assert panel.info["best_effort"] is True
+    open_dir = "u" if which == "torus90" else "v"
+    assert panel.info["ruling_direction"] == open_dir
+    assert info[f"openness_{open_dir}"] > 0.1 and info[f"openness_{'v' if open_dir == 'u' else 'u'}"] < 1e-12

@@ -46,7 +46,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from ..errors import GHTError, NotDevelopableError
+from ..errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from ..ruled import RuledSurface
 from ..unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
@@ -207,12 +207,26 @@ def surface_breaks(ad: BRepAdaptor_Surface, direction: str) -> np.ndarray:
     return np.array([arr.Value(i) for i in range(1, n + 2)])
 
 
-def _straightness(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> float:
-    """Max distance of isoline samples from their chord, relative to the chord (along ``direction``)."""
+def _isoline_stats(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> tuple[float, float]:
+    r"""Straightness and openness of the isolines running along ``direction``.
+
+    Nine isolines (fixed other parameter at 0, 1/8, ..., 1 of its range), each sampled at 33
+    points ``p_0 .. p_32``, polyline length ``L = Σ |p_{k+1} - p_k|``, chord ``c = p_32 - p_0``.
+    The line an isoline is compared with is its chord line when ``|c| > 1e-9 L``, else (a closed
+    isoline) the best-fitting line (through the centroid along the principal axis of the points).
+    The deviation of one isoline is ``max_k dist(p_k, line) / L`` (0 for a straight segment,
+    ``1/π`` for a half circle, ``1/(2π)`` for a full circle); isolines with ``L = 0`` (a pole or
+    an apex) are points and skipped.
+
+    Returns:
+        ``(deviation, openness)``: the largest deviation and the smallest ``|c| / L`` over the
+        non-degenerate isolines (``openness`` 0 for closed isolines, 1 for straight ones);
+        ``(0.0, 1.0)`` when every isoline is degenerate.
+    """
     u0, u1, v0, v1 = bounds
     fixed = np.linspace(0.0, 1.0, 9)
-    run = np.linspace(0.0, 1.0, 17)
-    worst = 0.0
+    run = np.linspace(0.0, 1.0, 33)
+    worst, openness = 0.0, 1.0
     for f in fixed:
         if direction == "v":
             u = np.full_like(run, u0 + f * (u1 - u0))
@@ -221,26 +235,47 @@ def _straightness(ev: _SurfEval, bounds: tuple[float, float, float, float], dire
             u = u0 + run * (u1 - u0)
             v = np.full_like(run, v0 + f * (v1 - v0))
         p = ev.value(u, v)
+        L = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+        if not math.isfinite(L) or L <= 1e-14 * max(1.0, float(np.abs(p).max())):
+            continue  # the isoline is a point (pole, apex)
         c = p[-1] - p[0]
-        L = float(np.linalg.norm(c))
-        if L == 0:
-            continue
-        dev = np.linalg.norm(np.cross(p - p[0], c / L), axis=1).max() / L
-        worst = max(worst, float(dev))
-    return worst
+        chord = float(np.linalg.norm(c))
+        if chord > 1e-9 * L:
+            origin, axis = p[0], c / chord
+        else:  # closed isoline: its best-fitting straight line
+            origin = p.mean(axis=0)
+            axis = np.linalg.svd(p - origin, full_matrices=False)[2][0]
+        dev = float(np.linalg.norm(np.cross(p - origin, axis), axis=1).max()) / L
+        worst = max(worst, dev)
+        openness = min(openness, chord / L)
+    return worst, openness
+
+
+def _straightness(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> float:
+    """Largest isoline deviation from a straight line relative to the isoline length (:func:`_isoline_stats`)."""
+    return _isoline_stats(ev, bounds, direction)[0]
 
 
 def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
-    """Which parameter direction of the face has straight isolines (the rulings).
+    r"""Which parameter direction of the face has straight isolines (the rulings).
 
-    Returns ``("v", {...})`` when v-isolines are straight (relative deviation from the chord
-    < 1e-9), ``"u"`` likewise, ``None`` when neither; the dict holds both measured deviations.
-    Planes return ``"v"``.
+    Args:
+        face: a build123d/cadquery Face or TopoDS_Face.
+
+    Returns:
+        ``("v", info)`` when the v-isolines are straight (deviation ``max dist(p, line) / L``
+        < 1e-9, see :func:`_isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
+        likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v`` (finite,
+        relative to the isoline length) and ``openness_u``, ``openness_v`` (smallest chord /
+        length; 0 for closed isolines). Planes, cylinders, cones and extrusions return ``"v"``.
+
+    Raises:
+        GHTError: not a face, or a shape with several faces.
     """
     f, ad, bounds, ev = _open_face(face)
-    dv = _straightness(ev, bounds, "v")
-    du = _straightness(ev, bounds, "u")
-    info = {"deviation_v": dv, "deviation_u": du}
+    dv, ov = _isoline_stats(ev, bounds, "v")
+    du, ou = _isoline_stats(ev, bounds, "u")
+    info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
     if ad.GetType() in (GeomAbs_Plane, GeomAbs_Cylinder, GeomAbs_Cone, GeomAbs_SurfaceOfExtrusion):
         return "v", info
     if ad.GetType() in (GeomAbs_BSplineSurface, GeomAbs_BezierSurface):
@@ -253,6 +288,30 @@ def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
     if du <= 1e-9:
         return "u", info
     return None, info
+
+
+def _best_effort_direction(info: dict[str, float], label: str) -> str:
+    """Ruling direction for flattening a non-ruled face: the boundary isolines ``S(·, v0)``,
+    ``S(·, v1)`` (rulings along v) must be distinct curves, i.e. the v-isolines must be open.
+    Among directions whose isolines are clearly open (chord ≥ 1 % of the length), else merely
+    open (chord > 1e-6 of the length), the straighter one is used.
+
+    Raises:
+        DegenerateGeometryError: the isolines are closed in both directions (a torus): there are
+            no two distinct boundary isolines to span rulings between.
+    """
+    for lim in (1e-2, 1e-6):
+        cands = [d for d in ("v", "u") if info[f"openness_{d}"] >= lim]
+        if cands:
+            return min(cands, key=lambda d: info[f"deviation_{d}"])
+    raise DegenerateGeometryError(
+        f"face {label!r} is not ruled (its isolines deviate from straight lines by "
+        f"{info['deviation_u']:.3g} (u-isolines) and {info['deviation_v']:.3g} (v-isolines) relative to "
+        "their lengths; allowed 1e-9) and cannot be flattened even with best_effort=True: its isolines are "
+        f"closed in both directions (chord/length {info['openness_u']:.3g} (u) and {info['openness_v']:.3g} "
+        "(v); allowed > 1e-6), so it has no two distinct boundary isolines to span rulings between; split "
+        "the face (e.g. cut a torus into sectors) first"
+    )
 
 
 def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callable, Callable, float, Callable]:
@@ -388,7 +447,9 @@ def unroll_face(
         face: a Face (build123d, cadquery) or TopoDS_Face (or a shape holding exactly one face).
         best_effort: flatten a face that is not ruled / not developable within ``tol_deg``; a
             non-ruled face is replaced by the ruled surface between its v0 and v1 (or u0, u1)
-            boundary isolines, and the report measures the distortion against the true face.
+            boundary isolines (the straighter direction whose isolines are open;
+            ``info["ruling_direction"]``), and the report measures the distortion against the
+            true face.
         tol_deg: largest accepted ``θ_max`` in degrees (spec section 5).
         rulings: interior rulings drawn as bend lines (clipped to the trimmed outline).
         samples: points per boundary edge in the outline polylines.
@@ -399,9 +460,12 @@ def unroll_face(
         FlatPattern with one panel: all wires of the face (outer + holes) mapped to the plane.
 
     Raises:
-        NotDevelopableError: the face is not ruled (message gives the isolines' relative
-            deviation from straight lines) or its θ_max exceeds ``tol_deg`` (message gives θ_max
-            and DD), and best_effort is False.
+        NotDevelopableError: the face is not ruled (message gives the isolines' largest distance
+            from a straight line relative to their length, :func:`_isoline_stats`; a closed isoline
+            gives about 0.159) or its θ_max exceeds ``tol_deg`` (message gives θ_max and DD), and
+            best_effort is False.
+        DegenerateGeometryError: best_effort on a non-ruled face whose isolines are closed in both
+            directions (a full torus): no open boundary isolines to span rulings between.
         GHTError: not a face, or a shape with several faces.
     """
     f, ad, bounds, ev = _open_face(face)
@@ -429,10 +493,12 @@ def unroll_face(
                 raise NotDevelopableError(
                     f"face {label!r} is not ruled: its isolines deviate from straight lines by "
                     f"{straight['deviation_u']:.3g} (u-isolines) and {straight['deviation_v']:.3g} "
-                    "(v-isolines) relative to their chords (allowed 1e-9); pass best_effort=True to "
-                    "flatten the ruled surface between its boundary isolines with a distortion report"
+                    "(v-isolines) relative to their lengths (allowed 1e-9; a closed isoline deviates "
+                    "0.159); pass best_effort=True to flatten the ruled surface between its boundary "
+                    "isolines with a distortion report"
                 )
-            ruled_dir = "v" if straight["deviation_v"] <= straight["deviation_u"] else "u"
+            ruled_dir = _best_effort_direction(straight, label)
+        info["ruling_direction"] = ruled_dir
         ruled_surface = FaceRuledSurface(ad, ruled_dir, bounds)
         dd = _check_developable(ruled_surface, tol_deg, best_effort, f"face {label!r}")
         info["developability"] = dd.as_dict()
