@@ -376,3 +376,16 @@ def test_step_declares_the_design_units(tmp_path) -> None:
     run_design(design, tmp_path / "out", progress=False)
     text = (tmp_path / "out" / "model.step").read_text(errors="replace")
     assert re.search(r"LENGTH_UNIT\(\) NAMED_UNIT\(\*\) SI_UNIT\(\$,\.METRE\.\)", text)
+
+
+def test_hull_plate_header_describes_its_join() -> None:
+    """The example's comment header names the join the file really has (sheer -> stem, G1)."""
+    path = Path(__file__).resolve().parent.parent / "examples" / "design_hull_plate.toml"
+    header = " ".join(ln.lstrip("# ").strip() for ln in path.read_text().splitlines() if ln.startswith("#"))
+    d = load_design(path)
+    assert [(j.first, j.second, j.continuity, j.k) for j in d.joins] == [("sheer", "stem", "G1", 0.8)]
+    assert "sheer line continues into the stem" in header and "joined to the sheer's end with G1" in header
+    assert "k = 0.8" in header and "chine is built from two segments" not in header
+    # the stem really starts where the sheer ends (the join is at the sheer's end)
+    sheer, stem = (next(c for c in d.curves if c.name == n) for n in ("sheer", "stem"))
+    assert list(stem.control_points[0]) == list(sheer.control_points[-1])
