@@ -40,10 +40,22 @@ __all__ = [
     "layout_panels",
     "mark_shared_edges",
     "INSUNITS",
+    "SVG_UNITS",
 ]
 
 #: DXF $INSUNITS codes
 INSUNITS = {"unitless": 0, "in": 1, "ft": 2, "mm": 4, "cm": 5, "m": 6}
+
+#: SVG width/height unit and scale per model unit: SVG lengths know mm, cm, in (not m, ft), so
+#: ``1 m = 1000 mm`` and ``1 ft = 12 in``; the viewBox stays in model units (true-scale print).
+SVG_UNITS = {
+    "unitless": ("", 1.0),
+    "mm": ("mm", 1.0),
+    "cm": ("cm", 1.0),
+    "m": ("mm", 1000.0),
+    "in": ("in", 1.0),
+    "ft": ("in", 12.0),
+}
 
 _ROMBERG_N = 128
 
@@ -664,7 +676,18 @@ class FlatPattern:
         return "\n".join(out) + "\n"
 
     def svg_text(self, margin: float | None = None) -> str:
-        """The SVG document as a string (see :meth:`export_svg`)."""
+        """The SVG document as a string (see :meth:`export_svg`).
+
+        The viewBox is in model units; ``width``/``height`` are the same extent in an SVG length
+        unit (:data:`SVG_UNITS`: ``width = (extent + 2 margin) × scale`` with m → mm × 1000,
+        ft → in × 12, mm/cm/in × 1), so the drawing prints at true scale.
+
+        Args:
+            margin: blank border in model units (default 3 % of the larger extent).
+
+        Returns:
+            The SVG text.
+        """
         pts = np.concatenate(self.outlines, axis=0)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         span = float(np.max(hi - lo))
@@ -675,11 +698,11 @@ class FlatPattern:
             return float(p[0] - lo[0] + m), float(hi[1] - p[1] + m)
 
         sw = span / 800.0
-        unit = "" if self.units == "unitless" else self.units
+        unit, scale = SVG_UNITS[self.units]
         out = [
             '<?xml version="1.0" encoding="UTF-8" standalone="no"?>',
             f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" '
-            f'version="1.1" width="{W:.6g}{unit}" height="{H:.6g}{unit}" viewBox="0 0 {W:.9g} {H:.9g}">',
+            f'version="1.1" width="{W * scale:.9g}{unit}" height="{H * scale:.9g}{unit}" viewBox="0 0 {W:.9g} {H:.9g}">',
             f'<g id="OUTLINE" inkscape:groupmode="layer" inkscape:label="OUTLINE" fill="none" stroke="black" stroke-width="{sw:.6g}">',
         ]
         for lp in self.outlines:
@@ -711,7 +734,8 @@ class FlatPattern:
         return "\n".join(out) + "\n"
 
     def export_svg(self, path: str | os.PathLike) -> Path:
-        """Write an SVG: groups (Inkscape layers) OUTLINE, BEND (dashed), MARKS, LABELS; size in units."""
+        """Write an SVG: groups (Inkscape layers) OUTLINE, BEND (dashed), MARKS, LABELS; true-scale
+        size in mm, cm or in (m and ft converted, see :meth:`svg_text`)."""
         return write_text_atomic(path, self.svg_text())
 
     def plot_png(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:

@@ -183,3 +183,45 @@ def test_dxf_r12_fallback_without_ezdxf(pattern: FlatPattern, tmp_path, monkeypa
     bends = msp.query('LINE[layer=="BEND"]')
     assert len(bends) == 7 and all(b.dxf.linetype == "DASHED" for b in bends)
     assert [t.dxf.text for t in msp.query("TEXT")] == ["P1"]
+
+
+#: mm per unit, for the model units and for the SVG length units (CSS: 1in = 25.4mm)
+_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
+
+
+def _unit_square(units: str) -> FlatPattern:
+    line = lambda y: GHTCurve(np.array([(0.0, y, 0.0), (0.5, y, 0.0), (1.0, y, 0.0)]), gamma=-1)  # noqa: E731
+    return unroll(CurvePairRuledSurface(line(0.0), line(1.0)), rulings=0, units=units)
+
+
+def _svg_size(text: str) -> tuple[float, str, float, str, list[float]]:
+    import re
+
+    root = ET.fromstring(text)
+    out = []
+    for key in ("width", "height"):
+        m = re.fullmatch(r"([0-9.eE+-]+)(mm|cm|in)", root.get(key))
+        assert m, f"{key}={root.get(key)!r} is not an SVG length in mm, cm or in"
+        out += [float(m.group(1)), m.group(2)]
+    return (*out, [float(x) for x in root.get("viewBox").split()])
+
+
+@pytest.mark.parametrize("units", ["mm", "cm", "m", "in", "ft"])
+def test_svg_size_is_true_scale_in_a_valid_svg_unit(units: str) -> None:
+    """width/height carry mm, cm or in (m → mm, ft → in) and equal the viewBox extent (model
+    units) at true scale: width [mm] = viewBox width × (mm per model unit), to 1e-8."""
+    pat = _unit_square(units)
+    np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [1.0, 1.0], rtol=1e-12)
+    W, wu, H, hu, vb = _svg_size(pat.svg_text(margin=0.0))
+    assert wu == hu == {"m": "mm", "ft": "in"}.get(units, units)
+    np.testing.assert_allclose(vb, [0.0, 0.0, 1.0, 1.0], atol=1e-9)
+    np.testing.assert_allclose([W * _MM[wu], H * _MM[hu]], [_MM[units], _MM[units]], rtol=1e-8)
+    # the default margin (3 % of the extent) is scaled the same way
+    W, wu, H, hu, vb = _svg_size(pat.svg_text())
+    np.testing.assert_allclose(vb[2:], [1.06, 1.06], rtol=1e-8)
+    np.testing.assert_allclose([W * _MM[wu], H * _MM[hu]], [1.06 * _MM[units]] * 2, rtol=1e-8)
+
+
+def test_svg_one_metre_is_1000mm_and_one_foot_12in() -> None:
+    assert _svg_size(_unit_square("m").svg_text(margin=0.0))[:4] == (1000.0, "mm", 1000.0, "mm")
+    assert _svg_size(_unit_square("ft").svg_text(margin=0.0))[:4] == (12.0, "in", 12.0, "in")
