@@ -1238,13 +1238,23 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
     ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: summary;
     ``.png``: rendered surface (or the curves when the design has no surface).
 
+    All or nothing: every file is first written into a temporary folder beside its target
+    (which also proves the target's folder is writable) and the files are moved into place only
+    when every one was written; a failure leaves every target as it was (existing files
+    untouched, no new file).
+
+    Args:
+        design: a validated design (:func:`load_design`).
+        files: output paths; the suffix selects the content.
+
     Raises:
-        DesignError: a suffix that is not allowed, or a surface output without [surface].
+        DesignError: a suffix that is not allowed, a surface output without [surface], or a
+            target whose folder cannot be written (the message names the target).
+
+    Returns:
+        ``{kind: path}`` for each written file (``kind`` = suffix without dot, ``_<n>`` appended
+        for repeats).
     """
-    import json
-
-    from .io import write_text_atomic
-
     files = [Path(f) for f in files]
     allowed = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
     for f in files:
@@ -1252,35 +1262,121 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
             raise DesignError(f"{f}: unknown output suffix {f.suffix!r}; allowed: {', '.join(allowed)}")
     curves, _ = build_curves(design)
     built = build_surface(design, curves=curves) if design.surface is not None else None
-    pattern = None
-    out: dict[str, str] = {}
-    for f in files:
-        suf = f.suffix.lower()
-        if suf in (".dxf", ".svg") and built is None:
-            raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
-        if suf in (".step", ".stp"):
-            if built is not None:
-                export_step(built, f)
-            else:
-                from .cad.occ import write_step
-
-                write_step(curve_edges(curves), f, units=design.units)
-        elif suf in (".dxf", ".svg"):
-            pattern = pattern or unroll_surface(built)
-            (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(f)
-        elif suf == ".json":
-            summ = surface_summary(built) if built is not None else {}
-            summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
-            write_text_atomic(f, json.dumps(_jsonable(summ), indent=2) + "\n")
-        else:
-            from .plotting import plot_curve, plot_surface
-
-            if built is not None:
-                plot_surface(surface_view(built), f, title=design.name)
-            else:
-                plot_curve(list(curves.values()), f)
-        out[suf.lstrip(".") + (f"_{len(out)}" if suf.lstrip(".") in out else "")] = str(f)
+    if built is None:
+        for f in files:
+            if f.suffix.lower() in (".dxf", ".svg"):
+                raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
+    stage = _FileStage(files)
+    try:
+        out: dict[str, str] = {}
+        pattern = None
+        for f in files:
+            pattern = _export_one(design, curves, built, f, stage.path(f), pattern)
+            suf = f.suffix.lower().lstrip(".")
+            out[suf + (f"_{len(out)}" if suf in out else "")] = str(f)
+        stage.commit()
+    finally:
+        stage.cleanup()
     return out
+
+
+def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | None, target: Path,
+                tmp: Path, pattern: Any) -> Any:
+    """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
+    import json
+
+    from .io import write_text_atomic
+
+    suf = target.suffix.lower()
+    if suf in (".step", ".stp"):
+        if built is not None:
+            export_step(built, tmp)
+        else:
+            from .cad.occ import write_step
+
+            write_step(curve_edges(curves), tmp, units=design.units)
+    elif suf in (".dxf", ".svg"):
+        pattern = pattern or unroll_surface(built)
+        (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp)
+    elif suf == ".json":
+        summ = surface_summary(built) if built is not None else {}
+        summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
+        write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
+    else:
+        from .plotting import plot_curve, plot_surface
+
+        if built is not None:
+            plot_surface(surface_view(built), tmp, title=design.name)
+        else:
+            plot_curve(list(curves.values()), tmp)
+    return pattern
+
+
+class _FileStage:
+    """One temporary folder beside each target's folder; :meth:`commit` moves all files into place.
+
+    Creating the temporary folders up front checks that every target folder is writable before
+    anything is computed or written. Folders created for missing parents are removed again on
+    failure.
+    """
+
+    def __init__(self, targets: Sequence[Path]) -> None:
+        self.dirs: dict[Path, Path] = {}
+        self.made: list[Path] = []
+        self.map: dict[Path, Path] = {}
+        try:
+            for t in targets:
+                parent = t.parent.absolute()
+                if t.exists() and t.is_dir():
+                    raise DesignError(f"cannot write {t}: it is a folder; allowed: a file path")
+                if parent not in self.dirs:
+                    self._mkdirs(parent, t)
+                    try:
+                        self.dirs[parent] = Path(tempfile.mkdtemp(prefix=".ght-cad-export.", dir=parent))
+                    except OSError as exc:
+                        raise DesignError(
+                            f"cannot write {t}: folder {parent} is not writable ({exc.strerror or exc})"
+                        ) from None
+                # a numbered name keeps repeated or equal base names apart; the suffix is kept for writers
+                self.map[t] = self.dirs[parent] / f"{len(self.map)}{t.suffix}"
+        except BaseException:
+            self.cleanup()
+            raise
+
+    def _mkdirs(self, parent: Path, target: Path) -> None:
+        missing = []
+        p = parent
+        while not p.exists() and p != p.parent:
+            missing.append(p)
+            p = p.parent
+        for d in reversed(missing):
+            try:
+                d.mkdir()
+            except OSError as exc:
+                raise DesignError(f"cannot write {target}: cannot create folder {d} ({exc.strerror or exc})") from None
+            self.made.append(d)
+
+    def path(self, target: Path) -> Path:
+        return self.map[target]
+
+    def commit(self) -> None:
+        """Move every staged file onto its target (same file system: ``os.replace`` each)."""
+        for t, tmp in self.map.items():
+            if not tmp.is_file():
+                raise GHTError(f"writing {t} produced no file")
+        for t, tmp in self.map.items():
+            os.replace(tmp, t)
+        self.made = []  # the folders now hold results
+
+    def cleanup(self) -> None:
+        for d in self.dirs.values():
+            shutil.rmtree(d, ignore_errors=True)
+        for d in reversed(self.made):
+            try:
+                d.rmdir()
+            except OSError:
+                pass
+        self.made = []
 
 
 def _jsonable(o: Any) -> Any:

@@ -186,3 +186,53 @@ def test_composite_design_single_step_commands(tmp_path: Path, capsys) -> None:
     assert rc == EXIT_USAGE and "'surface.type': 'composite' cannot be optimized" in out["error"]
     rc, out, err = run_json(["unroll", str(tmp_path / "s.step")], capsys)
     assert rc == EXIT_OK and out["face_count"] == 2 and out["panels"] == 2, err
+
+
+# --- export is all-or-nothing ---
+
+
+def _snapshot(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_export_is_all_or_nothing_when_a_target_folder_is_unwritable(cone: Path, tmp_path: Path, capsys) -> None:
+    """A target under a regular file (its folder cannot exist) fails before anything is written."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "keep.step").write_text("old step\n")  # an existing target: must stay as it was
+    (out / "blocker").write_text("a file, not a folder\n")
+    before = _snapshot(out)
+    files = [str(out / "keep.step"), str(out / "new.svg"), str(out / "blocker" / "zz.dxf")]
+    rc, res, err = run_json(["export", str(cone), *files], capsys)
+    assert rc == EXIT_USAGE and "zz.dxf" in res["error"] and len(err.strip().splitlines()) == 1
+    assert _snapshot(out) == before and sorted(p.name for p in out.iterdir()) == ["blocker", "keep.step"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cone.toml", "out"]  # no temporaries left
+
+
+def test_export_is_all_or_nothing_when_a_writer_fails(cone: Path, tmp_path: Path, capsys, monkeypatch) -> None:
+    """The last writer fails after the STEP and SVG were produced: none of the targets appears."""
+    import ght_cad.plotting as P
+
+    def boom(*a, **k):
+        raise RuntimeError("renderer exploded")
+
+    monkeypatch.setattr(P, "plot_surface", boom)
+    (tmp_path / "a.json").write_text("{}\n")
+    sub = tmp_path / "new" / "folder"  # missing folders are created for the set and removed on failure
+    files = [str(tmp_path / "a.step"), str(sub / "a.svg"), str(tmp_path / "a.json"), str(tmp_path / "a.png")]
+    rc, res, err = run_json(["export", str(cone), *files], capsys)
+    assert rc == EXIT_FAILURE and "renderer exploded" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "cone.toml"]
+    assert (tmp_path / "a.json").read_text() == "{}\n"
+
+
+def test_export_success_replaces_existing_and_creates_folders(cone: Path, tmp_path: Path, capsys) -> None:
+    (tmp_path / "a.json").write_text("{}\n")
+    files = [str(tmp_path / "a.json"), str(tmp_path / "d" / "e" / "a.dxf"), str(tmp_path / "d" / "a.step")]
+    rc, res, err = run_json(["export", str(cone), *files], capsys)
+    assert rc == EXIT_OK, err
+    assert json.loads((tmp_path / "a.json").read_text())["surface"]["area_3d"] > 0
+    assert (tmp_path / "d" / "e" / "a.dxf").stat().st_size > 1000
+    assert (tmp_path / "d" / "a.step").read_text().startswith("ISO-10303-21")
+    leftovers = [p for p in tmp_path.rglob("*") if "ght-cad" in p.name]
+    assert not leftovers
