@@ -19,8 +19,11 @@ Exit codes (stable, scripts may rely on them):
        range (one line on stderr naming the file, the key and the allowed values)
     130 interrupted (Ctrl-C)
 
-With ``--json`` the result (or ``{"ok": false, "error": ..., "exit_code": ...}``) is printed to
-stdout as one JSON object; human-readable text goes to stdout otherwise. A progress bar is drawn
+With ``--json`` the result (or ``{"ok": false, "error": ..., "exit_code": ...}``, also for usage
+errors found by the argument parser) is printed to stdout as one JSON object and nothing else:
+while the command runs, file descriptor 1 is redirected to stderr so that console output of the
+CAD kernel (OCCT prints parse errors from C++) cannot corrupt it. Human-readable text goes to
+stdout otherwise. A progress bar is drawn
 on stderr only when stderr is a terminal. Heavy modules (numpy, scipy, matplotlib, OCP) are
 imported inside the commands so that ``ght-cad --help`` is fast.
 """
@@ -51,10 +54,25 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line on stderr and exit code 2."""
+    """ArgumentParser whose errors are one line on stderr and exit code 2.
+
+    When the command line being parsed contains ``--json`` (set by :func:`main`), the error is
+    also printed to stdout as one JSON object ``{"ok": false, "error": ..., "exit_code": 2}``.
+    """
+
+    json_errors = False
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+        msg = " ".join(f"{message} (see '{self.prog} --help')".split())
+        if _Parser.json_errors:
+            sys.stdout.write(dumps({"ok": False, "error": f"{self.prog}: {msg}", "exit_code": EXIT_USAGE}) + "\n")
+            sys.stdout.flush()
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {msg}\n")
+
+
+def _wants_json(argv: Sequence[str]) -> bool:
+    """True if ``argv`` asks for ``--json`` (argparse also accepts the prefixes ``--j``, ``--js``, ...)."""
+    return any(a.startswith("--j") and "--json".startswith(a) for a in argv)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -111,15 +129,44 @@ def _parse_points(text: str, what: str = "--points") -> list[list[float]]:
             raise UsageError(f"{what} is not valid JSON: {exc}") from None
         if not isinstance(pts, list) or not all(isinstance(p, list) for p in pts):
             raise UsageError(f"{what} must be a JSON list of coordinate lists, e.g. [[0,0],[1,2],[3,0]]")
-        return pts
-    groups = [g for g in s.replace(";", " ").split() if g]
-    pts = []
-    for g in groups:
-        try:
-            pts.append([float(x) for x in g.split(",")])
-        except ValueError:
-            raise UsageError(f"{what}: {g!r} is not a point; write points as 'x,y[,z]' separated by spaces") from None
+    else:
+        groups = [g for g in s.replace(";", " ").split() if g]
+        pts = []
+        for g in groups:
+            try:
+                pts.append([float(x) for x in g.split(",")])
+            except ValueError:
+                raise UsageError(f"{what}: {g!r} is not a point; write points as 'x,y[,z]' separated by spaces") from None
+    _check_same_dimension(pts, what)
     return pts
+
+
+def _check_same_dimension(pts: list[list[float]], what: str) -> None:
+    """Raise :class:`UsageError` naming the first point whose dimension differs from point 1's."""
+    if not pts:
+        return
+    dim = len(pts[0])
+    for i, pt in enumerate(pts[1:], start=2):
+        if len(pt) != dim:
+            raise UsageError(
+                f"{what}: point {i} ({_fmt_point(pt)}) has dimension {len(pt)} but point 1 "
+                f"({_fmt_point(pts[0])}) has dimension {dim}; all points need the same dimension"
+            )
+
+
+def _fmt_point(pt: list[Any]) -> str:
+    return ",".join(f"{x:g}" if isinstance(x, (int, float)) else repr(x) for x in pt)
+
+
+def _check_suffix(option: str, value: str | os.PathLike | None, allowed: Sequence[str]) -> None:
+    """Raise :class:`UsageError` unless ``value`` (if given) ends in one of ``allowed`` (case-insensitive)."""
+    if value is None:
+        return
+    suf = Path(value).suffix
+    if suf.lower() not in allowed:
+        raise UsageError(
+            f"{option} {str(value)!r}: unknown suffix {suf!r}; allowed: {', '.join(allowed)}"
+        )
 
 
 def _progress(total: int | None, label: str) -> Any:
@@ -130,7 +177,7 @@ def _progress(total: int | None, label: str) -> Any:
 
 def _emit(args: argparse.Namespace, result: dict[str, Any], text: Callable[[dict[str, Any]], str]) -> None:
     if getattr(args, "json", False):
-        print(dumps({"ok": True, **result}))
+        args._json_out = dumps({"ok": True, **result})  # printed by main() once stdout is restored
     else:
         print(text(result))
 
@@ -149,6 +196,7 @@ def cmd_plot_basis(args: argparse.Namespace) -> int:
     """``ght-cad plot-basis``: PNG of ``b_{i,m}(t; μ,ν,γ)`` (or a derivative), one panel per triple."""
     from .plotting import SIZES, plot_basis
 
+    _check_suffix("--out", args.out, _PNG)
     params = []
     for p in args.params or ["0,0,-1", "0,0,0", "0,0,1", "-0.8,0.8,0"]:
         vals = _parse_floats(p, "--params")
@@ -176,6 +224,9 @@ def cmd_curve(args: argparse.Namespace) -> int:
 
     if args.points is None:
         raise UsageError("--points is required, e.g. --points '0,0 1,2 3,2 4,0'")
+    _check_suffix("--step", args.step, _STEP)
+    _check_suffix("--plot", args.plot, _PNG)
+    _check_suffix("--curvature-plot", args.curvature_plot, _PNG)
     curve = GHTCurve(_parse_points(args.points), args.mu, args.nu, args.gamma)
     t = np.linspace(0.0, 1.0, 513)
     kappa = curve.curvature(t)
@@ -278,6 +329,8 @@ def cmd_surface(args: argparse.Namespace) -> int:
     """``ght-cad surface``: developability degree (θ_max, θ_rms, DD, R) of a design's surface."""
     from .design import build_surface, surface_summary, surface_view
 
+    _check_suffix("--step", args.step, _STEP)
+    _check_suffix("--plot", args.plot, _PNG)
     design = _load(args)
     built = build_surface(design)
     result = {"command": "surface", "name": design.name, **surface_summary(built), "outputs": {}}
@@ -304,6 +357,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     """``ght-cad optimize``: :func:`ght_cad.design.optimize_design` with command-line overrides."""
     from .design import optimize_design
 
+    _check_suffix("--plot", args.plot, _PNG)
     design = _load(args)
     overrides = {k: getattr(args, k) for k in ("method", "objective", "iterations", "population", "seed")}
     result_opt = optimize_design(design, overrides={k: v for k, v in overrides.items() if v is not None},
@@ -330,6 +384,9 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 
 def cmd_unroll(args: argparse.Namespace) -> int:
     """``ght-cad unroll``: flat pattern of a design's surface, or of the faces of a STEP file."""
+    _check_suffix("--dxf", args.dxf, (".dxf",))
+    _check_suffix("--svg", args.svg, (".svg",))
+    _check_suffix("--png", args.png, _PNG)
     if Path(args.design).suffix.lower() in (".step", ".stp"):
         return _unroll_step(args)
     for opt, val in (("--face", args.face), ("--best-effort", args.best_effort or None), ("--units", args.units),
@@ -418,6 +475,8 @@ def _errors_dict(pattern: Any) -> dict[str, Any]:
 
 
 _EXPORT_SUFFIXES = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
+_STEP = (".step", ".stp")
+_PNG = (".png",)
 
 
 def cmd_export(args: argparse.Namespace) -> int:
@@ -441,7 +500,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------------------------------------
 _EPILOG = (
     "exit codes: 0 success, 1 internal failure, 2 bad input or usage (one line on stderr), "
-    "130 interrupted. Design files: see docs/design-files.md."
+    "130 interrupted. With --json, stdout is exactly one JSON object, errors included "
+    '({"ok": false, "exit_code": N, "error": ...}). Design files: see docs/design-files.md.'
 )
 
 
@@ -613,17 +673,78 @@ def _fail(args: argparse.Namespace | None, code: int, message: str) -> int:
     msg = " ".join(str(message).split())  # one line
     sys.stderr.write(f"{PROG}: error: {msg}\n")
     if args is not None and getattr(args, "json", False):
-        print(dumps({"ok": False, "error": msg, "exit_code": code}))
+        args._json_out = dumps({"ok": False, "error": msg, "exit_code": code})
     return code
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``ght-cad``; returns the exit code (0 ok, 1 failure, 2 bad input, 130 Ctrl-C)."""
+    """Entry point of ``ght-cad``; returns the exit code (0 ok, 1 failure, 2 bad input, 130 Ctrl-C).
+
+    With ``--json``, file descriptor 1 points to stderr while the command runs (C++ console
+    output of the CAD kernel goes there) and the one JSON object is printed to the restored
+    stdout at the end, for success and failure alike.
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
-    args = parser.parse_args(argv)
+    _Parser.json_errors = _wants_json(argv)
+    try:
+        args = parser.parse_args(argv)
+    finally:
+        _Parser.json_errors = False
     if not getattr(args, "command", None):
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    if not getattr(args, "json", False):
+        return _dispatch(args)
+    saved = _redirect_stdout_to_stderr()
+    try:
+        code = _dispatch(args)
+    finally:
+        _restore_stdout(saved)
+    out = getattr(args, "_json_out", None)
+    if out is None:  # a command that returned without a result: still one JSON object
+        out = dumps({"ok": code == EXIT_OK, "exit_code": code})
+    sys.stdout.write(out + "\n")
+    sys.stdout.flush()
+    return code
+
+
+def _redirect_stdout_to_stderr() -> int | None:
+    """Point fd 1 at fd 2; returns a duplicate of the old fd 1 (None if fd 1 or 2 is unusable)."""
+    for stream in (sys.stdout, sys.__stdout__):  # what was printed before goes to the real stdout
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):  # pragma: no cover - closed stdout
+            pass
+    try:
+        saved = os.dup(1)
+    except OSError:  # pragma: no cover - fd 1 closed
+        return None
+    try:
+        os.dup2(2, 1)
+    except OSError:  # pragma: no cover - fd 2 closed
+        os.close(saved)
+        return None
+    return saved
+
+
+def _restore_stdout(saved: int | None) -> None:
+    """Undo :func:`_redirect_stdout_to_stderr` (flushing what Python buffered for the redirected fd 1)."""
+    if saved is None:
+        return
+    for stream in (sys.stdout, sys.__stdout__):
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):  # pragma: no cover
+            pass
+    os.dup2(saved, 1)
+    os.close(saved)
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    """Run ``args.func`` and map exceptions to exit codes (one line on stderr each)."""
     try:
         from .errors import GHTError
     except Exception:  # pragma: no cover

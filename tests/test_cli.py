@@ -188,7 +188,84 @@ def test_composite_design_single_step_commands(tmp_path: Path, capsys) -> None:
     assert rc == EXIT_OK and out["face_count"] == 2 and out["panels"] == 2, err
 
 
-# --- export is all-or-nothing ---
+# --- audit fixes: JSON on argparse errors, output suffixes, ragged points, all-or-nothing export ---
+
+
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["optimize", "X.toml", "--method", "foo", "--json"], "invalid choice: 'foo'"),
+        (["plot-basis", "--degree", "x", "--json"], "invalid int value: 'x'"),
+        (["plot-basis", "--json"], "--out"),  # a required option is missing
+        (["--json", "curve"], "unrecognized arguments: --json"),  # --json before the command
+    ],
+)
+def test_parser_errors_give_one_json_object_with_json(argv: list[str], needle: str, capsys) -> None:
+    with pytest.raises(SystemExit) as ei:
+        main(argv)
+    cap = capsys.readouterr()
+    assert ei.value.code == EXIT_USAGE
+    res = json.loads(cap.out)  # exactly one JSON object, nothing else on stdout
+    assert res["ok"] is False and res["exit_code"] == 2 and needle in res["error"]
+    assert len(cap.err.strip().splitlines()) == 1 and needle in cap.err
+
+
+def test_parser_errors_without_json_keep_stdout_empty(capsys) -> None:
+    with pytest.raises(SystemExit) as ei:
+        main(["plot-basis", "--degree", "x"])
+    cap = capsys.readouterr()
+    assert ei.value.code == EXIT_USAGE and cap.out == "" and "invalid int value" in cap.err
+
+
+def test_help_documents_exit_codes_and_json_errors(capsys) -> None:
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "0 success, 1 internal failure, 2 bad input or usage" in out and "130 interrupted" in out
+    assert "With --json, stdout is exactly one JSON object, errors included" in out
+
+
+@pytest.mark.parametrize(
+    "argv,option,allowed",
+    [
+        (["unroll", "{cone}", "--dxf", "p.txt"], "--dxf", ".dxf"),
+        (["unroll", "{cone}", "--svg", "p.dxf"], "--svg", ".svg"),
+        (["unroll", "{cone}", "--png", "p.svg"], "--png", ".png"),
+        (["plot-basis", "--out", "b.txt"], "--out", ".png"),
+        (["curve", "--points", "0,0 1,1 2,0", "--step", "c.txt"], "--step", ".step, .stp"),
+        (["curve", "--points", "0,0 1,1 2,0", "--plot", "c.pdf"], "--plot", ".png"),
+        (["curve", "--points", "0,0 1,1 2,0", "--curvature-plot", "k"], "--curvature-plot", ".png"),
+        (["surface", "{cone}", "--step", "s.igs"], "--step", ".step, .stp"),
+        (["surface", "{cone}", "--plot", "s.txt"], "--plot", ".png"),
+        (["optimize", "{cone}", "--plot", "o.txt"], "--plot", ".png"),
+    ],
+)
+def test_output_suffixes_are_checked(argv: list[str], option: str, allowed: str, cone: Path, tmp_path: Path,
+                                     capsys, monkeypatch) -> None:
+    """A wrong output suffix is one line naming the option, the value and the allowed suffixes; nothing written."""
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    argv = [a.replace("{cone}", str(cone)) for a in argv]
+    value = argv[argv.index(option) + 1]
+    rc, res, err = run_json(argv, capsys)
+    assert rc == EXIT_USAGE and res["exit_code"] == 2 and len(err.strip().splitlines()) == 1
+    assert f"{option} {value!r}" in err and f"allowed: {allowed}" in err
+    assert not list(work.iterdir())
+
+
+@pytest.mark.parametrize(
+    "points,needle",
+    [
+        ("1,0 1,1,3 0,1", "point 2 (1,1,3) has dimension 3 but point 1 (1,0) has dimension 2"),
+        ("0,0,0 1,1,1 2,0", "point 3 (2,0) has dimension 2 but point 1 (0,0,0) has dimension 3"),
+        ("[[1, 0], [1, 1], [0, 1, 5]]", "point 3 (0,1,5) has dimension 3 but point 1 (1,0) has dimension 2"),
+    ],
+)
+def test_ragged_points_name_the_point(points: str, needle: str, capsys) -> None:
+    rc, res, err = run_json(["curve", "--points", points], capsys)
+    assert rc == EXIT_USAGE and needle in err and "all points need the same dimension" in err
+    assert "inhomogeneous" not in err and len(err.strip().splitlines()) == 1
 
 
 def _snapshot(folder: Path) -> dict[str, bytes]:
