@@ -1883,7 +1883,7 @@ def unroll_step(
                    if dev else " ".join(str(exc).split()))
             if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
                 how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
-                       "relative to their chords (allowed 1e-9), so it has no rulings to unroll along")
+                       "relative to their lengths (allowed 1e-9), so it has no rulings to unroll along")
             raise NotDevelopableError(
                 f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; "
                 "allowed: developable faces, or --best-effort to flatten it with a distortion report"
