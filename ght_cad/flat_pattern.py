@@ -372,7 +372,10 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
         panel.bend_lines = clip_segments(panel.bend_lines, loops)
     lo, hi = panel.bbox()
     c = _centroid(loops[0])
-    panel.texts.append((float(c[0]), float(c[1]), panel.label, float(0.06 * max(hi - lo))))
+    ext = hi - lo
+    # horizontal text is about 0.7 h wide per character: keep it within a third of the panel's width
+    h = min(0.05 * float(max(ext)), 0.35 * float(ext[0]) / (0.7 * max(len(panel.label), 1)), 0.2 * float(ext[1]))
+    panel.texts.append((float(c[0]), float(c[1]), panel.label, float(h)))
     return panel.report
 
 
