@@ -414,19 +414,30 @@ def cmd_unroll(args: argparse.Namespace) -> int:
 
 
 def _write_pattern(args: argparse.Namespace, pattern: Any, title: str) -> dict[str, str]:
-    """Write ``--dxf``/``--svg``/``--png`` (each atomically); returns ``{kind: path}``."""
-    out: dict[str, str] = {}
-    if args.dxf:
-        pattern.export_dxf(args.dxf)
-        out["dxf"] = str(args.dxf)
-    if args.svg:
-        pattern.export_svg(args.svg)
-        out["svg"] = str(args.svg)
-    if args.png:
-        from .design import plot_pattern
+    """Write ``--dxf``/``--svg``/``--png`` all or nothing; returns ``{kind: path}``.
 
-        out["png"] = str(plot_pattern(pattern, args.png, title=title))
-    return out
+    The files are staged beside their targets and moved into place only when every one was
+    written, so a failure leaves neither a partial file nor a partial set.
+    """
+    from .design import _FileStage, plot_pattern
+
+    wanted = [(kind, Path(p)) for kind, p in (("dxf", args.dxf), ("svg", args.svg), ("png", args.png)) if p]
+    if not wanted:
+        return {}
+    stage = _FileStage([t for _, t in wanted])
+    try:
+        for kind, target in wanted:
+            tmp = stage.path(target)
+            if kind == "dxf":
+                pattern.export_dxf(tmp)
+            elif kind == "svg":
+                pattern.export_svg(tmp)
+            else:
+                plot_pattern(pattern, tmp, title=title)
+        stage.commit()
+    finally:
+        stage.cleanup()
+    return {kind: str(target) for kind, target in wanted}
 
 
 def _unroll_step(args: argparse.Namespace) -> int:

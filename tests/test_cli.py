@@ -313,3 +313,27 @@ def test_export_success_replaces_existing_and_creates_folders(cone: Path, tmp_pa
     assert (tmp_path / "d" / "a.step").read_text().startswith("ISO-10303-21")
     leftovers = [p for p in tmp_path.rglob("*") if "ght-cad" in p.name]
     assert not leftovers
+
+
+def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
+    """A failing PNG after the DXF and SVG were written: none of the three targets appears."""
+    from pathlib import Path
+
+    import ght_cad.design as design_mod
+    from ght_cad.cli import main
+
+    duct = Path(__file__).resolve().parents[1] / "examples" / "design_duct.toml"
+    dxf, svg, png = tmp_path / "p.dxf", tmp_path / "p.svg", tmp_path / "p.png"
+    svg.write_text("old")
+
+    def broken(*a, **k):
+        raise RuntimeError("plot failed")
+
+    monkeypatch.setattr(design_mod, "plot_pattern", broken)
+    rc = main(["unroll", str(duct), "--dxf", str(dxf), "--svg", str(svg), "--png", str(png)])
+    assert rc == 1
+    assert not dxf.exists() and not png.exists() and svg.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.svg"]
+    monkeypatch.undo()
+    assert main(["unroll", str(duct), "--dxf", str(dxf), "--svg", str(svg), "--png", str(png)]) == 0
+    assert dxf.stat().st_size > 0 and svg.read_text() != "old" and png.stat().st_size > 0
