@@ -146,6 +146,29 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  {name:30s} DE-default nfev to target {med:.0f} ({reached}/{len(seeds)}): "
               + ", ".join(rcell(m) for m in ("igwo", "pso", "gwo")))
 
+    print("\n## PSO and I-GWO with their schedules tied to the budget: the smallest max_iter (pop 30) whose")
+    print("## median final value reaches the same target (rtol 1e-3), in evaluations, against DE's median")
+    for name, (fun, bounds) in problems.items():
+        if name.startswith(("rastrigin", "rosenbrock")):
+            continue
+        rs = [r for r in rows if r.problem == name]
+        target = set_target(rs, 1e-3)
+        de_n = {r.method: r for r in rs}["de"].nfev_to_target
+        cells = []
+        for m in ("pso", "igwo"):
+            found = None
+            for it in (10, 15, 20, 30, 40, 50, 75, 100, 150, 200):
+                runs = [METHODS[m](fun, bounds, pop_size=args.pop, max_iter=it, seed=s) for s in seeds]
+                if np.median([r.fun for r in runs]) <= target:
+                    found = (it, float(np.median([r.nfev for r in runs])))
+                    break
+            if found is None:
+                cells.append(f"{m} never (max_iter <= 200)")
+            else:
+                ratio = f", ratio {found[1] / de_n:.2f}" if np.isfinite(de_n) else ""
+                cells.append(f"{m} max_iter {found[0]}: {found[1]:.0f} evaluations{ratio}")
+        print(f"  {name:30s} DE {de_n:.0f}: " + "; ".join(cells))
+
     print("\n## problem 1 (strip) before/after, best I-GWO run; problem 2 surfaces stay developable")
     best = min((r for r in rows if r.problem.startswith("strip") and r.method == "igwo"), key=lambda r: r.best)
     run = min(best.runs, key=lambda r: r.fun)
