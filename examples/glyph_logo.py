@@ -78,17 +78,6 @@ def _green_area(cc: CompositeCurve) -> float:
     return abs(total)
 
 
-def _volume(shape: Any) -> float:
-    """Volume by OCCT's default Gauss integration (its adaptive ``Eps`` variant scatters by
-    ~1e-5 relative on these solids while reporting 1e-11)."""
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape.wrapped, props)
-    return float(props.Mass())
-
-
 def main(out_dir: str | Path) -> dict[str, Any]:
     """Build the glyph solid and export ``glyph_logo.step`` into ``out_dir``.
 
@@ -104,6 +93,7 @@ def main(out_dir: str | Path) -> dict[str, Any]:
 
     from ght_cad.cad.curves import GHTCompositeLine, exact_edges
     from ght_cad.cad.occ import is_valid, write_step
+    from ght_cad.cad.occ import volume as solid_volume
 
     outer, inner = glyph_outlines()
     with exact_edges():
@@ -126,7 +116,7 @@ def main(out_dir: str | Path) -> dict[str, Any]:
     # moving a boundary of length L by at most δ changes the area by at most L δ + π δ² (Steiner)
     segs = outer.segments + inner.segments
     bound = HEIGHT * sum(s.length * d + np.pi * d * d for s, d in zip(segs, devs))
-    volume = _volume(solid)
+    volume = solid_volume(solid)
     return {
         "step": step,
         "volume": volume,

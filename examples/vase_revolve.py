@@ -68,17 +68,6 @@ def _pappus_volume(outer: CompositeCurve, inner: CompositeCurve) -> float:
     return float(np.pi * abs(integral(outer) - integral(inner)))
 
 
-def _volume(shape: Any) -> float:
-    """Volume by OCCT's default Gauss integration (its adaptive ``Eps`` variant scatters by
-    ~1e-5 relative on these solids while reporting 1e-11)."""
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape.wrapped, props)
-    return float(props.Mass())
-
-
 def main(out_dir: str | Path) -> dict[str, Any]:
     """Revolve the profile and export ``vase_revolve.step`` into ``out_dir``.
 
@@ -92,6 +81,7 @@ def main(out_dir: str | Path) -> dict[str, Any]:
 
     from ght_cad.cad.curves import exact_edges, ght_wire
     from ght_cad.cad.occ import is_valid, write_step
+    from ght_cad.cad.occ import volume as solid_volume
 
     outer = profile()
     shift = np.array([-WALL, 0.0, 0.0])
@@ -118,7 +108,7 @@ def main(out_dir: str | Path) -> dict[str, Any]:
         2 * np.pi * (float(np.abs(s.control_points[:, 0]).max()) + d) * (s.length * d + np.pi * d * d)
         for s, d in zip(segs, devs)
     )
-    volume = _volume(solid)
+    volume = solid_volume(solid)
     return {
         "step": step,
         "volume": volume,

@@ -23,7 +23,7 @@ from OCP.TopoDS import TopoDS  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.curves import GHTBezierLine, GHTCompositeLine, exact_edges, export_step, ght_edge, ght_face, ght_shape, ght_wire  # noqa: E402
-from ght_cad.cad.occ import read_step, write_step  # noqa: E402
+from ght_cad.cad.occ import read_step, volume, write_step  # noqa: E402
 from ght_cad.composite import CompositeCurve  # noqa: E402
 from ght_cad.curve import gauss_legendre  # noqa: E402
 from ght_cad.errors import GHTError  # noqa: E402
@@ -40,14 +40,6 @@ def _length(shape) -> float:
 def _area(shape) -> float:
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(getattr(shape, "wrapped", shape), props, 1e-11)
-    return props.Mass()
-
-
-def _volume(shape) -> float:
-    """OCCT's default volume integration (its adaptive ``Eps`` variant is erratic on these
-    solids: we saw ±1e-5 relative scatter while it reported 1e-11)."""
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(getattr(shape, "wrapped", shape), props)
     return props.Mass()
 
 
@@ -184,13 +176,13 @@ def test_closed_g2_glyph_in_builders_has_exact_area(tmp_path):
     # bound from the certified deviations δ_i of the edges (lengths L_i): |ΔA| <= Σ L_i δ_i + π δ_i²
     devs = [d.max_deviation for d in ght_wire(cc).ght_bspline]
     bound = height * sum(s.length * d + np.pi * d * d for s, d in zip(cc.segments, devs))
-    assert abs(_volume(solid) - exact * height) <= bound <= 1e-5 * exact * height
+    assert abs(volume(solid) - exact * height) <= bound <= 1e-5 * exact * height
     path = tmp_path / "glyph.step"
     write_step(solid, path)
     back = read_step(path)
     ex = TopExp_Explorer(back, TopAbs_SOLID)
     assert ex.More() and _valid(back)
-    assert _volume(back) == pytest.approx(_volume(solid), rel=1e-9)
+    assert volume(back) == pytest.approx(volume(solid), rel=1e-9)
 
 
 def test_bezier_line_builder_and_algebra_mode_agree():
@@ -224,9 +216,9 @@ def test_revolved_profile_volume_matches_pappus(tmp_path):
     p, d = prof.evaluate(t), prof.derivative(t, 1)
     exact = abs(np.pi * float(np.sum(w * p[:, 0] ** 2 * d[:, 1])))
     assert _valid(solid)
-    assert _volume(solid) == pytest.approx(exact, rel=1e-6)
+    assert volume(solid) == pytest.approx(exact, rel=1e-6)
     write_step(solid, tmp_path / "rev.step")
-    assert _volume(read_step(tmp_path / "rev.step")) == pytest.approx(_volume(solid), rel=1e-9)
+    assert volume(read_step(tmp_path / "rev.step")) == pytest.approx(volume(solid), rel=1e-9)
 
 
 def test_face_from_patch_area_and_step(tmp_path):

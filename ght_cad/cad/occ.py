@@ -32,6 +32,7 @@ __all__ = [
     "make_edge",
     "make_face",
     "is_valid",
+    "volume",
     "write_step",
     "read_step",
     "unwrap",
@@ -128,6 +129,20 @@ def make_face(data: BSplineSurfaceData, tolerance: float = 1e-7) -> Any:
     if not builder.IsDone():
         raise GHTError("OCCT could not build a face on the B-spline surface")
     return Face(builder.Face())
+
+
+def volume(shape: Any) -> float:
+    """Volume of a solid (build123d, cadquery or OCP) by OCCT's default Gauss integration.
+
+    The adaptive ``BRepGProp.VolumeProperties_s(shape, props, Eps)`` variant scattered by about 1e-5
+    relative on GHT solids while reporting 1e-11, so it is not used.
+    """
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(unwrap(shape), props)
+    return float(props.Mass())
 
 
 def is_valid(shape: Any) -> bool:
