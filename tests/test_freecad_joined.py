@@ -13,13 +13,12 @@ import json
 import os
 import re
 import shutil
-import signal
-import subprocess
 from pathlib import Path
 
 import pytest
 
 from conftest import freecadcmd_or_skip
+from freecad_launch import freecad_env, run_process, summary
 
 REPO = Path(__file__).resolve().parents[1]
 WB = REPO / "freecad_workbench"
@@ -27,51 +26,19 @@ WB = REPO / "freecad_workbench"
 pytestmark = pytest.mark.freecad
 
 
-def _env(tmp_path: Path) -> dict[str, str]:
-    env = dict(os.environ)
-    home = tmp_path / "home"
-    home.mkdir(exist_ok=True)
-    env["HOME"] = str(home)  # FreeCAD's user config goes here, not into the real home
-    env["GHT_FC_OUT"] = str(tmp_path)
-    env.pop("PYTHONHOME", None)
-    env.pop("VIRTUAL_ENV", None)
-    import ght_cad  # the very core this pytest process imports
-
-    core = Path(ght_cad.__file__).resolve().parents[1]
-    env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys([str(WB), str(core), str(REPO)]))
-    return env
-
-
-def _run(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
-    """Run in a new session; on timeout kill the whole process group and fail."""
-    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        out, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, err = proc.communicate()
-        pytest.fail(f"{cmd[0]} timed out after {timeout} s:\n{(out + err)[-4000:]}")
-    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
-
-
-def _summary(proc: subprocess.CompletedProcess) -> str:
-    lines = [l for l in (proc.stdout + proc.stderr).splitlines() if l.strip() and not l.startswith("  #")]
-    return "\n".join(lines[-80:])
-
-
 def test_joined_developable_inside_freecadcmd(tmp_path: Path) -> None:
     exe = freecadcmd_or_skip()
-    proc = _run([exe, "-t", "freecad.ght_workbench.tests.fc_joined"], _env(tmp_path), tmp_path, 120)
+    proc = run_process([exe, "-t", "freecad.ght_workbench.tests.fc_joined"], freecad_env(tmp_path), tmp_path, 120)
     out = proc.stdout + proc.stderr
-    assert proc.returncode == 0, _summary(proc)
+    assert proc.returncode == 0, summary(proc)
     ran = re.search(r"Ran (\d+) tests?", out)
-    assert ran and int(ran.group(1)) >= 9, _summary(proc)
-    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), _summary(proc)
-    assert "skipped=" not in out, _summary(proc)
+    assert ran and int(ran.group(1)) >= 9, summary(proc)
+    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
+    assert "skipped=" not in out, summary(proc)
     # every requested order was measured, on both geometries
     for cont, r in (("G1", 1), ("G2", 2), ("G3", 3)):
-        assert re.search(rf"^.*\b{cont}: JointOrder={r} ", out, re.M), _summary(proc)
-        assert f"cone {cont}: JointOrder={r} " in out, _summary(proc)
+        assert re.search(rf"^.*\b{cont}: JointOrder={r} ", out, re.M), summary(proc)
+        assert f"cone {cont}: JointOrder={r} " in out, summary(proc)
     angles = [float(a) for a in re.findall(r"normal angle=([\deE.+-]+) deg", out)]
     assert len(angles) == 6 and max(angles) < 1e-6, angles
     assert (tmp_path / "joined.step").stat().st_size > 0
@@ -98,7 +65,7 @@ def test_joined_command_in_gui_under_xvfb(tmp_path: Path) -> None:
         if os.environ.get("CI") == "true":
             pytest.fail("the FreeCAD GUI (freecad-python3) or xvfb-run (xvfb, xauth) is missing but CI=true")
         pytest.skip("FreeCAD GUI or xvfb-run not installed")
-    env = _env(tmp_path)
+    env = freecad_env(tmp_path)
     env.pop("PYTHONPATH", None)  # installed as a user would: the addon linked into the user's Mod folder
     mod = Path(env["HOME"]) / ".local" / "share" / "FreeCAD" / "Mod"
     mod.mkdir(parents=True)
@@ -107,9 +74,9 @@ def test_joined_command_in_gui_under_xvfb(tmp_path: Path) -> None:
     env["QT_QPA_PLATFORM"] = "xcb"
     env["GHT_JOINED_GUI"] = "1"
     script = WB / "freecad" / "ght_workbench" / "tests" / "fc_joined.py"
-    proc = _run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(script)], env, tmp_path, 180)
+    proc = run_process(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(script)], env, tmp_path, 180)
     result = tmp_path / "joined_gui.json"
-    assert result.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{_summary(proc)}"
+    assert result.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{summary(proc)}"
     res = json.loads(result.read_text())
     assert "error" not in res, res["error"]
     assert res["registered"] and res["pixmap"], res

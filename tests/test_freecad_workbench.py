@@ -17,7 +17,6 @@ import json
 import os
 import re
 import shutil
-import signal
 import subprocess
 from pathlib import Path
 
@@ -25,6 +24,7 @@ import numpy as np
 import pytest
 
 from conftest import freecadcmd_or_skip
+from freecad_launch import freecad_env, run_process, summary
 
 REPO = Path(__file__).resolve().parents[1]
 WB = REPO / "freecad_workbench"
@@ -33,61 +33,25 @@ WB_TESTS = WB / "freecad" / "ght_workbench" / "tests"
 pytestmark = pytest.mark.freecad
 
 
-def _env(tmp_path: Path, pythonpath: bool = True) -> dict[str, str]:
-    env = dict(os.environ)
-    home = tmp_path / "home"
-    home.mkdir(exist_ok=True)
-    env["HOME"] = str(home)  # FreeCAD's user config goes here, not into the real home
-    env["GHT_FC_OUT"] = str(tmp_path)
-    env.pop("PYTHONHOME", None)
-    env.pop("VIRTUAL_ENV", None)
-    if pythonpath:
-        # the very ght_cad this pytest process imports, so both sides run the same core code
-        import ght_cad
-
-        core = Path(ght_cad.__file__).resolve().parents[1]
-        env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys([str(WB), str(core), str(REPO)]))
-    else:
-        env.pop("PYTHONPATH", None)
-    return env
-
-
-def _run(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
-    """Run in a new session; on timeout kill the whole process group (FreeCAD, Xvfb) and fail."""
-    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        out, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, err = proc.communicate()
-        pytest.fail(f"{cmd[0]} timed out after {timeout} s:\n{(out + err)[-4000:]}")
-    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
-
-
 def _run_unittest(module: str, tmp_path: Path, timeout: float = 240) -> subprocess.CompletedProcess:
     exe = freecadcmd_or_skip()
-    return _run([exe, "-t", module], _env(tmp_path), tmp_path, timeout)
-
-
-def _summary(proc: subprocess.CompletedProcess) -> str:
-    lines = [l for l in (proc.stdout + proc.stderr).splitlines() if l.strip() and not l.startswith("  #")]
-    return "\n".join(lines[-80:])
+    return run_process([exe, "-t", module], freecad_env(tmp_path), tmp_path, timeout)
 
 
 def test_features_inside_freecadcmd(tmp_path: Path) -> None:
     proc = _run_unittest("freecad.ght_workbench.tests.fc_features", tmp_path)
     out = proc.stdout + proc.stderr
-    assert proc.returncode == 0, _summary(proc)
-    assert "Ran " in out and "\nOK" in out, _summary(proc)
+    assert proc.returncode == 0, summary(proc)
+    assert "Ran " in out and "\nOK" in out, summary(proc)
     # every test class of the module ran (a silently skipped feature would hide here)
     for name in (
         "GHTCurveTest", "CompositeCurveTest", "DevelopableTest", "SpineDevelopableTest", "FlatPatternTest", "OptimizationTest"
     ):
-        assert name in out, f"{name} did not run:\n{_summary(proc)}"
+        assert name in out, f"{name} did not run:\n{summary(proc)}"
     ran = re.search(r"Ran (\d+) tests?", out)
-    assert ran and int(ran.group(1)) >= 16, _summary(proc)
-    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), _summary(proc)
-    assert "skipped=" not in out, _summary(proc)
+    assert ran and int(ran.group(1)) >= 16, summary(proc)
+    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
+    assert "skipped=" not in out, summary(proc)
     for f in ("curve.step", "composite.step", "developable.step", "flat.step", "flat.dxf", "flat.svg"):
         assert (tmp_path / f).stat().st_size > 0, f
     # the files FreeCAD wrote are read by the project's other tools: ezdxf (DXF) and OCP 7.9 (STEP)
@@ -121,7 +85,7 @@ def _load_core_numbers():
 
 def test_core_numbers_equal_inside_freecad(tmp_path: Path) -> None:
     proc = _run_unittest("freecad.ght_workbench.tests.fc_core_numbers", tmp_path, timeout=180)
-    assert proc.returncode == 0, _summary(proc)
+    assert proc.returncode == 0, summary(proc)
     got = json.loads((tmp_path / "core_numbers.json").read_text())
     mod = _load_core_numbers()
     ours = mod.compute()
@@ -157,16 +121,16 @@ def _gui_exe() -> str:
 
 def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     exe = _gui_exe()
-    env = _env(tmp_path, pythonpath=False)
+    env = freecad_env(tmp_path, pythonpath=False)
     # install as a user would: link the addon into the user's Mod folder (Debian: XDG data dir)
     mod = Path(env["HOME"]) / ".local" / "share" / "FreeCAD" / "Mod"
     mod.mkdir(parents=True)
     (mod / "ght_workbench").symlink_to(WB, target_is_directory=True)
     env["QTWEBENGINE_DISABLE_SANDBOX"] = "1"  # Qt WebEngine refuses to start as root otherwise
     env["QT_QPA_PLATFORM"] = "xcb"
-    proc = _run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(WB_TESTS / "gui_check.py")], env, tmp_path, 240)
+    proc = run_process(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(WB_TESTS / "gui_check.py")], env, tmp_path, 240)
     result_file = tmp_path / "gui_result.json"
-    assert result_file.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{_summary(proc)}"
+    assert result_file.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{summary(proc)}"
     res = json.loads(result_file.read_text())
     shot = tmp_path / "ght_workbench.png"
     if os.environ.get("ARTIFACTS_DIR") and shot.exists():
@@ -215,15 +179,15 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
 
 def test_example_macro_in_freecadcmd(tmp_path: Path) -> None:
     exe = freecadcmd_or_skip()
-    env = _env(tmp_path, pythonpath=False)  # the macro finds the workbench next to itself
+    env = freecad_env(tmp_path, pythonpath=False)  # the macro finds the workbench next to itself
     env["GHT_MACRO_OUT"] = str(tmp_path / "out")
-    proc = _run([exe, str(REPO / "examples" / "freecad_macro.FCMacro")], env, tmp_path, 180)
+    proc = run_process([exe, str(REPO / "examples" / "freecad_macro.FCMacro")], env, tmp_path, 180)
     out = proc.stdout + proc.stderr
     m = re.search(r"quarter cylinder pattern ([\d.]+) x ([\d.]+)", out)
-    assert m, _summary(proc)
+    assert m, summary(proc)
     # r = 40, H = 60: the pattern is the exact r·π/2 × H rectangle (printed to 1e-9)
     assert abs(float(m.group(1)) - 20 * np.pi) < 2e-9 and abs(float(m.group(2)) - 60.0) < 2e-9, m.group(0)
     fair = re.search(r"fairness En: ([\deE.+-]+) -> ([\deE.+-]+)", out)
-    assert fair and float(fair.group(2)) < float(fair.group(1)), _summary(proc)
+    assert fair and float(fair.group(2)) < float(fair.group(1)), summary(proc)
     for name in ("ght_example.step", "ght_example_pattern.dxf", "ght_example_pattern.svg", "ght_example.FCStd"):
         assert (tmp_path / "out" / name).stat().st_size > 0, name

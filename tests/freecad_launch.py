@@ -1,0 +1,52 @@
+"""Launching Debian's FreeCAD (freecadcmd, the GUI under Xvfb) from pytest: shared by the workbench tests."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+WB = REPO / "freecad_workbench"
+
+
+def freecad_env(tmp_path: Path, pythonpath: bool = True) -> dict[str, str]:
+    """Environment for a FreeCAD process: its own HOME in ``tmp_path``, no venv variables, and
+    (with ``pythonpath``) the workbench and this process's ght_cad on PYTHONPATH."""
+    env = dict(os.environ)
+    home = tmp_path / "home"
+    home.mkdir(exist_ok=True)
+    env["HOME"] = str(home)  # FreeCAD's user config goes here, not into the real home
+    env["GHT_FC_OUT"] = str(tmp_path)
+    env.pop("PYTHONHOME", None)
+    env.pop("VIRTUAL_ENV", None)
+    if pythonpath:
+        # the very ght_cad this pytest process imports, so both sides run the same core code
+        import ght_cad
+
+        core = Path(ght_cad.__file__).resolve().parents[1]
+        env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys([str(WB), str(core), str(REPO)]))
+    else:
+        env.pop("PYTHONPATH", None)
+    return env
+
+
+def run_process(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
+    """Run in a new session; on timeout kill the whole process group (FreeCAD, Xvfb) and fail."""
+    proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        pytest.fail(f"{cmd[0]} timed out after {timeout} s:\n{(out + err)[-4000:]}")
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+
+
+def summary(proc: subprocess.CompletedProcess) -> str:
+    """The last 80 non-blank output lines of a FreeCAD run, for assertion messages."""
+    lines = [l for l in (proc.stdout + proc.stderr).splitlines() if l.strip() and not l.startswith("  #")]
+    return "\n".join(lines[-80:])
