@@ -18,11 +18,15 @@ Holes and trimmed boundaries are kept: every wire of the face is traversed in or
 ``F``; 3-D reference lengths come from the edges' own 3-D curves (``GCPnts_AbscissaPoint``) and the
 3-D area by Green's theorem in (u, v) with Gauss–Legendre quadrature (:func:`face_area`;
 OCCT's ``BRepGProp`` is only ~1e-8 accurate on extrusions).
+
+This module is the OCP adapter of the kernel-free implementation :mod:`ght_cad.face_unroll`
+(shared with the FreeCAD workbench): it describes a ``TopoDS_Face`` as a
+:class:`ght_cad.face_unroll.FaceData` (surface evaluator from ``BRepAdaptor_Surface``, pcurves
+from ``BRepAdaptor_Curve2d``, 3-D lengths from ``GCPnts_AbscissaPoint``).
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, Callable
 
 import numpy as np
@@ -46,12 +50,13 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from ..errors import DegenerateGeometryError, GHTError, NotDevelopableError
-from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
-from ..ruled import RuledSurface
-from ..unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
+from .. import face_unroll as _core
+from ..errors import GHTError
+from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
+from ..flat_pattern import FlatPattern
+from ..unroll import DEFAULT_TOL_DEG
 
-__all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "shape_faces"]
+__all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "face_data", "shape_faces"]
 
 
 def shape_faces(shape: Any) -> list[TopoDS_Face]:
@@ -92,13 +97,39 @@ def _open_face(face: Any) -> tuple[TopoDS_Face, BRepAdaptor_Surface, tuple[float
     return f, ad, BRepTools.UVBounds_s(f), _SurfEval(ad)
 
 
-class _SurfEval:
-    """Vectorized (Python loop) evaluation of a BRepAdaptor_Surface: points and partials."""
+_KINDS = {
+    GeomAbs_Plane: "plane",
+    GeomAbs_Cylinder: "cylinder",
+    GeomAbs_Cone: "cone",
+    GeomAbs_SurfaceOfExtrusion: "extrusion",
+    GeomAbs_BSplineSurface: "bspline",
+    GeomAbs_BezierSurface: "bezier",
+}
+
+
+class _SurfEval(SurfaceAdapter):
+    """A BRepAdaptor_Surface as :class:`ght_cad.face_unroll.SurfaceAdapter`: kind, radius and
+    semi-angle from OCCT, points and partials by a Python loop over ``D0``/``D1``/``D2``."""
 
     def __init__(self, adaptor: BRepAdaptor_Surface) -> None:
         self.ad = adaptor
         self._p = gp_Pnt()
         self._v = [gp_Vec() for _ in range(5)]
+        kind = adaptor.GetType()
+        self.kind = _KINDS.get(kind, "other")
+        if kind == GeomAbs_Cylinder:
+            self.radius = adaptor.Cylinder().Radius()
+        elif kind == GeomAbs_Cone:
+            cone = adaptor.Cone()
+            self.radius, self.semi_angle = cone.RefRadius(), cone.SemiAngle()
+        elif kind in (GeomAbs_BSplineSurface, GeomAbs_BezierSurface):
+            if adaptor.VDegree() == 1 and adaptor.NbVPoles() == 2:
+                self.ruled_hint = "v"
+            elif adaptor.UDegree() == 1 and adaptor.NbUPoles() == 2:
+                self.ruled_hint = "u"
+
+    def breaks(self, direction: str) -> np.ndarray:
+        return surface_breaks(self.ad, direction)
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         out = np.empty((u.size, 3))
@@ -131,8 +162,9 @@ class _SurfEval:
         return out
 
 
-class FaceRuledSurface(RuledSurface):
-    r"""The ruled surface of a face whose ``ruled``-isolines are straight lines.
+class FaceRuledSurface(_core.FaceRuledSurface):
+    r"""The ruled surface of a face whose ``ruled``-isolines are straight lines
+    (:class:`ght_cad.face_unroll.FaceRuledSurface` of a ``BRepAdaptor_Surface``).
 
     With ``ruled == "v"`` (rulings along v): ``a(t) = S(u0 + t Δu, v0)``, ``b(t) = S(u0 + t Δu, v1)``,
     ``a^(r)(t) = Δu^r ∂_u^r S``; with ``ruled == "u"`` the roles of u and v swap. ``breakpoints``
@@ -140,46 +172,7 @@ class FaceRuledSurface(RuledSurface):
     """
 
     def __init__(self, adaptor: BRepAdaptor_Surface, ruled: str, bounds: tuple[float, float, float, float]) -> None:
-        if ruled not in ("u", "v"):
-            raise GHTError(f"ruled={ruled!r} is not allowed; use 'u' or 'v'")
-        self.ev = _SurfEval(adaptor)
-        self.ruled = ruled
-        self.bounds = bounds
-        u0, u1, v0, v1 = bounds
-        if ruled == "v":
-            self.t0, self.t1, self.s0, self.s1 = u0, u1, v0, v1
-        else:
-            self.t0, self.t1, self.s0, self.s1 = v0, v1, u0, u1
-        ks = surface_breaks(adaptor, "u" if ruled == "v" else "v")
-        self.breakpoints = tuple(((ks - self.t0) / (self.t1 - self.t0)).tolist())
-
-    def uv(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Face parameters of ruled parameters (t, s) ∈ [0, 1]²."""
-        tp = self.t0 + t * (self.t1 - self.t0)
-        sp = self.s0 + s * (self.s1 - self.s0)
-        return (tp, sp) if self.ruled == "v" else (sp, tp)
-
-    def ts(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Ruled parameters (t, s) of face parameters (u, v)."""
-        tp, sp = (u, v) if self.ruled == "v" else (v, u)
-        return (tp - self.t0) / (self.t1 - self.t0), (sp - self.s0) / (self.s1 - self.s0)
-
-    def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        u, v = self.uv(t, np.full_like(t, s))
-        if derivative == 0:
-            return self.ev.value(u, v)
-        if derivative > 2:
-            raise GHTError(f"derivative={derivative} is not available for faces; allowed 0, 1, 2")
-        d = self.ev.d2(u, v)
-        k = (1 if self.ruled == "v" else 2) if derivative == 1 else (3 if self.ruled == "v" else 4)
-        return d[k] * (self.t1 - self.t0) ** derivative
-
-    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
-        return self._edge(u, 0.0, derivative)
-
-    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
-        return self._edge(u, 1.0, derivative)
+        super().__init__(_SurfEval(adaptor), ruled, bounds)
 
 
 def surface_breaks(ad: BRepAdaptor_Surface, direction: str) -> np.ndarray:
@@ -207,55 +200,6 @@ def surface_breaks(ad: BRepAdaptor_Surface, direction: str) -> np.ndarray:
     return np.array([arr.Value(i) for i in range(1, n + 2)])
 
 
-def _isoline_stats(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> tuple[float, float]:
-    r"""Straightness and openness of the isolines running along ``direction``.
-
-    Nine isolines (fixed other parameter at 0, 1/8, ..., 1 of its range), each sampled at 33
-    points ``p_0 .. p_32``, polyline length ``L = Σ |p_{k+1} - p_k|``, chord ``c = p_32 - p_0``.
-    The line an isoline is compared with is its chord line when ``|c| > 1e-9 L``, else (a closed
-    isoline) the best-fitting line (through the centroid along the principal axis of the points).
-    The deviation of one isoline is ``max_k dist(p_k, line) / L`` (0 for a straight segment,
-    ``1/π`` for a half circle, ``1/(2π)`` for a full circle); isolines with ``L = 0`` (a pole or
-    an apex) are points and skipped.
-
-    Returns:
-        ``(deviation, openness)``: the largest deviation and the smallest ``|c| / L`` over the
-        non-degenerate isolines (``openness`` 0 for closed isolines, 1 for straight ones);
-        ``(0.0, 1.0)`` when every isoline is degenerate.
-    """
-    u0, u1, v0, v1 = bounds
-    fixed = np.linspace(0.0, 1.0, 9)
-    run = np.linspace(0.0, 1.0, 33)
-    worst, openness = 0.0, 1.0
-    for f in fixed:
-        if direction == "v":
-            u = np.full_like(run, u0 + f * (u1 - u0))
-            v = v0 + run * (v1 - v0)
-        else:
-            u = u0 + run * (u1 - u0)
-            v = np.full_like(run, v0 + f * (v1 - v0))
-        p = ev.value(u, v)
-        L = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-        if not math.isfinite(L) or L <= 1e-14 * max(1.0, float(np.abs(p).max())):
-            continue  # the isoline is a point (pole, apex)
-        c = p[-1] - p[0]
-        chord = float(np.linalg.norm(c))
-        if chord > 1e-9 * L:
-            origin, axis = p[0], c / chord
-        else:  # closed isoline: its best-fitting straight line
-            origin = p.mean(axis=0)
-            axis = np.linalg.svd(p - origin, full_matrices=False)[2][0]
-        dev = float(np.linalg.norm(np.cross(p - origin, axis), axis=1).max()) / L
-        worst = max(worst, dev)
-        openness = min(openness, chord / L)
-    return worst, openness
-
-
-def _straightness(ev: _SurfEval, bounds: tuple[float, float, float, float], direction: str) -> float:
-    """Largest isoline deviation from a straight line relative to the isoline length (:func:`_isoline_stats`)."""
-    return _isoline_stats(ev, bounds, direction)[0]
-
-
 def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
     r"""Which parameter direction of the face has straight isolines (the rulings).
 
@@ -264,7 +208,7 @@ def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
 
     Returns:
         ``("v", info)`` when the v-isolines are straight (deviation ``max dist(p, line) / L``
-        < 1e-9, see :func:`_isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
+        < 1e-9, see :func:`ght_cad.face_unroll.isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
         likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v`` (finite,
         relative to the isoline length) and ``openness_u``, ``openness_v`` (smallest chord /
         length; 0 for closed isolines). Planes, cylinders, cones and extrusions return ``"v"``.
@@ -272,46 +216,8 @@ def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
     Raises:
         GHTError: not a face, or a shape with several faces.
     """
-    f, ad, bounds, ev = _open_face(face)
-    dv, ov = _isoline_stats(ev, bounds, "v")
-    du, ou = _isoline_stats(ev, bounds, "u")
-    info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
-    if ad.GetType() in (GeomAbs_Plane, GeomAbs_Cylinder, GeomAbs_Cone, GeomAbs_SurfaceOfExtrusion):
-        return "v", info
-    if ad.GetType() in (GeomAbs_BSplineSurface, GeomAbs_BezierSurface):
-        if ad.VDegree() == 1 and ad.NbVPoles() == 2:
-            return "v", info
-        if ad.UDegree() == 1 and ad.NbUPoles() == 2:
-            return "u", info
-    if dv <= 1e-9 and dv <= du:
-        return "v", info
-    if du <= 1e-9:
-        return "u", info
-    return None, info
-
-
-def _best_effort_direction(info: dict[str, float], label: str) -> str:
-    """Ruling direction for flattening a non-ruled face: the boundary isolines ``S(·, v0)``,
-    ``S(·, v1)`` (rulings along v) must be distinct curves, i.e. the v-isolines must be open.
-    Among directions whose isolines are clearly open (chord ≥ 1 % of the length), else merely
-    open (chord > 1e-6 of the length), the straighter one is used.
-
-    Raises:
-        DegenerateGeometryError: the isolines are closed in both directions (a torus): there are
-            no two distinct boundary isolines to span rulings between.
-    """
-    for lim in (1e-2, 1e-6):
-        cands = [d for d in ("v", "u") if info[f"openness_{d}"] >= lim]
-        if cands:
-            return min(cands, key=lambda d: info[f"deviation_{d}"])
-    raise DegenerateGeometryError(
-        f"face {label!r} is not ruled (its isolines deviate from straight lines by "
-        f"{info['deviation_u']:.3g} (u-isolines) and {info['deviation_v']:.3g} (v-isolines) relative to "
-        "their lengths; allowed 1e-9) and cannot be flattened even with best_effort=True: its isolines are "
-        f"closed in both directions (chord/length {info['openness_u']:.3g} (u) and {info['openness_v']:.3g} "
-        "(v); allowed > 1e-6), so it has no two distinct boundary isolines to span rulings between; split "
-        "the face (e.g. cut a torus into sectors) first"
-    )
+    _, _, bounds, ev = _open_face(face)
+    return _core.ruling_direction(ev, bounds)
 
 
 def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callable, Callable, float, Callable]:
@@ -353,45 +259,6 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     return uv, xyz, float(length), duv
 
 
-def face_area(ev: _SurfEval, edges_uv: list[list[tuple[Callable, Callable]]], u_lo: float, u_breaks: np.ndarray) -> float:
-    r"""3-D area ``∬_Ω |S_u × S_v| du dv`` of a trimmed face by Green's theorem in (u, v).
-
-    ``∬_Ω f du dv = ∮_{∂Ω} P dv`` with ``P(u, v) = ∫_{u_lo}^{u} f(s, v) ds``: the outer integral by
-    16 × 12-point Gauss–Legendre panels along each pcurve (split at the pcurve's knots), the inner one by 2 × 12-point panels per
-    interval between ``u_breaks`` (the surface's knots), i.e. exact up to the smoothness of ``f``.
-    The absolute value of the signed total over all loops is returned (orientation-free).
-    """
-    xg, wg = np.polynomial.legendre.leggauss(12)
-    total = 0.0
-    for loop in edges_uv:
-        for uvf, duv in loop:
-            te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
-            tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
-            tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
-            dv = duv(tn)[:, 1]
-            if np.max(np.abs(dv)) == 0.0:
-                continue
-            u, v = uvf(tn)
-            S, Vv, W, owner = [], [], [], []
-            for i, (ui, vi) in enumerate(zip(u, v)):
-                lo, hi = (u_lo, ui) if ui >= u_lo else (ui, u_lo)
-                sign = 1.0 if ui >= u_lo else -1.0
-                br = u_breaks[(u_breaks > lo) & (u_breaks < hi)]
-                ed = np.unique(np.concatenate([[lo, hi], br, 0.5 * (np.concatenate([[lo], br]) + np.concatenate([br, [hi]]))]))
-                h = 0.5 * np.diff(ed)
-                s = ((ed[:-1] + h)[:, None] + h[:, None] * xg[None, :]).ravel()
-                S.append(s)
-                Vv.append(np.full_like(s, vi))
-                W.append(sign * (h[:, None] * wg[None, :]).ravel())
-                owner.append(np.full(s.size, i))
-            s_all, v_all, w_all, own = (np.concatenate(x) for x in (S, Vv, W, owner))
-            d = ev.d1(s_all, v_all)
-            f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
-            P = np.bincount(own, weights=f * w_all, minlength=tn.size)
-            total += float(np.sum(P * dv * tw))
-    return abs(total)
-
-
 def _wires(face: TopoDS_Face) -> list[Any]:
     outer = BRepTools.OuterWire_s(face)
     ws = [outer]
@@ -402,33 +269,6 @@ def _wires(face: TopoDS_Face) -> list[Any]:
             ws.append(w)
         exp.Next()
     return ws
-
-
-def _metric(ev: _SurfEval, fmap: Callable, bounds: tuple[float, float, float, float]) -> dict[str, np.ndarray]:
-    """Angles between S_u, S_v (OCCT D1) and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
-    u0, u1, v0, v1 = bounds
-    uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
-    vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
-    U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
-    d = ev.d2(U, V)
-    return metric_angles(d[1], d[2], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
-
-
-class _ClosedFormMap:
-    """Development map of a plane, cylinder or cone (closed form, see module doc)."""
-
-    def __init__(self, kind: str, R: float = 0.0, s: float = 0.0) -> None:
-        self.kind, self.R, self.s = kind, R, s
-
-    def map(self, u: Any, v: Any) -> np.ndarray:
-        u, v = broadcast_uv(u, v)
-        if self.kind == "plane":
-            return np.stack([u, v], axis=1)
-        if self.kind == "cylinder":
-            return np.stack([self.R * u, v], axis=1)
-        rho = self.R / self.s + v
-        ang = self.s * u
-        return np.stack([rho * np.cos(ang), rho * np.sin(ang)], axis=1)
 
 
 def unroll_face(
@@ -468,118 +308,35 @@ def unroll_face(
             directions (a full torus): no open boundary isolines to span rulings between.
         GHTError: not a face, or a shape with several faces.
     """
-    f, ad, bounds, ev = _open_face(face)
-    kind = ad.GetType()
-    info: dict[str, Any] = {"best_effort": bool(best_effort)}
-    ruled_surface: FaceRuledSurface | None = None
-    if kind == GeomAbs_Plane:
-        dmap = _ClosedFormMap("plane")
-        ruled_dir: str | None = None
-        info["method"] = "plane (identity in plane coordinates)"
-    elif kind == GeomAbs_Cylinder:
-        dmap = _ClosedFormMap("cylinder", R=ad.Cylinder().Radius())
-        ruled_dir = "v"
-        info["method"] = "cylinder (closed form)"
-    elif kind == GeomAbs_Cone:
-        cone = ad.Cone()
-        dmap = _ClosedFormMap("cone", R=cone.RefRadius(), s=math.sin(cone.SemiAngle()))
-        ruled_dir = "v"
-        info["method"] = "cone (closed form)"
-    else:
-        ruled_dir, straight = face_ruling_direction(f)
-        info.update(straight)
-        if ruled_dir is None:
-            if not best_effort:
-                raise NotDevelopableError(
-                    f"face {label!r} is not ruled: its isolines deviate from straight lines by "
-                    f"{straight['deviation_u']:.3g} (u-isolines) and {straight['deviation_v']:.3g} "
-                    "(v-isolines) relative to their lengths (allowed 1e-9; a closed isoline deviates "
-                    "0.159); pass best_effort=True to flatten the ruled surface between its boundary "
-                    "isolines with a distortion report"
-                )
-            ruled_dir = _best_effort_direction(straight, label)
-        info["ruling_direction"] = ruled_dir
-        ruled_surface = FaceRuledSurface(ad, ruled_dir, bounds)
-        dd = _check_developable(ruled_surface, tol_deg, best_effort, f"face {label!r}")
-        info["developability"] = dd.as_dict()
-        dev = RuledDevelopment(ruled_surface, breakpoints=ruled_surface.breakpoints)
-        info["method"] = "quadrature along rulings (adaptive Chebyshev panels)"
-        info["panels"] = dev.panels
-        info["quadrature_error_estimate"] = dev.quadrature_error_estimate
-        rs = ruled_surface
-        straight_ok = min(info["deviation_u"], info["deviation_v"]) <= 1e-9
+    f, _, bounds, ev = _open_face(face)
+    return unroll_face_data(
+        face_data(f, ev, bounds),
+        best_effort=best_effort,
+        tol_deg=tol_deg,
+        rulings=rulings,
+        samples=samples,
+        units=units,
+        label=label,
+    )
 
-        class _FaceMap:
-            def map(self, u: Any, v: Any) -> np.ndarray:
-                u, v = broadcast_uv(u, v)
-                t, s = rs.ts(u, v)
-                if straight_ok:  # exact ruled face: project the true point onto its ruling
-                    return dev.map_points(t, ev.value(u, v))
-                return dev.map(t, s)
 
-        dmap = _FaceMap()  # type: ignore[assignment]
-    # boundary loops
-    loops = []
-    loops_uv = []
+def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, float]) -> FaceData:
+    """The face as :class:`ght_cad.face_unroll.FaceData`: every wire (outer first) traversed by
+    ``BRepTools_WireExplorer``, each edge's pcurve, 3-D curve and length (:func:`_edge_samples`)."""
+    wires = []
     for w in _wires(f):
         loop = []
-        loop_uv = []
         exp = BRepTools_WireExplorer(w, f)
         k = 0
         while exp.More():
             e = exp.Current()
             uvf, xyzf, L3, duvf = _edge_samples(e, f, e.Orientation() == TopAbs_REVERSED)
-            loop_uv.append((uvf, duvf))
-
-            def flat_fn(t: np.ndarray, uvf: Callable = uvf) -> np.ndarray:
-                u, v = uvf(t)
-                return dmap.map(u, v)
-
-            loop.append(BoundaryEdge(name=f"edge{k}", flat_fn=flat_fn, xyz_fn=xyzf, length_3d=L3, samples=samples))
+            loop.append(EdgeData(uv=uvf, duv=duvf, xyz=xyzf, length_3d=L3, breaks=duvf.breaks, name=f"edge{k}"))
             k += 1
             exp.Next()
         if loop:
-            loops.append(loop)
-            loops_uv.append(loop_uv)
-    # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
-    u0, u1, v0, v1 = bounds
-    bends = np.zeros((0, 2, 2))
-    g3 = gf = np.zeros(0)
-    if ruled_dir is not None:
-        tt = np.linspace(0.0, 1.0, 129)
-        tb = np.arange(1, rulings + 1) / (rulings + 1)
-
-        def ends(t: np.ndarray) -> tuple[np.ndarray, ...]:
-            if ruled_dir == "v":
-                uu = u0 + t * (u1 - u0)
-                return uu, np.full_like(t, v0), uu, np.full_like(t, v1)
-            vv = v0 + t * (v1 - v0)
-            return np.full_like(t, u0), vv, np.full_like(t, u1), vv
-
-        ua, va, ub, vb = ends(tt)
-        g3 = np.linalg.norm(ev.value(ub, vb) - ev.value(ua, va), axis=1)
-        gf = np.linalg.norm(dmap.map(ub, vb) - dmap.map(ua, va), axis=1)
-        if rulings:
-            ua, va, ub, vb = ends(tb)
-            bends = np.stack([dmap.map(ua, va), dmap.map(ub, vb)], axis=1)
-    u_breaks = surface_breaks(ad, "u")
-    area_3d = face_area(ev, loops_uv, u0, u_breaks)
-    panel = FlatPanel(
-        label=label,
-        loops=loops,
-        bend_lines=bends,
-        ruling_lengths_3d=g3,
-        ruling_lengths_flat=gf,
-        area_3d=area_3d,
-        metric=_metric(ev, dmap.map, bounds),
-        info=info,
-        development=dmap,
-    )
-    measure_panel(panel)
-    # place: bounding box at the origin
-    lo, _ = panel.bbox()
-    panel.translate(-lo)
-    return FlatPattern([panel], units=units)
+            wires.append(loop)
+    return FaceData(surface=ev, bounds=bounds, wires=wires)
 
 
 def flat_faces(pattern: FlatPattern, *, spline: bool = True) -> list[Any]:

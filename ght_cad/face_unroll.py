@@ -1,0 +1,604 @@
+r"""Kernel-free unrolling of a CAD face (plane, cylinder, cone, extrusion, ruled B-spline, trimmed).
+
+One implementation behind two thin adapters: :mod:`ght_cad.cad.unroll_faces` (OCP / build123d /
+cadquery) and the FreeCAD workbench's ``flat_pattern`` (FreeCAD's ``Part`` API). An adapter
+describes a face by a :class:`FaceData`: its surface (a :class:`SurfaceAdapter`: kind, radius /
+semi-angle where analytic, value and partials at arrays of (u, v), parameter breaks), its
+parameter bounds and its wires (outer first), each a list of :class:`EdgeData` in wire order
+(t ∈ [0, 1] -> (u, v), (u', v'), xyz, and the 3-D length).
+
+Development maps ``F(u, v)`` from the face's own parameters to the plane:
+
+* plane: ``F(u, v) = (u, v)`` (the parameters of a plane are orthonormal coordinates);
+* cylinder of radius R: ``F(u, v) = (R u, v)``;
+* cone with reference radius R and semi-angle α, ``s = sin α``: the slant distance from the apex
+  is ``ρ(v) = R/s + v`` and ``F(u, v) = ρ(v) (cos(s u), sin(s u))`` (annular sector of angle
+  ``s Δu``: for a full cone ``2π r / ρ``);
+* every other face whose isolines in one parameter direction are straight (surface of linear
+  extrusion, B-spline/Bézier of degree 1 in one direction, ...): a :class:`FaceRuledSurface`
+  ``a(t) = S(u(t), v0)``, ``b(t) = S(u(t), v1)`` developed by quadrature along the rulings
+  (:class:`ght_cad.unroll.RuledDevelopment`); a point ``S(u, v)`` maps to ``A(t) + s |g| D(t)``
+  where ``s`` is its projection onto the ruling.
+
+Holes and trimmed boundaries are kept: every edge's pcurve ``(u(t), v(t))`` is mapped through
+``F``; 3-D reference lengths come from the edges' own 3-D curves and the 3-D area by Green's
+theorem in (u, v) with Gauss–Legendre quadrature (:func:`face_area`).
+
+numpy/scipy only (runs inside FreeCAD's Python with numpy 1.24 / scipy 1.10).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
+from .ruled import RuledSurface
+from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
+
+__all__ = [
+    "SurfaceAdapter",
+    "EdgeData",
+    "FaceData",
+    "FaceRuledSurface",
+    "ClosedFormMap",
+    "isoline_stats",
+    "ruling_direction",
+    "best_effort_direction",
+    "face_area",
+    "fd_derivative",
+    "chain_loop",
+    "unroll_face_data",
+]
+
+Bounds = tuple[float, float, float, float]
+#: surface kinds with a structural ruling direction "v" (their v-isolines are straight lines)
+RULED_KINDS = ("plane", "cylinder", "cone", "extrusion")
+
+
+class SurfaceAdapter:
+    """The surface of a face as the core sees it (the adapter protocol; subclass and override).
+
+    Attributes:
+        kind: "plane", "cylinder", "cone", "extrusion", "bspline", "bezier" or "other".
+        radius: cylinder radius / cone reference radius R (analytic kinds only).
+        semi_angle: cone semi-angle α in radians (cone only).
+        ruled_hint: "v" or "u" when the surface is structurally ruled in that direction (a B-spline
+            or Bézier of degree 1 with 2 poles across), else None.
+    """
+
+    kind: str = "other"
+    radius: float = 0.0
+    semi_angle: float = 0.0
+    ruled_hint: str | None = None
+
+    def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Points ``S(u, v)``, shape (n, 3)."""
+        raise NotImplementedError
+
+    def d1(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """``[S_u, S_v]`` at the points, each (n, 3)."""
+        d = self.d2(u, v)
+        return [d[1], d[2]]
+
+    def d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """``[S, S_u, S_v, S_uu, S_vv, S_uv]`` at the points, each (n, 3)."""
+        raise NotImplementedError
+
+    def breaks(self, direction: str) -> np.ndarray:
+        """Parameters in ``direction`` ("u" or "v") where the surface is not C∞ (B-spline knots);
+        may include the ends; empty for analytic surfaces."""
+        return np.zeros(0)
+
+
+@dataclass
+class EdgeData:
+    """One boundary edge of a face in wire order, t ∈ [0, 1].
+
+    Attributes:
+        uv: t -> (u, v) arrays (the pcurve).
+        duv: t -> (n, 2) derivatives ``(du/dt, dv/dt)``.
+        xyz: t -> (n, 3) points of the edge's 3-D curve.
+        length_3d: 3-D length (0 for a degenerate edge, e.g. a cone apex).
+        breaks: interior t where the pcurve is not C∞ (its knots), sorted.
+        name: edge name.
+    """
+
+    uv: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+    duv: Callable[[np.ndarray], np.ndarray]
+    xyz: Callable[[np.ndarray], np.ndarray]
+    length_3d: float
+    breaks: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    name: str = ""
+
+
+@dataclass
+class FaceData:
+    """A face for :func:`unroll_face_data`: surface, parameter bounds (u0, u1, v0, v1), wires
+    (outer first, then holes; each a list of :class:`EdgeData` in traversal order)."""
+
+    surface: SurfaceAdapter
+    bounds: Bounds
+    wires: list[list[EdgeData]]
+
+
+class FaceRuledSurface(RuledSurface):
+    r"""The ruled surface of a face whose ``ruled``-isolines are straight lines.
+
+    With ``ruled == "v"`` (rulings along v): ``a(t) = S(u0 + t Δu, v0)``, ``b(t) = S(u0 + t Δu, v1)``,
+    ``a^(r)(t) = Δu^r ∂_u^r S``; with ``ruled == "u"`` the roles of u and v swap. ``breakpoints``
+    are the surface's C∞-interval ends (B-spline knots) in t.
+
+    Raises:
+        GHTError: ``ruled`` is not "u" or "v".
+    """
+
+    def __init__(self, surface: SurfaceAdapter, ruled: str, bounds: Bounds) -> None:
+        if ruled not in ("u", "v"):
+            raise GHTError(f"ruled={ruled!r} is not allowed; use 'u' or 'v'")
+        self.ev = surface
+        self.ruled = ruled
+        self.bounds = bounds
+        u0, u1, v0, v1 = bounds
+        if ruled == "v":
+            self.t0, self.t1, self.s0, self.s1 = u0, u1, v0, v1
+        else:
+            self.t0, self.t1, self.s0, self.s1 = v0, v1, u0, u1
+        ks = np.asarray(surface.breaks("u" if ruled == "v" else "v"), dtype=float)
+        self.breakpoints = tuple(((ks - self.t0) / (self.t1 - self.t0)).tolist())
+
+    def uv(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Face parameters of ruled parameters (t, s) ∈ [0, 1]²."""
+        tp = self.t0 + t * (self.t1 - self.t0)
+        sp = self.s0 + s * (self.s1 - self.s0)
+        return (tp, sp) if self.ruled == "v" else (sp, tp)
+
+    def ts(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Ruled parameters (t, s) of face parameters (u, v)."""
+        tp, sp = (u, v) if self.ruled == "v" else (v, u)
+        return (tp - self.t0) / (self.t1 - self.t0), (sp - self.s0) / (self.s1 - self.s0)
+
+    def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        u, v = self.uv(t, np.full_like(t, s))
+        if derivative == 0:
+            return self.ev.value(u, v)
+        if derivative > 2:
+            raise GHTError(f"derivative={derivative} is not available for faces; allowed 0, 1, 2")
+        d = self.ev.d2(u, v)
+        k = (1 if self.ruled == "v" else 2) if derivative == 1 else (3 if self.ruled == "v" else 4)
+        return d[k] * (self.t1 - self.t0) ** derivative
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._edge(u, 0.0, derivative)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._edge(u, 1.0, derivative)
+
+
+def isoline_stats(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> tuple[float, float]:
+    r"""Straightness and openness of the isolines running along ``direction``.
+
+    Nine isolines (fixed other parameter at 0, 1/8, ..., 1 of its range), each sampled at 33
+    points ``p_0 .. p_32``, polyline length ``L = Σ |p_{k+1} - p_k|``, chord ``c = p_32 - p_0``.
+    The line an isoline is compared with is its chord line when ``|c| > 1e-9 L``, else (a closed
+    isoline) the best-fitting line (through the centroid along the principal axis of the points).
+    The deviation of one isoline is ``max_k dist(p_k, line) / L`` (0 for a straight segment,
+    ``1/π`` for a half circle, ``1/(2π)`` for a full circle); isolines with ``L = 0`` (a pole or
+    an apex) are points and skipped.
+
+    Args:
+        ev: the surface.
+        bounds: (u0, u1, v0, v1).
+        direction: "u" (isolines along u) or "v".
+
+    Returns:
+        ``(deviation, openness)``: the largest deviation and the smallest ``|c| / L`` over the
+        non-degenerate isolines (``openness`` 0 for closed isolines, 1 for straight ones);
+        ``(0.0, 1.0)`` when every isoline is degenerate.
+    """
+    u0, u1, v0, v1 = bounds
+    fixed = np.linspace(0.0, 1.0, 9)
+    run = np.linspace(0.0, 1.0, 33)
+    worst, openness = 0.0, 1.0
+    for f in fixed:
+        if direction == "v":
+            u = np.full_like(run, u0 + f * (u1 - u0))
+            v = v0 + run * (v1 - v0)
+        else:
+            u = u0 + run * (u1 - u0)
+            v = np.full_like(run, v0 + f * (v1 - v0))
+        p = ev.value(u, v)
+        L = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+        if not math.isfinite(L) or L <= 1e-14 * max(1.0, float(np.abs(p).max())):
+            continue  # the isoline is a point (pole, apex)
+        c = p[-1] - p[0]
+        chord = float(np.linalg.norm(c))
+        if chord > 1e-9 * L:
+            origin, axis = p[0], c / chord
+        else:  # closed isoline: its best-fitting straight line
+            origin = p.mean(axis=0)
+            axis = np.linalg.svd(p - origin, full_matrices=False)[2][0]
+        dev = float(np.linalg.norm(np.cross(p - origin, axis), axis=1).max()) / L
+        worst = max(worst, dev)
+        openness = min(openness, chord / L)
+    return worst, openness
+
+
+def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | None, dict[str, float]]:
+    r"""Which parameter direction of the face has straight isolines (the rulings).
+
+    Args:
+        surface: the face's surface.
+        bounds: its parameter bounds (u0, u1, v0, v1).
+
+    Returns:
+        ``("v", info)`` when the v-isolines are straight (deviation ``max dist(p, line) / L``
+        < 1e-9, see :func:`isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
+        likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v`` and
+        ``openness_u``, ``openness_v``. Planes, cylinders, cones and extrusions return ``"v"``,
+        a structurally ruled B-spline/Bézier its ``ruled_hint``.
+    """
+    dv, ov = isoline_stats(surface, bounds, "v")
+    du, ou = isoline_stats(surface, bounds, "u")
+    info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
+    if surface.kind in RULED_KINDS:
+        return "v", info
+    if surface.ruled_hint in ("u", "v"):
+        return surface.ruled_hint, info
+    if dv <= 1e-9 and dv <= du:
+        return "v", info
+    if du <= 1e-9:
+        return "u", info
+    return None, info
+
+
+def best_effort_direction(info: dict[str, float], label: str) -> str:
+    """Ruling direction for flattening a non-ruled face: the boundary isolines ``S(·, v0)``,
+    ``S(·, v1)`` (rulings along v) must be distinct curves, i.e. the v-isolines must be open.
+    Among directions whose isolines are clearly open (chord ≥ 1 % of the length), else merely
+    open (chord > 1e-6 of the length), the straighter one is used.
+
+    Raises:
+        DegenerateGeometryError: the isolines are closed in both directions (a torus): there are
+            no two distinct boundary isolines to span rulings between.
+    """
+    for lim in (1e-2, 1e-6):
+        cands = [d for d in ("v", "u") if info[f"openness_{d}"] >= lim]
+        if cands:
+            return min(cands, key=lambda d: info[f"deviation_{d}"])
+    raise DegenerateGeometryError(
+        f"face {label!r} is not ruled (its isolines deviate from straight lines by "
+        f"{info['deviation_u']:.3g} (u-isolines) and {info['deviation_v']:.3g} (v-isolines) relative to "
+        "their lengths; allowed 1e-9) and cannot be flattened even with best_effort=True: its isolines are "
+        f"closed in both directions (chord/length {info['openness_u']:.3g} (u) and {info['openness_v']:.3g} "
+        "(v); allowed > 1e-6), so it has no two distinct boundary isolines to span rulings between; split "
+        "the face (e.g. cut a torus into sectors) first"
+    )
+
+
+def face_area(ev: SurfaceAdapter, edges_uv: list[list[tuple[Callable, Callable]]], u_lo: float, u_breaks: np.ndarray) -> float:
+    r"""3-D area ``∬_Ω |S_u × S_v| du dv`` of a trimmed face by Green's theorem in (u, v).
+
+    ``∬_Ω f du dv = ∮_{∂Ω} P dv`` with ``P(u, v) = ∫_{u_lo}^{u} f(s, v) ds``: the outer integral by
+    16 × 12-point Gauss–Legendre panels along each pcurve (split at the pcurve's knots, the
+    ``breaks`` attribute of ``duv``), the inner one by 2 × 12-point panels per interval between
+    ``u_breaks`` (the surface's knots), i.e. exact up to the smoothness of ``f``.
+
+    Args:
+        ev: the surface (``d1``).
+        edges_uv: per loop, per edge ``(t -> (u, v), t -> (u', v'))``.
+        u_lo: lower limit of the inner integral (any u; the face's u0).
+        u_breaks: the surface's u breaks.
+
+    Returns:
+        The absolute value of the signed total over all loops (orientation-free).
+    """
+    xg, wg = np.polynomial.legendre.leggauss(12)
+    total = 0.0
+    u_breaks = np.asarray(u_breaks, dtype=float)
+    for loop in edges_uv:
+        for uvf, duv in loop:
+            te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
+            tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
+            tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
+            dv = duv(tn)[:, 1]
+            if np.max(np.abs(dv)) == 0.0:
+                continue
+            u, v = uvf(tn)
+            S, Vv, W, owner = [], [], [], []
+            for i, (ui, vi) in enumerate(zip(u, v)):
+                lo, hi = (u_lo, ui) if ui >= u_lo else (ui, u_lo)
+                sign = 1.0 if ui >= u_lo else -1.0
+                br = u_breaks[(u_breaks > lo) & (u_breaks < hi)]
+                ed = np.unique(np.concatenate([[lo, hi], br, 0.5 * (np.concatenate([[lo], br]) + np.concatenate([br, [hi]]))]))
+                h = 0.5 * np.diff(ed)
+                s = ((ed[:-1] + h)[:, None] + h[:, None] * xg[None, :]).ravel()
+                S.append(s)
+                Vv.append(np.full_like(s, vi))
+                W.append(sign * (h[:, None] * wg[None, :]).ravel())
+                owner.append(np.full(s.size, i))
+            s_all, v_all, w_all, own = (np.concatenate(x) for x in (S, Vv, W, owner))
+            d = ev.d1(s_all, v_all)
+            f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
+            P = np.bincount(own, weights=f * w_all, minlength=tn.size)
+            total += float(np.sum(P * dv * tw))
+    return abs(total)
+
+
+def fd_derivative(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, breaks: Sequence[float] = (), h: float = 1e-4) -> np.ndarray:
+    r"""Derivative of a piecewise-smooth ``fun: t -> (n, k)`` on [0, 1] by 5-point differences.
+
+    Central ``(-f(t+2h) + 8 f(t+h) - 8 f(t-h) + f(t-2h)) / 12h`` (O(h⁴)) with
+    ``h = min(h, d/2.5)`` where ``d`` is the distance of t to the nearest break or end, so the
+    stencil never straddles a knot; at a break or end (``d < 1e-9``) the one-sided 5-point formula
+    ``(-25 f0 + 48 f1 - 36 f2 + 16 f3 - 3 f4) / 12h`` (O(h⁴)) pointing into [0, 1] is used.
+
+    Args:
+        fun: the function (vectorized over t).
+        t: points in [0, 1].
+        breaks: interior points where ``fun`` is not smooth.
+        h: largest step.
+
+    Returns:
+        (n, k) derivatives.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    knots = np.unique(np.concatenate([[0.0, 1.0], np.asarray(breaks, dtype=float)]))
+    dist = np.min(np.abs(t[:, None] - knots[None, :]), axis=1)
+    step = np.minimum(h, dist / 2.5)
+    out = np.empty((t.size, np.asarray(fun(t[:1])).shape[1]))
+    central = dist >= 1e-9
+    if central.any():
+        tc, hc = t[central], step[central][:, None]
+        f = [np.asarray(fun(tc + k * hc[:, 0])) for k in (-2, -1, 1, 2)]
+        out[central] = (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * hc)
+    if (~central).any():
+        tb = t[~central]
+        sgn = np.where(tb < 0.5, 1.0, -1.0)
+        hb = h * sgn
+        f = [np.asarray(fun(tb + k * hb)) for k in range(5)]
+        out[~central] = (-25 * f[0] + 48 * f[1] - 36 * f[2] + 16 * f[3] - 3 * f[4]) / (12 * hb[:, None])
+    return out
+
+
+def chain_loop(
+    ends: list[tuple[np.ndarray, np.ndarray]], periods: tuple[float, float], tol: float
+) -> list[tuple[bool, np.ndarray]]:
+    r"""Make a wire's pcurves one continuous loop in (u, v).
+
+    A seam edge of a periodic surface has two pcurves a period apart and a kernel may hand out the
+    other one (or an edge in the other direction): walking the wire, each edge is kept or reversed
+    and shifted by whole periods ``(k_u P_u, k_v P_v)`` so that it starts where the previous one
+    ended (within ``tol``).
+
+    Args:
+        ends: per edge its (start, end) uv points in the given direction.
+        periods: (P_u, P_v), 0 for a non-periodic direction.
+        tol: matching tolerance in (u, v).
+
+    Returns:
+        Per edge ``(reverse, shift)``. Edges that cannot be matched are kept as given.
+    """
+    P = np.asarray(periods, dtype=float)
+
+    def shift_to(p: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+        d = q - p
+        k = np.where(P > 0, np.round(d / np.where(P > 0, P, 1.0)), 0.0)
+        s = k * P
+        return s if np.all(np.abs(d - s) <= tol) else None
+
+    out: list[tuple[bool, np.ndarray]] = [(False, np.zeros(2))]
+    if not ends:
+        return []
+    a0, b0 = ends[0]
+    if len(ends) > 1:  # the first edge given in the other direction: the second one starts at its start
+        a1, b1 = ends[1]
+        if shift_to(a1, b0) is None and shift_to(b1, b0) is None and (
+            shift_to(a1, a0) is not None or shift_to(b1, a0) is not None
+        ):
+            out[0] = (True, np.zeros(2))
+            a0, b0 = b0, a0
+    cur = b0
+    for a, b in ends[1:]:
+        s = shift_to(a, cur)
+        if s is not None:
+            out.append((False, s))
+            cur = b + s
+            continue
+        s = shift_to(b, cur)
+        if s is not None:
+            out.append((True, s))
+            cur = a + s
+            continue
+        out.append((False, np.zeros(2)))
+        cur = b
+    return out
+
+
+def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds) -> dict[str, np.ndarray]:
+    """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
+    u0, u1, v0, v1 = bounds
+    uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
+    vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
+    U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
+    d = ev.d2(U, V)
+    return metric_angles(d[1], d[2], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
+
+
+class ClosedFormMap:
+    """Development map of a plane, cylinder or cone (closed form, see module doc)."""
+
+    def __init__(self, kind: str, R: float = 0.0, s: float = 0.0) -> None:
+        self.kind, self.R, self.s = kind, R, s
+
+    def map(self, u: Any, v: Any) -> np.ndarray:
+        """``F(u, v)``, shape (n, 2)."""
+        u, v = broadcast_uv(u, v)
+        if self.kind == "plane":
+            return np.stack([u, v], axis=1)
+        if self.kind == "cylinder":
+            return np.stack([self.R * u, v], axis=1)
+        rho = self.R / self.s + v
+        ang = self.s * u
+        return np.stack([rho * np.cos(ang), rho * np.sin(ang)], axis=1)
+
+
+class _RuledFaceMap:
+    """Development map of a ruled face by quadrature along its rulings (see module doc)."""
+
+    def __init__(self, rs: FaceRuledSurface, dev: RuledDevelopment, ev: SurfaceAdapter, project: bool) -> None:
+        self.rs, self.dev, self.ev, self.project = rs, dev, ev, project
+
+    def map(self, u: Any, v: Any) -> np.ndarray:
+        u, v = broadcast_uv(u, v)
+        t, s = self.rs.ts(u, v)
+        if self.project:  # exact ruled face: project the true point onto its ruling
+            return self.dev.map_points(t, self.ev.value(u, v))
+        return self.dev.map(t, s)
+
+
+def unroll_face_data(
+    face: FaceData,
+    *,
+    best_effort: bool = False,
+    tol_deg: float = DEFAULT_TOL_DEG,
+    rulings: int = 16,
+    samples: int = 257,
+    units: str = "mm",
+    label: str = "P1",
+) -> FlatPattern:
+    """Unroll one face given by an adapter (see module doc for the maps used).
+
+    Args:
+        face: the face's surface, bounds and wires.
+        best_effort: flatten a face that is not ruled / not developable within ``tol_deg``; a
+            non-ruled face is replaced by the ruled surface between its v0 and v1 (or u0, u1)
+            boundary isolines (the straighter direction whose isolines are open;
+            ``info["ruling_direction"]``), and the report measures the distortion against the
+            true face.
+        tol_deg: largest accepted ``θ_max`` in degrees (spec section 5).
+        rulings: interior rulings drawn as bend lines (clipped to the trimmed outline).
+        samples: points per boundary edge in the outline polylines.
+        units: length unit of the model.
+        label: panel label.
+
+    Returns:
+        FlatPattern with one panel: all wires of the face (outer + holes) mapped to the plane.
+
+    Raises:
+        NotDevelopableError: the face is not ruled (message gives the isolines' largest distance
+            from a straight line relative to their length, :func:`isoline_stats`; a closed isoline
+            gives about 0.159) or its θ_max exceeds ``tol_deg`` (message gives θ_max and DD), and
+            best_effort is False.
+        DegenerateGeometryError: best_effort on a non-ruled face whose isolines are closed in both
+            directions (a full torus): no open boundary isolines to span rulings between.
+    """
+    ev, bounds, kind = face.surface, face.bounds, face.surface.kind
+    info: dict[str, Any] = {"best_effort": bool(best_effort)}
+    ruled_dir: str | None
+    if kind == "plane":
+        dmap: Any = ClosedFormMap("plane")
+        ruled_dir = None
+        info["method"] = "plane (identity in plane coordinates)"
+    elif kind == "cylinder":
+        dmap = ClosedFormMap("cylinder", R=ev.radius)
+        ruled_dir = "v"
+        info["method"] = "cylinder (closed form)"
+    elif kind == "cone":
+        dmap = ClosedFormMap("cone", R=ev.radius, s=math.sin(ev.semi_angle))
+        ruled_dir = "v"
+        info["method"] = "cone (closed form)"
+    else:
+        ruled_dir, straight = ruling_direction(ev, bounds)
+        info.update(straight)
+        if ruled_dir is None:
+            if not best_effort:
+                raise NotDevelopableError(
+                    f"face {label!r} is not ruled: its isolines deviate from straight lines by "
+                    f"{straight['deviation_u']:.3g} (u-isolines) and {straight['deviation_v']:.3g} "
+                    "(v-isolines) relative to their lengths (allowed 1e-9; a closed isoline deviates "
+                    "0.159); pass best_effort=True to flatten the ruled surface between its boundary "
+                    "isolines with a distortion report"
+                )
+            ruled_dir = best_effort_direction(straight, label)
+        info["ruling_direction"] = ruled_dir
+        rs = FaceRuledSurface(ev, ruled_dir, bounds)
+        dd = _check_developable(rs, tol_deg, best_effort, f"face {label!r}")
+        info["developability"] = dd.as_dict()
+        dev = RuledDevelopment(rs, breakpoints=rs.breakpoints)
+        info["method"] = "quadrature along rulings (adaptive Chebyshev panels)"
+        info["panels"] = dev.panels
+        info["quadrature_error_estimate"] = dev.quadrature_error_estimate
+        dmap = _RuledFaceMap(rs, dev, ev, min(info["deviation_u"], info["deviation_v"]) <= 1e-9)
+    # boundary loops
+    loops = []
+    loops_uv = []
+    for wire in face.wires:
+        loop = []
+        loop_uv = []
+        for k, e in enumerate(wire):
+            duv = e.duv
+            if not hasattr(duv, "breaks"):
+                duv = _with_breaks(e.duv, e.breaks)
+            loop_uv.append((e.uv, duv))
+
+            def flat_fn(t: np.ndarray, uvf: Callable = e.uv) -> np.ndarray:
+                u, v = uvf(t)
+                return dmap.map(u, v)
+
+            name = e.name or f"edge{k}"
+            loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=e.xyz, length_3d=float(e.length_3d), samples=samples))
+        if loop:
+            loops.append(loop)
+            loops_uv.append(loop_uv)
+    # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
+    u0, u1, v0, v1 = bounds
+    bends = np.zeros((0, 2, 2))
+    g3 = gf = np.zeros(0)
+    if ruled_dir is not None:
+        tt = np.linspace(0.0, 1.0, 129)
+        tb = np.arange(1, rulings + 1) / (rulings + 1)
+
+        def ends(t: np.ndarray) -> tuple[np.ndarray, ...]:
+            if ruled_dir == "v":
+                uu = u0 + t * (u1 - u0)
+                return uu, np.full_like(t, v0), uu, np.full_like(t, v1)
+            vv = v0 + t * (v1 - v0)
+            return np.full_like(t, u0), vv, np.full_like(t, u1), vv
+
+        ua, va, ub, vb = ends(tt)
+        g3 = np.linalg.norm(ev.value(ub, vb) - ev.value(ua, va), axis=1)
+        gf = np.linalg.norm(dmap.map(ub, vb) - dmap.map(ua, va), axis=1)
+        if rulings:
+            ua, va, ub, vb = ends(tb)
+            bends = np.stack([dmap.map(ua, va), dmap.map(ub, vb)], axis=1)
+    area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"))
+    panel = FlatPanel(
+        label=label,
+        loops=loops,
+        bend_lines=bends,
+        ruling_lengths_3d=g3,
+        ruling_lengths_flat=gf,
+        area_3d=area_3d,
+        metric=_metric(ev, dmap.map, bounds),
+        info=info,
+        development=dmap,
+    )
+    measure_panel(panel)
+    # place: bounding box at the origin
+    lo, _ = panel.bbox()
+    panel.translate(-lo)
+    return FlatPattern([panel], units=units)
+
+
+def _with_breaks(duv: Callable[[np.ndarray], np.ndarray], breaks: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    def f(t: np.ndarray) -> np.ndarray:
+        return duv(t)
+
+    f.breaks = np.asarray(breaks, dtype=float)  # type: ignore[attr-defined]
+    return f
