@@ -1,10 +1,18 @@
-r"""Flat pattern (development) of a developable feature or ruled face, with bend lines (spec 6).
+r"""Flat pattern (development) of a developable feature or of any developable face, with bend lines (spec 6).
 
-The source is a developable feature of this workbench (its exact core surface is unrolled) or
-any face on a non-rational B-spline surface of degree 1 in one direction (a ruled face, e.g. one
-re-imported from STEP): its two boundary pole rows give ``a(u)`` and ``b(u)`` exactly.
-:func:`ght_cad.unroll` develops it by quadrature along the rulings (near machine precision);
-every boundary edge of the pattern is fitted as a planar B-spline edge (straight ones become
+The source is a developable feature of this workbench (its exact core ruled surface is unrolled
+by :func:`ght_cad.unroll`, quadrature along the rulings) or any face of any FreeCAD object whose
+surface is developable: the lateral face of a ``Part::Cylinder`` / ``Part::Cone`` (closed-form
+maps), a plane, a surface of extrusion, a ruled B-spline or Bézier face (``Part::RuledSurface``,
+re-imported STEP), trimmed or with holes. Faces go through the kernel-free
+:func:`ght_cad.face_unroll.unroll_face_data` (the same code that unrolls build123d/OCP faces)
+via the small adapter below (:func:`face_data`): FreeCAD's ``face.Surface`` evaluated with
+``value``/``getDN``, every wire (``OuterWire`` first) in ``OrderedEdges`` order with its pcurve
+``face.curveOnSurface(edge)``, the edges' 3-D curves and lengths. The face's real outline and
+holes are kept. Non-developable faces (sphere, torus, twisted loft) are refused with the
+isolines' deviation or θ_max / DD unless ``BestEffort``.
+
+Every boundary edge of the pattern is fitted as a planar B-spline edge (straight ones become
 line segments) and the interior rulings become bend-line edges. The shape is a compound of the
 planar face and the bend lines in the XY plane (move it with ``Placement``).
 """
@@ -18,59 +26,203 @@ import numpy as np
 import FreeCAD as App
 import Part
 
+from ght_cad.face_unroll import EdgeData, FaceData, SurfaceAdapter, chain_loop, fd_derivative, unroll_face_data
+
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only
 from .convert import edge_from_data
 
-__all__ = ["FlatPatternFeature", "make_flat_pattern", "surface_of_source", "ruled_surface_from_face"]
+__all__ = ["FlatPatternFeature", "make_flat_pattern", "surface_of_source", "face_of_source", "face_data", "FreeCADSurface"]
+
+_KINDS = {
+    "Plane": "plane",
+    "Cylinder": "cylinder",
+    "Cone": "cone",
+    "SurfaceOfExtrusion": "extrusion",
+    "BSplineSurface": "bspline",
+    "BezierSurface": "bezier",
+}
 
 
-def ruled_surface_from_face(face: "Part.Face") -> Any:
-    """Exact :class:`ght_cad.ruled.FunctionRuledSurface` of a ruled non-rational B-spline face.
+class FreeCADSurface(SurfaceAdapter):
+    """A FreeCAD ``face.Surface`` as :class:`ght_cad.face_unroll.SurfaceAdapter`.
+
+    ``kind`` from the surface's Python type, ``radius`` (``Radius``) and ``semi_angle``
+    (``SemiAngle``) for cylinders and cones, ``ruled_hint`` for B-spline/Bézier surfaces of degree
+    1 with 2 poles across; points by ``value(u, v)`` and partials by ``getDN(u, v, i, j)``
+    (location included: ``face.Surface`` is already placed).
+    """
+
+    def __init__(self, face: "Part.Face") -> None:
+        s = face.Surface
+        self.s = s
+        self.type_name = type(s).__name__
+        self.kind = _KINDS.get(self.type_name, "other")
+        if self.kind in ("cylinder", "cone"):
+            self.radius = float(s.Radius)
+        if self.kind == "cone":
+            self.semi_angle = float(s.SemiAngle)
+        if self.kind in ("bspline", "bezier"):
+            if s.VDegree == 1 and s.NbVPoles == 2:
+                self.ruled_hint = "v"
+            elif s.UDegree == 1 and s.NbUPoles == 2:
+                self.ruled_hint = "u"
+
+    def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        val = self.s.value
+        out = [tuple(val(a, b)) for a, b in zip(np.ravel(u).tolist(), np.ravel(v).tolist())]
+        return np.array(out, dtype=float).reshape(-1, 3)
+
+    def _dn(self, u: np.ndarray, v: np.ndarray, orders: tuple) -> list[np.ndarray]:
+        dn = self.s.getDN
+        uu, vv = np.ravel(u).tolist(), np.ravel(v).tolist()
+        return [np.array([tuple(dn(a, b, i, j)) for a, b in zip(uu, vv)], dtype=float).reshape(-1, 3) for i, j in orders]
+
+    def d1(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        return self._dn(u, v, ((1, 0), (0, 1)))
+
+    def d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        return [self.value(u, v)] + self._dn(u, v, ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1)))
+
+    def breaks(self, direction: str) -> np.ndarray:
+        s = self.s
+        if self.kind == "bspline":
+            return np.asarray(s.getUKnots() if direction == "u" else s.getVKnots(), dtype=float)
+        if self.kind == "extrusion" and direction == "u" and hasattr(s.BasisCurve, "getKnots"):
+            return np.asarray(s.BasisCurve.getKnots(), dtype=float)
+        if self.type_name == "SurfaceOfRevolution" and direction == "v" and hasattr(s.BasisCurve, "getKnots"):
+            return np.asarray(s.BasisCurve.getKnots(), dtype=float)
+        return np.zeros(0)
+
+    def periods(self) -> tuple[float, float]:
+        """(P_u, P_v), 0 for a non-periodic direction."""
+        s = self.s
+        return (float(s.UPeriod()) if s.isUPeriodic() else 0.0, float(s.VPeriod()) if s.isVPeriodic() else 0.0)
+
+
+class _Edge:
+    """One edge of a FreeCAD face: its pcurve ``face.curveOnSurface(edge)`` and 3-D curve, both as
+    functions of t ∈ [0, 1] (``reverse``: from the last parameter to the first), ``shift`` added
+    to (u, v) (a seam's other pcurve lies a period away)."""
+
+    def __init__(self, face: "Part.Face", edge: "Part.Edge", surface: FreeCADSurface) -> None:
+        cs = face.curveOnSurface(edge)
+        if not cs:
+            raise ValueError(f"an edge of the face has no curve on its surface (pcurve); cannot unroll it")
+        self.c2, p0, p1 = cs[0], float(cs[1]), float(cs[2])
+        self.p = (p0, p1)
+        self.degenerated = bool(edge.Degenerated)
+        self.edge, self.surface = edge, surface
+        self.q = tuple(float(x) for x in edge.ParameterRange)
+        self.reverse = edge.Orientation == "Reversed"
+        self.shift = np.zeros(2)
+        knots = np.asarray(self.c2.getKnots(), dtype=float) if hasattr(self.c2, "getKnots") else np.zeros(0)
+        tb = (knots - p0) / (p1 - p0) if p1 != p0 else np.zeros(0)
+        self._knots_t = np.sort(tb[(tb > 1e-12) & (tb < 1 - 1e-12)])
+
+    def _par(self, t: np.ndarray, rng: tuple) -> np.ndarray:
+        a, b = (rng[1], rng[0]) if self.reverse else rng
+        return a + np.asarray(t, dtype=float) * (b - a)
+
+    def ends(self) -> tuple[np.ndarray, np.ndarray]:
+        u, v = self.uv(np.array([0.0, 1.0]))
+        return np.array([u[0], v[0]]), np.array([u[1], v[1]])
+
+    def uv(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        val = self.c2.value
+        pts = np.array([(q.x, q.y) for q in (val(p) for p in np.ravel(self._par(t, self.p)).tolist())], dtype=float).reshape(-1, 2)
+        return pts[:, 0] + self.shift[0], pts[:, 1] + self.shift[1]
+
+    def duv(self, t: np.ndarray) -> np.ndarray:
+        return fd_derivative(lambda x: np.stack(self.uv(x), axis=1), t, self.breaks())
+
+    def breaks(self) -> np.ndarray:
+        return np.sort(1.0 - self._knots_t) if self.reverse else self._knots_t
+
+    def xyz(self, t: np.ndarray) -> np.ndarray:
+        if self.degenerated:  # no 3-D curve (a cone apex): the surface point of the pcurve
+            return self.surface.value(*self.uv(t))
+        at = self.edge.valueAt
+        return np.array([tuple(at(q)) for q in np.ravel(self._par(t, self.q)).tolist()], dtype=float).reshape(-1, 3)
+
+    def length(self) -> float:
+        if self.degenerated:
+            return 0.0
+        q0, q1 = self.q
+        try:  # adaptive Gauss (GCPnts_AbscissaPoint) with a tight tolerance; edge.Length uses 1e-7
+            return abs(float(self.edge.Curve.length(q0, q1, 1e-13)))
+        except Exception:  # noqa: BLE001 - curves without a length() binding
+            return float(self.edge.Length)
+
+
+def face_data(face: "Part.Face") -> FaceData:
+    """A FreeCAD face as :class:`ght_cad.face_unroll.FaceData` (the adapter of this workbench).
+
+    Wires: ``face.OuterWire`` first, then the other wires of ``face.Wires`` (holes), each in
+    ``OrderedEdges`` order; every edge's pcurve is traversed in its orientation and, on periodic
+    surfaces, shifted by whole periods so each loop is continuous in (u, v)
+    (:func:`ght_cad.face_unroll.chain_loop`) and lies in ``face.ParameterRange``.
 
     Raises:
-        ValueError: the face is not on a B-spline surface of degree 1 with 2 poles in u or v.
+        ValueError: an edge without a pcurve.
     """
-    from ght_cad.bspline import BSplineCurveData
-    from ght_cad.ruled import FunctionRuledSurface
-
-    surf = face.Surface
-    if not isinstance(surf, Part.BSplineSurface):
-        surf = face.toNurbs().Faces[0].Surface
-    if surf.isURational() or surf.isVRational():
-        raise ValueError("rational B-spline faces are not supported; convert to a non-rational ruled face")
-    poles = np.array([[[p.x, p.y, p.z] for p in row] for row in surf.getPoles()])
-
-    def full(knots: list, mults: list) -> np.ndarray:
-        k = np.repeat(np.asarray(knots, dtype=float), np.asarray(mults, dtype=int))
-        return (k - k[0]) / (k[-1] - k[0])
-
-    if surf.VDegree == 1 and surf.NbVPoles == 2:
-        knots, degree = full(surf.getUKnots(), surf.getUMultiplicities()), surf.UDegree
-        rows = poles[:, 0], poles[:, 1]
-    elif surf.UDegree == 1 and surf.NbUPoles == 2:
-        knots, degree = full(surf.getVKnots(), surf.getVMultiplicities()), surf.VDegree
-        rows = poles[0], poles[1]
-    else:
-        raise ValueError(
-            f"the face is not ruled: B-spline degrees ({surf.UDegree}, {surf.VDegree}) with "
-            f"{surf.NbUPoles}x{surf.NbVPoles} poles; need degree 1 with 2 poles in one direction"
+    surf = FreeCADSurface(face)
+    u0, u1, v0, v1 = (float(x) for x in face.ParameterRange)
+    periods = surf.periods()
+    tol = 1e-6 * max(1.0, abs(u1 - u0), abs(v1 - v0))
+    outer = face.OuterWire
+    wires = [outer] + [w for w in face.Wires if not w.isSame(outer)]
+    loops = []
+    for w in wires:
+        edges = [_Edge(face, e, surf) for e in w.OrderedEdges]
+        if not edges:
+            continue
+        for e, (rev, shift) in zip(edges, chain_loop([e.ends() for e in edges], periods, tol)):
+            if rev:
+                e.reverse = not e.reverse
+            e.shift = np.asarray(shift, dtype=float)
+        # the whole loop into the face's parameter range (periodic directions)
+        pts = np.concatenate([np.stack(e.uv(np.linspace(0.0, 1.0, 5)), axis=1) for e in edges])
+        for i, (lo, P) in enumerate(((u0, periods[0]), (v0, periods[1]))):
+            if P > 0:
+                k = np.floor((pts[:, i].min() - lo + tol) / P)
+                for e in edges:
+                    e.shift[i] -= k * P
+        loops.append(
+            [EdgeData(uv=e.uv, duv=e.duv, xyz=e.xyz, length_3d=e.length(), breaks=e.breaks(), name=f"edge{k}") for k, e in enumerate(edges)]
         )
-    da, db = BSplineCurveData(rows[0], knots, degree), BSplineCurveData(rows[1], knots, degree)
-    return FunctionRuledSurface(lambda u, r: da.evaluate(u, r), lambda u, r: db.evaluate(u, r))
+    return FaceData(surface=surf, bounds=(u0, u1, v0, v1), wires=loops)
 
 
-def surface_of_source(obj: Any) -> Any:
-    """Core ruled surface of the flat pattern's ``Source`` (feature proxy surface, else the face)."""
+def face_of_source(obj: Any) -> "Part.Face | None":
+    """The face the flat pattern unrolls: the linked sub-element, the single face of the Source,
+    or None when the Source is a developable feature of this workbench (its core surface is used).
+
+    Raises:
+        ValueError: no Source, or a Source with several faces and no face selected.
+    """
     src, subs = obj.Source if obj.Source else (None, [])
     if src is None:
         raise ValueError(f"{obj.Label}: no Source linked")
     subs = [s for s in (subs or []) if s]
     if not subs and hasattr(getattr(src, "Proxy", None), "surface"):
-        return src.Proxy.surface(src)
-    face = src.Shape.getElement(subs[0]) if subs else (src.Shape.Faces[0] if len(src.Shape.Faces) == 1 else None)
-    if face is None:
-        raise ValueError(f"{src.Label} has {len(src.Shape.Faces)} faces; select one face")
-    return ruled_surface_from_face(face)
+        return None
+    if subs:
+        return src.Shape.getElement(subs[0])
+    if len(src.Shape.Faces) == 1:
+        return src.Shape.Faces[0]
+    raise ValueError(f"{src.Label} has {len(src.Shape.Faces)} faces; select one face")
+
+
+def surface_of_source(obj: Any) -> Any:
+    """Core ruled surface of a Source that is a developable feature of this workbench
+    (``Source.Proxy.surface``).
+
+    Raises:
+        ValueError: the Source is a face, not a developable feature (see :func:`face_of_source`).
+    """
+    if face_of_source(obj) is not None:
+        raise ValueError(f"{obj.Label}: the Source is a face, not a developable feature; use face_data(face)")
+    return obj.Source[0].Proxy.surface(obj.Source[0])
 
 
 def _planar_edge(f: Callable[[np.ndarray], np.ndarray], tol: float) -> "Part.Edge":
@@ -96,7 +248,7 @@ class FlatPatternFeature(FeatureProxy):
     Type = "GHT::FlatPattern"
 
     def setup(self, obj: Any) -> None:
-        obj.addProperty("App::PropertyLinkSub", "Source", "Input", "A developable feature, or a ruled B-spline face")
+        obj.addProperty("App::PropertyLinkSub", "Source", "Input", "A developable feature, or any developable face (plane, cylinder, cone, extrusion, ruled B-spline)")
         obj.addProperty("App::PropertyInteger", "BendLines", "Input", "Number of interior rulings drawn as bend lines")
         obj.BendLines = 8
         obj.addProperty("App::PropertyBool", "BestEffort", "Input", "Flatten even if the source is not developable (see MaxRelativeError)")
@@ -112,7 +264,13 @@ class FlatPatternFeature(FeatureProxy):
         """The core :class:`ght_cad.flat_pattern.FlatPattern` of the source."""
         from ght_cad import unroll
 
-        return unroll(surface_of_source(obj), rulings=max(int(obj.BendLines), 0), best_effort=bool(obj.BestEffort), samples=65)
+        opts = dict(rulings=max(int(obj.BendLines), 0), best_effort=bool(obj.BestEffort), samples=65)
+        face = face_of_source(obj)
+        if face is None:
+            return unroll(surface_of_source(obj), **opts)
+        src, subs = obj.Source
+        label = src.Label + "".join(f".{x}" for x in (subs or [])[:1] if x)
+        return unroll_face_data(face_data(face), label=label, **opts)
 
     def compute(self, obj: Any) -> None:
         pat = self.pattern(obj)
@@ -123,7 +281,11 @@ class FlatPatternFeature(FeatureProxy):
         for panel in pat.panels:
             wires = []
             for loop in panel.loops:
-                edges = [_planar_edge(lambda t, e=e, off=panel.offset: np.asarray(e.flat_fn(t), float) + off, tol) for e in loop]
+                edges = [
+                    _planar_edge(lambda t, e=e, off=panel.offset: np.asarray(e.flat_fn(t), float) + off, tol)
+                    for e in loop
+                    if np.ptp(e.flat, axis=0).max() > tol  # a degenerate edge (cone apex) is a point
+                ]
                 wires.append(Part.Wire(edges))
             face = Part.Face(wires[0])
             if len(wires) > 1:
@@ -164,8 +326,9 @@ class CommandFlatPattern(BaseCommand):
     icon_name = "GHT_FlatPattern"
     menu_text = "Flat pattern"
     tooltip = (
-        "Unroll the selected developable feature or ruled face into a planar face with bend lines "
-        "(exact development by quadrature along the rulings); errors vs 3-D in MaxRelativeError."
+        "Unroll the selected developable feature or developable face (cylinder, cone, plane, "
+        "extrusion, ruled B-spline; trimmed outline and holes kept) into a planar face with bend "
+        "lines (closed forms or exact quadrature along the rulings); errors vs 3-D in MaxRelativeError."
     )
 
     def IsActive(self) -> bool:
