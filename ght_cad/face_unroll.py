@@ -296,12 +296,14 @@ def face_area(ev: SurfaceAdapter, edges_uv: list[list[tuple[Callable, Callable]]
         u_breaks: the surface's u breaks.
 
     Returns:
-        The absolute value of the signed total over all loops (orientation-free).
+        ``|I_0| - Σ_{k≥1} |I_k|`` where ``I_k = ∮_{loop k} P dv`` (the first loop is the outer
+        one, the others holes): independent of the loops' orientations.
     """
     xg, wg = np.polynomial.legendre.leggauss(12)
-    total = 0.0
+    totals = []
     u_breaks = np.asarray(u_breaks, dtype=float)
     for loop in edges_uv:
+        total = 0.0
         for uvf, duv in loop:
             te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
             tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
@@ -327,7 +329,8 @@ def face_area(ev: SurfaceAdapter, edges_uv: list[list[tuple[Callable, Callable]]
             f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
             P = np.bincount(own, weights=f * w_all, minlength=tn.size)
             total += float(np.sum(P * dv * tw))
-    return abs(total)
+        totals.append(abs(total))
+    return totals[0] - sum(totals[1:]) if totals else 0.0
 
 
 def fd_derivative(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, breaks: Sequence[float] = (), h: float = 1e-4) -> np.ndarray:
@@ -382,7 +385,9 @@ def chain_loop(
         tol: matching tolerance in (u, v).
 
     Returns:
-        Per edge ``(reverse, shift)``. Edges that cannot be matched are kept as given.
+        Per edge ``(reverse, shift)`` (an edge matching both ways, e.g. a closed isoline spanning a
+        whole period, takes the smaller shift, then its given direction). Edges that cannot be
+        matched are kept as given.
     """
     P = np.asarray(periods, dtype=float)
 
@@ -405,18 +410,17 @@ def chain_loop(
             a0, b0 = b0, a0
     cur = b0
     for a, b in ends[1:]:
-        s = shift_to(a, cur)
-        if s is not None:
-            out.append((False, s))
-            cur = b + s
-            continue
-        s = shift_to(b, cur)
-        if s is not None:
-            out.append((True, s))
-            cur = a + s
-            continue
-        out.append((False, np.zeros(2)))
-        cur = b
+        fwd, rev = shift_to(a, cur), shift_to(b, cur)
+        # an edge spanning a whole period matches both ways: prefer the smaller shift, then forward
+        if rev is not None and (fwd is None or np.abs(rev).sum() < np.abs(fwd).sum()):
+            out.append((True, rev))
+            cur = a + rev
+        elif fwd is not None:
+            out.append((False, fwd))
+            cur = b + fwd
+        else:
+            out.append((False, np.zeros(2)))
+            cur = b
     return out
 
 
