@@ -34,6 +34,7 @@ import argparse
 import json
 import math
 import os
+import signal
 import sys
 import traceback
 from pathlib import Path
@@ -705,13 +706,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help(sys.stderr)
         return EXIT_USAGE
-    if not getattr(args, "json", False):
-        return _dispatch(args)
-    saved = _redirect_stdout_to_stderr()
+    previous = _watch_sigint()
     try:
-        code = _dispatch(args)
+        if not getattr(args, "json", False):
+            return _dispatch(args)
+        saved = _redirect_stdout_to_stderr()
+        try:
+            code = _dispatch(args)
+        finally:
+            _restore_stdout(saved)
     finally:
-        _restore_stdout(saved)
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
     out = getattr(args, "_json_out", None)
     if out is None:  # a command that returned without a result: still one JSON object
         out = dumps({"ok": code == EXIT_OK, "exit_code": code})
@@ -754,6 +760,35 @@ def _restore_stdout(saved: int | None) -> None:
     os.close(saved)
 
 
+#: Set by the SIGINT handler of :func:`_watch_sigint`: a Ctrl-C arrived during this run.
+_SIGINT_SEEN = [False]
+
+
+def _watch_sigint() -> Any:
+    """Remember that Ctrl-C arrived, then raise KeyboardInterrupt as Python's default handler does.
+
+    A Ctrl-C that lands while a C++ extension (OCP) is being imported can surface later as an
+    unrelated ImportError of the half-initialized module; with this flag :func:`_dispatch` still
+    reports "interrupted" with exit code 130. Installed only over Python's default handler
+    (a shell that starts the command with SIGINT ignored keeps it ignored). Returns the handler
+    to restore afterwards (None if nothing was installed).
+    """
+    _SIGINT_SEEN[0] = False
+    try:
+        previous = signal.getsignal(signal.SIGINT)
+        if previous is not signal.default_int_handler:
+            return None
+
+        def handler(signum: int, frame: Any) -> None:
+            _SIGINT_SEEN[0] = True
+            signal.default_int_handler(signum, frame)
+
+        signal.signal(signal.SIGINT, handler)
+        return previous
+    except ValueError:  # pragma: no cover - not the main thread (embedded use)
+        return None
+
+
 def _dispatch(args: argparse.Namespace) -> int:
     """Run ``args.func`` and map exceptions to exit codes (one line on stderr each)."""
     try:
@@ -771,6 +806,8 @@ def _dispatch(args: argparse.Namespace) -> int:
     except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         return _fail(args, EXIT_USAGE, f"{exc.strerror or exc}: {exc.filename}")
     except Exception as exc:  # noqa: BLE001 - exit code 1 for every internal failure
+        if _SIGINT_SEEN[0]:  # e.g. an ImportError of a module Ctrl-C cut off half-way
+            return _fail(args, EXIT_INTERRUPTED, "interrupted")
         if os.environ.get("GHT_CAD_DEBUG"):
             traceback.print_exc()
         return _fail(args, EXIT_FAILURE, f"internal failure: {type(exc).__name__}: {exc} (set GHT_CAD_DEBUG=1 for a traceback)")

@@ -337,3 +337,29 @@ def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
     monkeypatch.undo()
     assert main(["unroll", str(duct), "--dxf", str(dxf), "--svg", str(svg), "--png", str(png)]) == 0
     assert dxf.stat().st_size > 0 and svg.read_text() != "old" and png.stat().st_size > 0
+
+
+def test_ctrl_c_that_surfaces_as_another_error_still_exits_130(monkeypatch, capsys) -> None:
+    """A Ctrl-C that lands inside an extension's import can surface later as an ImportError of the
+    half-initialized module (seen with OCP): the run still reports "interrupted", exit 130, and the
+    SIGINT handler is restored afterwards."""
+    import os
+    import signal
+
+    from ght_cad import cli
+
+    def interrupted_import(args):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)  # the handler raises KeyboardInterrupt here
+        except KeyboardInterrupt:
+            pass  # swallowed half-way, as inside a module initializer
+        raise ImportError('generic_type: cannot initialize type "X": an object with that name is already defined')
+
+    monkeypatch.setattr(cli, "cmd_plot_basis", interrupted_import)
+    before = signal.getsignal(signal.SIGINT)
+    assert cli.main(["plot-basis", "--out", "b.png", "--json"]) == cli.EXIT_INTERRUPTED
+    assert json.loads(capsys.readouterr().out) == {"ok": False, "error": "interrupted", "exit_code": 130}
+    assert signal.getsignal(signal.SIGINT) is before
+    # the same ImportError without a Ctrl-C is an internal failure
+    monkeypatch.setattr(cli, "cmd_plot_basis", lambda args: (_ for _ in ()).throw(ImportError("boom")))
+    assert cli.main(["plot-basis", "--out", "b.png"]) == cli.EXIT_FAILURE
