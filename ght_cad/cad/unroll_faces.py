@@ -281,31 +281,23 @@ def unroll_face(
     units: str = "mm",
     label: str = "P1",
 ) -> FlatPattern:
-    """Unroll one build123d/cadquery/OCP face (see module doc for the maps used).
+    """Unroll one build123d/cadquery/OCP face by :func:`ght_cad.face_unroll.unroll_face_data`
+    (closed forms for plane/cylinder/cone, quadrature along the rulings otherwise; see module doc).
 
     Args:
         face: a Face (build123d, cadquery) or TopoDS_Face (or a shape holding exactly one face).
-        best_effort: flatten a face that is not ruled / not developable within ``tol_deg``; a
-            non-ruled face is replaced by the ruled surface between its v0 and v1 (or u0, u1)
-            boundary isolines (the straighter direction whose isolines are open;
-            ``info["ruling_direction"]``), and the report measures the distortion against the
-            true face.
-        tol_deg: largest accepted ``θ_max`` in degrees (spec section 5).
-        rulings: interior rulings drawn as bend lines (clipped to the trimmed outline).
-        samples: points per boundary edge in the outline polylines.
-        units: length unit of the model.
-        label: panel label.
+        best_effort, tol_deg, rulings, samples, units, label: as for
+            :func:`ght_cad.face_unroll.unroll_face_data` (flatten a non-developable face with a
+            distortion report; largest θ_max in degrees; bend lines; points per edge; length
+            unit; panel label).
 
     Returns:
         FlatPattern with one panel: all wires of the face (outer + holes) mapped to the plane.
 
     Raises:
-        NotDevelopableError: the face is not ruled (message gives the isolines' largest distance
-            from a straight line relative to their length, :func:`_isoline_stats`; a closed isoline
-            gives about 0.159) or its θ_max exceeds ``tol_deg`` (message gives θ_max and DD), and
-            best_effort is False.
-        DegenerateGeometryError: best_effort on a non-ruled face whose isolines are closed in both
-            directions (a full torus): no open boundary isolines to span rulings between.
+        NotDevelopableError: not ruled (isoline deviation in the message) or θ_max > tol_deg
+            (θ_max and DD in the message), unless best_effort.
+        DegenerateGeometryError: best_effort on a face whose isolines are all closed (a torus).
         GHTError: not a face, or a shape with several faces.
     """
     f, _, bounds, ev = _open_face(face)

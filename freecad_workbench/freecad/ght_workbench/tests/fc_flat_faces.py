@@ -24,6 +24,7 @@ import FreeCAD as App
 import Part
 
 from freecad.ght_workbench import flat_pattern
+from freecad.ght_workbench.tests.fc_features import _reopen  # save, close, reopen, recompute (into $GHT_FC_OUT)
 from ght_cad.errors import NotDevelopableError
 from ght_cad.face_unroll import unroll_face_data
 
@@ -63,20 +64,6 @@ def _record(name: str, face, pat, fp=None) -> None:
     }
     with open(RESULTS_JSON, "w") as fh:
         json.dump(data, fh, indent=1)
-
-
-def _reopen(doc):
-    path = os.path.join(OUT, doc.Name + ".FCStd")
-    doc.saveAs(path)
-    App.closeDocument(doc.Name)
-    doc2 = App.openDocument(path)
-    for o in doc2.Objects:
-        o.touch()
-    doc2.recompute()
-    bad = [o.Name for o in doc2.Objects if "Invalid" in o.State or "Error" in o.State]
-    if bad:
-        raise AssertionError(f"objects in error after reopening {path}: {bad}")
-    return doc2
 
 
 class FlatFacesTest(unittest.TestCase):
