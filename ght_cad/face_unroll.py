@@ -281,19 +281,28 @@ def best_effort_direction(info: dict[str, float], label: str) -> str:
     )
 
 
-def face_area(ev: SurfaceAdapter, edges_uv: list[list[tuple[Callable, Callable]]], u_lo: float, u_breaks: np.ndarray) -> float:
+def face_area(
+    ev: SurfaceAdapter,
+    edges_uv: list[list[tuple[Callable, Callable]]],
+    u_lo: float,
+    u_breaks: np.ndarray,
+    u_span: float | None = None,
+) -> float:
     r"""3-D area ``∬_Ω |S_u × S_v| du dv`` of a trimmed face by Green's theorem in (u, v).
 
     ``∬_Ω f du dv = ∮_{∂Ω} P dv`` with ``P(u, v) = ∫_{u_lo}^{u} f(s, v) ds``: the outer integral by
     16 × 12-point Gauss–Legendre panels along each pcurve (split at the pcurve's knots, the
-    ``breaks`` attribute of ``duv``), the inner one by 2 × 12-point panels per interval between
-    ``u_breaks`` (the surface's knots), i.e. exact up to the smoothness of ``f``.
+    ``breaks`` attribute of ``duv``), the inner one by 12-point panels, at least 2 per interval
+    between ``u_breaks`` (the surface's knots) and none wider than ``u_span / 8`` (an analytic
+    but non-polynomial ``f``, e.g. an extruded ellipse over its whole period), i.e. exact up to
+    the smoothness of ``f``.
 
     Args:
         ev: the surface (``d1``).
         edges_uv: per loop, per edge ``(t -> (u, v), t -> (u', v'))``.
         u_lo: lower limit of the inner integral (any u; the face's u0).
         u_breaks: the surface's u breaks.
+        u_span: the face's u range ``u1 - u0`` (None: no width limit for the inner panels).
 
     Returns:
         ``|I_0| - Σ_{k≥1} |I_k|`` where ``I_k = ∮_{loop k} P dv`` (the first loop is the outer
@@ -318,6 +327,10 @@ def face_area(ev: SurfaceAdapter, edges_uv: list[list[tuple[Callable, Callable]]
                 sign = 1.0 if ui >= u_lo else -1.0
                 br = u_breaks[(u_breaks > lo) & (u_breaks < hi)]
                 ed = np.unique(np.concatenate([[lo, hi], br, 0.5 * (np.concatenate([[lo], br]) + np.concatenate([br, [hi]]))]))
+                if u_span:
+                    n = np.maximum(1, np.ceil(np.diff(ed) * 8.0 / abs(u_span))).astype(int)
+                    if n.size and n.max() > 1:
+                        ed = np.concatenate([np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(ed[:-1], ed[1:], n)] + [ed[-1:]])
                 h = 0.5 * np.diff(ed)
                 s = ((ed[:-1] + h)[:, None] + h[:, None] * xg[None, :]).ravel()
                 S.append(s)
@@ -581,7 +594,7 @@ def unroll_face_data(
         if rulings:
             ua, va, ub, vb = ends(tb)
             bends = np.stack([dmap.map(ua, va), dmap.map(ub, vb)], axis=1)
-    area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"))
+    area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"), u1 - u0)
     panel = FlatPanel(
         label=label,
         loops=loops,

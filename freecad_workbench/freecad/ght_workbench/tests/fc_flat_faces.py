@@ -288,6 +288,27 @@ class FlatFacesTest(unittest.TestCase):
         self.assertAlmostEqual(pat2.area, face.Area, delta=1e-6 * face.Area)
         _record("extrusion_cut", face, pat2, fp2)
 
+    def test_closed_elliptic_extrusion(self):
+        """Part::Extrusion of a Part::Ellipse (10 x 5) by 15: a closed surface of extrusion, its
+        pattern a 15 × perimeter rectangle (FreeCAD's own face.Area is 3e-5 off here)."""
+        el = self.doc.addObject("Part::Ellipse", "Ellipse")
+        el.MajorRadius, el.MinorRadius = 10.0, 5.0
+        ext = self.doc.addObject("Part::Extrusion", "Tube")
+        ext.Base = el
+        ext.DirMode = "Custom"
+        ext.Dir = App.Vector(0, 0, 1)
+        ext.LengthFwd = 15.0
+        ext.Solid = False
+        self.doc.recompute()
+        fp = flat_pattern.make_flat_pattern(ext, "Face1", doc=self.doc)
+        self.assertTrue(fp.Shape.isValid())
+        pat = _pattern(fp)
+        perimeter = quad(lambda u: math.hypot(10 * math.sin(u), 5 * math.cos(u)), 0, 2 * math.pi, epsabs=0, epsrel=1e-13, limit=200)[0]
+        np.testing.assert_allclose(np.sort(np.ptp(pat.outlines[0], axis=0)), [15.0, perimeter], rtol=RTOL)
+        self.assertAlmostEqual(pat.area, 15.0 * perimeter, delta=RTOL * 15.0 * perimeter)
+        self.assertAlmostEqual(fp.Area3D, 15.0 * perimeter, delta=RTOL * 15.0 * perimeter)
+        self.assertLess(pat.errors["max"], 1e-12)
+
     def test_ruled_surface_is_unrolled(self):
         """Part::RuledSurface between two parallel circles (an oblique cone: developable)."""
         c1 = self.doc.addObject("Part::Circle", "C1")
