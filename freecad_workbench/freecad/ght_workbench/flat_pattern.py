@@ -107,7 +107,7 @@ class _Edge:
     def __init__(self, face: "Part.Face", edge: "Part.Edge", surface: FreeCADSurface) -> None:
         cs = face.curveOnSurface(edge)
         if not cs:
-            raise ValueError(f"an edge of the face has no curve on its surface (pcurve); cannot unroll it")
+            raise ValueError("an edge of the face has no curve on its surface (pcurve); cannot unroll it")
         self.c2, p0, p1 = cs[0], float(cs[1]), float(cs[2])
         self.p = (p0, p1)
         self.degenerated = bool(edge.Degenerated)

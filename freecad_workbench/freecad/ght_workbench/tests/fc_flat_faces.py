@@ -79,6 +79,17 @@ class FlatFacesTest(unittest.TestCase):
         c.Radius, c.Height = r, h
         return c
 
+    def _extrusion(self, base, length, name):
+        """A Part::Extrusion of ``base`` along +z by ``length`` (a sheet, not a solid), recomputed."""
+        ext = self.doc.addObject("Part::Extrusion", name)
+        ext.Base = base
+        ext.DirMode = "Custom"
+        ext.Dir = App.Vector(0, 0, 1)
+        ext.LengthFwd = length
+        ext.Solid = False
+        self.doc.recompute()
+        return ext
+
     def test_cylinder_lateral_face_is_rectangle_and_survives_reopen(self):
         cyl = self._cylinder(10.0, 20.0)
         self.doc.recompute()
@@ -256,13 +267,7 @@ class FlatFacesTest(unittest.TestCase):
         L = sp.length(sp.FirstParameter, sp.LastParameter, 1e-13)
         base = self.doc.addObject("Part::Feature", "Profile")
         base.Shape = sp.toShape()
-        ext = self.doc.addObject("Part::Extrusion", "Extrusion")
-        ext.Base = base
-        ext.DirMode = "Custom"
-        ext.Dir = App.Vector(0, 0, 1)
-        ext.LengthFwd = 25.0
-        ext.Solid = False
-        self.doc.recompute()
+        ext = self._extrusion(base, 25.0, "Extrusion")
         self.assertEqual(type(ext.Shape.Faces[0].Surface).__name__, "SurfaceOfExtrusion")
         fp = flat_pattern.make_flat_pattern(ext, "Face1", doc=self.doc)
         pat = _pattern(fp)
@@ -293,13 +298,7 @@ class FlatFacesTest(unittest.TestCase):
         pattern a 15 × perimeter rectangle (FreeCAD's own face.Area is 3e-5 off here)."""
         el = self.doc.addObject("Part::Ellipse", "Ellipse")
         el.MajorRadius, el.MinorRadius = 10.0, 5.0
-        ext = self.doc.addObject("Part::Extrusion", "Tube")
-        ext.Base = el
-        ext.DirMode = "Custom"
-        ext.Dir = App.Vector(0, 0, 1)
-        ext.LengthFwd = 15.0
-        ext.Solid = False
-        self.doc.recompute()
+        ext = self._extrusion(el, 15.0, "Tube")
         fp = flat_pattern.make_flat_pattern(ext, "Face1", doc=self.doc)
         self.assertTrue(fp.Shape.isValid())
         pat = _pattern(fp)
