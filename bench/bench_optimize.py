@@ -6,12 +6,14 @@ iteration budget; prints best / median / worst value, mean evaluations, median w
 evaluations each method needs to reach the same value (``f_best + 1e-3 (f_init - f_best)``: 99.9 %
 of the achievable improvement, see :mod:`ght_cad.optimize.compare`), with the ratio to
 differential_evolution (< 1: fewer evaluations than DE).
-Then times one full run (6 parameters, 30 agents, 200 iterations) of each method on the strip
+Then, for problems 1-3, each method at its best population and (PSO, I-GWO) schedule length
+(:func:`ght_cad.optimize.compare.budget_sweep`; skip with ``--no-sweep``, it takes minutes), and
+times one full run (6 parameters, 30 agents, 200 iterations) of each method on the strip
 problem against the 2 s target, and a Pareto front of (AL, En, CVEn).
 
 Usage::
 
-    python bench/bench_optimize.py [--seeds 10] [--iters 200] [--pop 30] [--out DIR]
+    python bench/bench_optimize.py [--seeds 10] [--iters 200] [--pop 30] [--out DIR] [--no-sweep]
 
 With ``--out`` it also writes ``comparison.md`` and convergence PNGs there.
 """
@@ -27,10 +29,14 @@ import numpy as np
 
 from ght_cad.io import write_text_atomic
 from ght_cad.optimize import METHODS
-from ght_cad.optimize.compare import compare, format_table, set_target
+from ght_cad.optimize.compare import budget_sweep, compare, format_table, set_target
 from ght_cad.optimize.pareto import pareto_front
 from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
 from ght_cad.progress import Progress
+
+
+SWEEP_POPS = (8, 10, 15, 20, 30)
+SWEEP_ITERS = (7, 10, 14, 20, 28, 40, 56, 80, 113, 160, 226)
 
 
 def rastrigin(X: np.ndarray) -> np.ndarray:
@@ -69,6 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--iters", type=int, default=200)
     ap.add_argument("--pop", type=int, default=30)
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--no-sweep", dest="sweep", action="store_false",
+                    help="skip the population x schedule sweep (the slowest part, a few minutes)")
     args = ap.parse_args(argv)
 
     strip = default_strip_problem()
@@ -146,28 +154,34 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  {name:30s} DE-default nfev to target {med:.0f} ({reached}/{len(seeds)}): "
               + ", ".join(rcell(m) for m in ("igwo", "pso", "gwo")))
 
-    print("\n## PSO and I-GWO with their schedules tied to the budget: the smallest max_iter (pop 30) whose")
-    print("## median final value reaches the same target (rtol 1e-3), in evaluations, against DE's median")
-    for name, (fun, bounds) in problems.items():
-        if name.startswith(("rastrigin", "rosenbrock")):
-            continue
-        rs = [r for r in rows if r.problem == name]
-        target = set_target(rs, 1e-3)
-        de_n = {r.method: r for r in rs}["de"].nfev_to_target
-        cells = []
-        for m in ("pso", "igwo"):
-            found = None
-            for it in (10, 15, 20, 30, 40, 50, 75, 100, 150, 200):
-                runs = [METHODS[m](fun, bounds, pop_size=args.pop, max_iter=it, seed=s) for s in seeds]
-                if np.median([r.fun for r in runs]) <= target:
-                    found = (it, float(np.median([r.nfev for r in runs])))
-                    break
-            if found is None:
-                cells.append(f"{m} never (max_iter <= 200)")
-            else:
-                ratio = f", ratio {found[1] / de_n:.2f}" if np.isfinite(de_n) else ""
-                cells.append(f"{m} max_iter {found[0]}: {found[1]:.0f} evaluations{ratio}")
-        print(f"  {name:30s} DE {de_n:.0f}: " + "; ".join(cells))
+    if args.sweep:
+        print("\n## each method at its best population and schedule (budget_sweep): fewest median evaluations")
+        print(f"## to reach the same target (rtol 1e-3) over pop_size {list(SWEEP_POPS)} x max_iter {list(SWEEP_ITERS)}")
+        print("## (DE has no schedule: population sweep only); ratio to DE's best (< 1 = fewer)")
+        verdicts = []
+        for name, (fun, bounds) in problems.items():
+            if name.startswith(("rastrigin", "rosenbrock")):
+                continue
+            rs = [r for r in rows if r.problem == name]
+            target = set_target(rs, 1e-3)
+            sw = {m: budget_sweep(fun, bounds, m, target, pop_sizes=SWEEP_POPS,
+                                  max_iters=(max(SWEEP_ITERS),) if m == "de" else SWEEP_ITERS, seeds=seeds)
+                  for m in ("de", "pso", "igwo")}
+            de_n = sw["de"].nfev
+
+            def scell(m: str) -> str:
+                r = sw[m]
+                if not np.isfinite(r.nfev):
+                    return f"{m} never"
+                where = f"pop {r.pop_size}" + ("" if m == "de" else f", max_iter {r.max_iter}")
+                ratio = f" = {r.nfev / de_n:.2f} DE" if np.isfinite(de_n) and m != "de" else ""
+                return f"{m} {r.nfev:.0f} ({where}){ratio}"
+
+            ok = all(np.isfinite(sw[m].nfev) and (not np.isfinite(de_n) or sw[m].nfev < de_n) for m in ("pso", "igwo"))
+            verdicts.append(ok)
+            print(f"  {name:30s} " + "; ".join(scell(m) for m in ("de", "pso", "igwo"))
+                  + f"   I-GWO and PSO fewer: {'yes' if ok else 'NO'}")
+        print(f"  target met on {sum(verdicts)} of {len(verdicts)} problems")
 
     print("\n## problem 1 (strip) before/after, best I-GWO run; problem 2 surfaces stay developable")
     best = min((r for r in rows if r.problem.startswith("strip") and r.method == "igwo"), key=lambda r: r.best)

@@ -10,7 +10,7 @@ import pytest
 
 from ght_cad.errors import GHTError
 from ght_cad.optimize import igwo, pso
-from ght_cad.optimize.compare import compare, format_table
+from ght_cad.optimize.compare import budget_sweep, compare, format_table
 from ght_cad.optimize.pipeline import optimize_design
 from ght_cad.optimize.plots import plot_convergence, plot_pareto
 from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
@@ -81,6 +81,28 @@ def test_compare_table_and_target():
         format_table(rows, "html")
     with pytest.raises(GHTError, match="'nelder'"):
         compare({"s": (sphere, (-np.ones(2), np.ones(2)))}, ("nelder",))
+
+
+def test_budget_sweep_takes_the_best_grid_point():
+    sphere = lambda X: np.sum((X - 0.3) ** 2, axis=1)  # noqa: E731
+    b = (-np.ones(2), np.ones(2))
+    sw = budget_sweep(sphere, b, "pso", 1e-4, pop_sizes=(6, 10), max_iters=(5, 40), seeds=(0, 1, 2))
+    assert set(sw.table) == {(6, 5), (6, 40), (10, 5), (10, 40)}
+    assert sw.nfev == min(sw.table.values()) and sw.table[(sw.pop_size, sw.max_iter)] == sw.nfev
+    # one grid point recomputed by hand: median over seeds of the first hit (inf if never)
+    hits = []
+    for s in (0, 1, 2):
+        h = pso(sphere, b, pop_size=10, max_iter=40, seed=s).nfev_to_reach(1e-4)
+        hits.append(math.inf if h is None else h)
+    assert sw.table[(10, 40)] == float(np.median(hits))
+    # 5 iterations of 6 particles (36 evaluations) cannot reach 1e-4 on all seeds; 40 iterations can
+    assert sw.table[(6, 5)] == sw.table[(10, 5)] == math.inf and math.isfinite(sw.nfev) and sw.max_iter == 40
+    never = budget_sweep(sphere, b, "igwo", -1.0, pop_sizes=(6,), max_iters=(5,), seeds=(0,))
+    assert never.nfev == math.inf and never.pop_size is None
+    with pytest.raises(GHTError, match="'nelder'"):
+        budget_sweep(sphere, b, "nelder", 0.0)
+    with pytest.raises(GHTError, match="at least one"):
+        budget_sweep(sphere, b, "pso", 0.0, pop_sizes=())
 
 
 def test_plots_are_png(tmp_path):

@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import GHTError
 from .optimizers import METHODS, OptimizeResult
 
-__all__ = ["MethodStats", "compare", "format_table", "set_target"]
+__all__ = ["MethodStats", "BudgetSweep", "budget_sweep", "compare", "format_table", "set_target"]
 
 
 @dataclass
@@ -157,3 +157,80 @@ def format_table(rows: Sequence[MethodStats], fmt: str = "markdown") -> str:
         fmt_row = lambda cells: "  ".join(c.ljust(w) for c, w in zip(cells, widths))  # noqa: E731
         return "\n".join([fmt_row(head), fmt_row(["-" * w for w in widths])] + [fmt_row(b) for b in body])
     raise GHTError(f"fmt={fmt!r} is not allowed; use 'markdown' or 'text'")
+
+
+@dataclass
+class BudgetSweep:
+    """Fewest evaluations with which one method reaches a target, over populations and schedules.
+
+    Attributes:
+        method: optimizer name.
+        target: the value to reach.
+        nfev: median (over seeds) evaluations to the first best value ``<= target`` at the best
+            (pop_size, max_iter) of the grid; ``inf`` if no grid point has a median that reaches it.
+        pop_size, max_iter: where that minimum was found (None if never).
+        table: ``(pop_size, max_iter) -> median evaluations to target`` for every grid point.
+    """
+
+    method: str
+    target: float
+    nfev: float
+    pop_size: int | None
+    max_iter: int | None
+    table: dict[tuple[int, int], float] = field(default_factory=dict, repr=False)
+
+
+def budget_sweep(
+    fun: Callable[[np.ndarray], Any],
+    bounds: Any,
+    method: str,
+    target: float,
+    *,
+    pop_sizes: Sequence[int] = (10, 15, 20, 30),
+    max_iters: Sequence[int] = (7, 10, 14, 20, 28, 40, 56, 80, 113, 160),
+    seeds: Sequence[int] = tuple(range(10)),
+) -> BudgetSweep:
+    r"""Evaluations a method needs to reach ``target`` when its population and schedule fit the task.
+
+    PSO's inertia ``w`` (0.9 → 0.4) and GWO/I-GWO's ``a`` (2 → 0) run over ``max_iter``
+    iterations (spec section 8), so a run only exploits at the end of its schedule and the
+    first-hit count of one long run overstates what the method needs. For every grid point
+    ``(pop_size, max_iter)`` this runs every seed and takes the median, over seeds, of the
+    evaluations after which the best value is first ``<= target`` (``inf`` for a run that never
+    gets there):
+
+        N(method) = min over (pop_size, max_iter) of median_seeds n_hit(pop_size, max_iter, seed)
+
+    Methods without a schedule (``de``) still get the population sweep; their ``max_iter`` only
+    caps the run, so give them the largest value only (``max_iters=(max(grid),)``).
+
+    Args:
+        fun, bounds: the problem.
+        method: name in :data:`~ght_cad.optimize.METHODS`.
+        target: the value to reach.
+        pop_sizes, max_iters: the grid.
+        seeds: one run per seed and grid point.
+
+    Returns:
+        BudgetSweep.
+
+    Raises:
+        GHTError: unknown method, empty grid or no seeds.
+    """
+    if method not in METHODS:
+        raise GHTError(f"method {method!r} is unknown; choose from {', '.join(METHODS)}")
+    if not len(pop_sizes) or not len(max_iters) or not len(seeds):
+        raise GHTError("pop_sizes, max_iters and seeds must each hold at least one value")
+    out = BudgetSweep(method=method, target=float(target), nfev=math.inf, pop_size=None, max_iter=None)
+    for pop in pop_sizes:
+        for it in max_iters:
+            hits = []
+            for s in seeds:
+                run = METHODS[method](fun, bounds, pop_size=int(pop), max_iter=int(it), seed=int(s))
+                h = run.nfev_to_reach(target)
+                hits.append(math.inf if h is None else float(h))
+            med = float(np.median(hits))
+            out.table[(int(pop), int(it))] = med
+            if med < out.nfev:
+                out.nfev, out.pop_size, out.max_iter = med, int(pop), int(it)
+    return out
