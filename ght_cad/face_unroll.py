@@ -49,9 +49,12 @@ __all__ = [
     "isoline_stats",
     "ruling_direction",
     "best_effort_direction",
+    "end_isoline_length",
     "face_area",
     "fd_derivative",
     "chain_loop",
+    "loop_uv_area",
+    "outer_loop_index",
     "unroll_face_data",
 ]
 
@@ -119,7 +122,9 @@ class EdgeData:
 @dataclass
 class FaceData:
     """A face for :func:`unroll_face_data`: surface, parameter bounds (u0, u1, v0, v1), wires
-    (outer first, then holes; each a list of :class:`EdgeData` in traversal order)."""
+    (outer first, then holes; each a list of :class:`EdgeData` in traversal order). A wrong
+    outer wire is tolerated: :func:`unroll_face_data` puts the loop enclosing the largest (u, v)
+    area first (:func:`outer_loop_index`)."""
 
     surface: SurfaceAdapter
     bounds: Bounds
@@ -239,13 +244,15 @@ def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | Non
     Returns:
         ``("v", info)`` when the v-isolines are straight (deviation ``max dist(p, line) / L``
         < 1e-9, see :func:`isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
-        likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v`` and
-        ``openness_u``, ``openness_v``. Planes, cylinders, cones and extrusions return ``"v"``,
+        likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v``,
+        ``openness_u``, ``openness_v`` and ``end_length_u``, ``end_length_v``
+        (:func:`end_isoline_length`). Planes, cylinders, cones and extrusions return ``"v"``,
         a structurally ruled B-spline/Bézier its ``ruled_hint``.
     """
     dv, ov = isoline_stats(surface, bounds, "v")
     du, ou = isoline_stats(surface, bounds, "u")
     info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
+    info.update({f"end_length_{d}": end_isoline_length(surface, bounds, d) for d in ("u", "v")})
     if surface.kind in RULED_KINDS:
         return "v", info
     if surface.ruled_hint in ("u", "v"):
@@ -257,27 +264,76 @@ def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | Non
     return None, info
 
 
+def end_isoline_length(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> float:
+    r"""How far the two end isolines along ``direction`` are from being points.
+
+    For ``direction == "u"``: the u-isolines ``S(·, v0)`` and ``S(·, v1)`` (the boundary curves
+    of rulings along v), each a 33-point polyline length, ``max(L(v0), L(v1)) / max_k L_k`` over
+    the nine isolines of :func:`isoline_stats`: 0 when both end isolines are points (the poles
+    of a full sphere), 1 when one of them is the longest.
+
+    Args:
+        ev: the surface.
+        bounds: (u0, u1, v0, v1).
+        direction: "u" or "v".
+
+    Returns:
+        The ratio in [0, 1] (1.0 when every isoline is a point).
+    """
+    u0, u1, v0, v1 = bounds
+    run = np.linspace(0.0, 1.0, 33)
+    lengths = []
+    for f in np.linspace(0.0, 1.0, 9):
+        if direction == "v":
+            u, v = np.full_like(run, u0 + f * (u1 - u0)), v0 + run * (v1 - v0)
+        else:
+            u, v = u0 + run * (u1 - u0), np.full_like(run, v0 + f * (v1 - v0))
+        L = float(np.linalg.norm(np.diff(ev.value(u, v), axis=0), axis=1).sum())
+        lengths.append(L if math.isfinite(L) else 0.0)
+    top = max(lengths)
+    return max(lengths[0], lengths[-1]) / top if top > 0 else 1.0
+
+
 def best_effort_direction(info: dict[str, float], label: str) -> str:
     """Ruling direction for flattening a non-ruled face: the boundary isolines ``S(·, v0)``,
-    ``S(·, v1)`` (rulings along v) must be distinct curves, i.e. the v-isolines must be open.
-    Among directions whose isolines are clearly open (chord ≥ 1 % of the length), else merely
-    open (chord > 1e-6 of the length), the straighter one is used.
+    ``S(·, v1)`` (rulings along v) must be distinct curves, i.e. the v-isolines must be open, and
+    must not both be points (``end_length_u`` > 1e-6, :func:`end_isoline_length`: rulings
+    between the two poles of a full sphere span no area). Among directions whose isolines are
+    clearly open (chord ≥ 1 % of the length), else merely open (chord > 1e-6 of the length), the
+    straighter one is used.
 
     Raises:
-        DegenerateGeometryError: the isolines are closed in both directions (a torus): there are
-            no two distinct boundary isolines to span rulings between.
+        DegenerateGeometryError: no direction qualifies (a torus: isolines closed both ways; a
+            full sphere: meridians open but both latitude ends are poles): there are no two
+            distinct boundary curves to span rulings between.
     """
+    other = {"u": "v", "v": "u"}
+    spans = [d for d in ("v", "u") if info.get(f"end_length_{other[d]}", 1.0) > 1e-6]
     for lim in (1e-2, 1e-6):
-        cands = [d for d in ("v", "u") if info[f"openness_{d}"] >= lim]
+        cands = [d for d in spans if info[f"openness_{d}"] >= lim]
         if cands:
             return min(cands, key=lambda d: info[f"deviation_{d}"])
+    why = []
+    if info["openness_u"] < 1e-6 and info["openness_v"] < 1e-6:
+        why.append(
+            f"its isolines are closed in both directions (chord/length {info['openness_u']:.3g} (u) and "
+            f"{info['openness_v']:.3g} (v); allowed > 1e-6)"
+        )
+    for d in ("u", "v") if not why else ():
+        if info[f"openness_{d}"] < 1e-6:
+            why.append(f"its {d}-isolines are closed (chord/length {info[f'openness_{d}']:.3g}; allowed > 1e-6)")
+        elif d not in spans:
+            why.append(
+                f"its {d}-isolines run between two points (both end {other[d]}-isolines are points: length "
+                f"ratio {info[f'end_length_{other[d]}']:.3g}; allowed > 1e-6)"
+            )
     raise DegenerateGeometryError(
         f"face {label!r} is not ruled (its isolines deviate from straight lines by "
         f"{info['deviation_u']:.3g} (u-isolines) and {info['deviation_v']:.3g} (v-isolines) relative to "
-        "their lengths; allowed 1e-9) and cannot be flattened even with best_effort=True: its isolines are "
-        f"closed in both directions (chord/length {info['openness_u']:.3g} (u) and {info['openness_v']:.3g} "
-        "(v); allowed > 1e-6), so it has no two distinct boundary isolines to span rulings between; split "
-        "the face (e.g. cut a torus into sectors) first"
+        "their lengths; allowed 1e-9) and cannot be flattened even with best_effort=True: "
+        + " and ".join(why)
+        + ", so it has no two distinct boundary curves to span rulings between; split the face (e.g. cut "
+        "a torus or a sphere into sectors) first"
     )
 
 
@@ -344,6 +400,43 @@ def face_area(
             total += float(np.sum(P * dv * tw))
         totals.append(abs(total))
     return totals[0] - sum(totals[1:]) if totals else 0.0
+
+
+def loop_uv_area(loop: list[tuple[Callable, Callable]]) -> float:
+    r"""Signed area a loop encloses in the parameter plane, ``∮ u dv`` (16 × 12-point
+    Gauss–Legendre panels per edge, split at the pcurve's knots: exact for polynomial pieces).
+
+    Args:
+        loop: per edge ``(t -> (u, v), t -> (u', v'))`` in traversal order.
+
+    Returns:
+        The signed (u, v)-area (positive counter-clockwise).
+    """
+    xg, wg = np.polynomial.legendre.leggauss(12)
+    total = 0.0
+    for uvf, duv in loop:
+        te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
+        tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
+        tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
+        u, _ = uvf(tn)
+        total += float(np.sum(np.asarray(u, dtype=float) * duv(tn)[:, 1] * tw))
+    return total
+
+
+def outer_loop_index(loops_uv: list[list[tuple[Callable, Callable]]]) -> int:
+    """Index of the outer loop of a face: the one enclosing the largest (u, v)-area
+    ``|∮ u dv|`` (:func:`loop_uv_area`; the outer boundary of a face's parameter domain encloses
+    its holes). 0 when there are no loops.
+
+    Args:
+        loops_uv: per loop, per edge ``(t -> (u, v), t -> (u', v'))``.
+
+    Returns:
+        The index in ``loops_uv``.
+    """
+    if len(loops_uv) < 2:
+        return 0
+    return int(np.argmax([abs(loop_uv_area(lp)) for lp in loops_uv]))
 
 
 def fd_derivative(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, breaks: Sequence[float] = (), h: float = 1e-4) -> np.ndarray:
@@ -505,7 +598,8 @@ def unroll_face_data(
         label: panel label.
 
     Returns:
-        FlatPattern with one panel: all wires of the face (outer + holes) mapped to the plane.
+        FlatPattern with one panel: all wires of the face mapped to the plane, the outer one
+        (largest enclosed (u, v) area, :func:`outer_loop_index`) first, then the holes.
 
     Raises:
         NotDevelopableError: the face is not ruled (message gives the isolines' largest distance
@@ -535,12 +629,17 @@ def unroll_face_data(
         info.update(straight)
         if ruled_dir is None:
             if not best_effort:
+                try:
+                    best_effort_direction(straight, label)
+                    hint = ("pass best_effort=True to flatten the ruled surface between its boundary "
+                            "isolines with a distortion report")
+                except DegenerateGeometryError as exc:  # say so instead of suggesting best_effort
+                    hint = "best_effort=True cannot flatten it either" + str(exc).split("best_effort=True", 1)[1]
                 raise NotDevelopableError(
                     f"face {label!r} is not ruled: its isolines deviate from straight lines by "
                     f"{straight['deviation_u']:.3g} (u-isolines) and {straight['deviation_v']:.3g} "
-                    "(v-isolines) relative to their lengths (allowed 1e-9; a closed isoline deviates "
-                    "0.159); pass best_effort=True to flatten the ruled surface between its boundary "
-                    "isolines with a distortion report"
+                    f"(v-isolines) relative to their lengths (allowed 1e-9; a closed isoline deviates "
+                    f"0.159); {hint}"
                 )
             ruled_dir = best_effort_direction(straight, label)
         info["ruling_direction"] = ruled_dir
@@ -573,6 +672,13 @@ def unroll_face_data(
         if loop:
             loops.append(loop)
             loops_uv.append(loop_uv)
+    # the outer loop first: an adapter's "outer wire" is not always right (FreeCAD 0.20's
+    # Face.OuterWire hands out a hole of a drilled cylinder), the outer loop encloses the others
+    k_out = outer_loop_index(loops_uv)
+    if k_out:
+        loops.insert(0, loops.pop(k_out))
+        loops_uv.insert(0, loops_uv.pop(k_out))
+        info["outer_wire_reordered"] = True
     # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
     u0, u1, v0, v1 = bounds
     bends = np.zeros((0, 2, 2))

@@ -183,15 +183,27 @@ def test_step_input_errors(tmp_path: Path, capsys) -> None:
 
 
 def test_non_ruled_face_is_refused_with_its_deviation(tmp_path: Path, capsys) -> None:
-    step = tmp_path / "sphere.step"
-    write_step(bd.Sphere(3.0).faces()[0], step)
+    step = tmp_path / "hemisphere.step"
+    write_step(bd.Sphere(3.0, arc_size1=0).faces()[0], step)
     rc, out, _ = _run(["unroll", str(step), "--png", str(tmp_path / "s.png")], capsys)
     assert rc == EXIT_USAGE and not (tmp_path / "s.png").exists()
     assert f"{step}: face 1 of 1 is not developable" in out["error"]
     # straightest isoline of a sphere: a closed parallel, deviation r / (2 pi r) = 1/(2 pi) = 0.159
     assert "it is not ruled: its straightest isolines deviate 0.159 from straight lines" in out["error"]
+    # best effort: rulings from the equator to the pole (a cone, area pi r l = 18 pi / sqrt 2 against
+    # 18 pi): the distortion 1 - 1/sqrt 2 = 0.293 is reported
     rc, out, _ = _run(["unroll", str(step), "--best-effort"], capsys)
-    assert rc == EXIT_OK and out["errors"]["area"] > 0.1  # the distortion is reported
+    assert rc == EXIT_OK and out["errors"]["area"] == pytest.approx(1 - 2**-0.5, rel=1e-6)
+
+
+def test_full_sphere_is_refused_even_with_best_effort(tmp_path: Path, capsys) -> None:
+    """The meridians of a full sphere run from pole to pole: the ruled surface between the two
+    boundary isolines (points) has no area (before: exit 0 and a pattern of area 7.7e-14)."""
+    step = tmp_path / "sphere.step"
+    write_step(bd.Sphere(3.0).faces()[0], step)
+    rc, out, _ = _run(["unroll", str(step), "--best-effort", "--dxf", str(tmp_path / "s.dxf")], capsys)
+    assert rc == EXIT_USAGE and not (tmp_path / "s.dxf").exists()
+    assert f"{step}: face 1 of 1" in out["error"] and "run between two points" in out["error"]
 
 
 def _cli_json(argv: list[str]) -> tuple[int, dict, str]:

@@ -366,6 +366,29 @@ def test_round_hole_is_kept(kind: str) -> None:
     assert pat.errors["max"] < RTOL
 
 
+@pytest.mark.parametrize("kind", ["cylinder", "other"])
+def test_hole_given_as_outer_wire_is_reordered(kind: str) -> None:
+    """An adapter that hands out a hole as the outer wire (FreeCAD 0.20's Face.OuterWire does
+    for drilled cylinders): the loop enclosing the largest (u, v) area becomes the outline, the
+    area stays R Δu H − π r² (before: −R Δu H − π r², negative, and the hole drawn as outline)."""
+    R, H, r = 4.0, 10.0, 1.5
+    surf = Cylinder(R, kind)
+    tau = 2 * math.pi
+    hole = [
+        _edge(surf, lambda t: (1.2 + (r / R) * np.cos(tau * t), 5.0 + r * np.sin(tau * t)),
+              lambda t: (-(r / R) * tau * np.sin(tau * t), r * tau * np.cos(tau * t)), "hole")
+    ]
+    face = FaceData(surf, (0.0, 2.5, 0.0, H), [hole, _box_loop(surf, 0.0, 2.5, 0.0, H)])
+    pat = unroll_face_data(face, rulings=4)
+    exact = R * 2.5 * H - math.pi * r * r
+    assert pat.area == pytest.approx(exact, rel=RTOL)
+    assert pat.panels[0].area_3d == pytest.approx(exact, rel=RTOL)
+    assert [e.name for e in pat.panels[0].loops[0]] == ["bottom", "right", "top", "left"]
+    np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [R * 2.5, H], rtol=RTOL)
+    assert pat.errors["max"] < RTOL
+    assert pat.panels[0].info["outer_wire_reordered"] is True
+
+
 def test_sphere_is_refused_naming_isolines() -> None:
     surf = Sphere()
     face = FaceData(surf, (0.0, 1.0, -0.5, 0.5), [_box_loop(surf, 0.0, 1.0, -0.5, 0.5)])

@@ -25,7 +25,7 @@ from freecad_launch import freecad_env, run_process, summary
 
 pytestmark = pytest.mark.freecad
 
-CASES = ("cylinder", "slanted", "drilled_cone", "seam_hole_cone", "extrusion_cut")
+CASES = ("cylinder", "slanted", "drilled_cone", "seam_hole_cone", "extrusion_cut", "drilled_cylinder")
 
 
 def _read_brep(path: Path):
@@ -74,6 +74,7 @@ def test_flat_faces_inside_freecadcmd(fc_run: tuple[Path, str]) -> None:
         "test_ruled_surface_is_unrolled",
         "test_sphere_is_refused_unless_best_effort",
         "test_twisted_face_is_refused_with_theta",
+        "test_cylinder_drilled_radially_twice",
     ):
         assert name in text, f"{name} did not run"
     assert (out / "flat_faces.FCStd").stat().st_size > 0
@@ -94,7 +95,8 @@ def test_ocp_adapter_agrees_with_freecad_adapter(fc_run: tuple[Path, str], case:
     lengths = sorted(float(e.length_3d) for loop in panel.loops for e in loop)
     np.testing.assert_allclose(lengths, fc["edge_lengths_3d"], rtol=1e-9, atol=1e-12)
     # FreeCAD's own Area of the 3-D face (BRepGProp without eps) is an independent, coarser check
-    assert pat.area == pytest.approx(fc["face_area"], rel=1e-6)
+    # (on the twice-drilled cylinder it is 6.5e-6 off: 7426.3559 vs 7426.4042 exact)
+    assert pat.area == pytest.approx(fc["face_area"], rel=1e-5 if case == "drilled_cylinder" else 1e-6)
     flat = out / f"{case}_flat.brep"
     if flat.exists():  # the planar face the FreeCAD feature built, measured by OCP to 1e-12
         assert _area(_read_brep(flat)) == pytest.approx(fc["area"], rel=1e-8)

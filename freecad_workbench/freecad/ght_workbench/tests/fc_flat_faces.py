@@ -25,7 +25,7 @@ import Part
 
 from freecad.ght_workbench import flat_pattern
 from freecad.ght_workbench.tests.fc_features import _reopen  # save, close, reopen, recompute (into $GHT_FC_OUT)
-from ght_cad.errors import NotDevelopableError
+from ght_cad.errors import DegenerateGeometryError, NotDevelopableError
 from ght_cad.face_unroll import unroll_face_data
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
@@ -260,6 +260,34 @@ class FlatFacesTest(unittest.TestCase):
         self.assertLess(pat.errors["max"], 1e-9)
         _record("seam_hole_cone", face, pat, fp)
 
+    def test_cylinder_drilled_radially_twice(self):
+        """Part.makeCylinder(20, 60) cut by two radial drills r=3 (along x at z=20, along y at z=40):
+        four holes, one across the seam. FreeCAD's Face.OuterWire names a hole as the outer wire
+        here (before the fix: negative area, IndexError in compute). Area 2π R H minus four holes,
+        each ∫ 2 R asin(√(r² - z²) / R) dz over z ∈ [-r, r]."""
+        R, H, r = 20.0, 60.0, 3.0
+        shape = Part.makeCylinder(R, H)
+        shape = shape.cut(Part.makeCylinder(r, 60.0, App.Vector(-30, 0, 20), App.Vector(1, 0, 0)))
+        shape = shape.cut(Part.makeCylinder(r, 60.0, App.Vector(0, -30, 40), App.Vector(0, 1, 0)))
+        obj = self.doc.addObject("Part::Feature", "Drilled")
+        obj.Shape = shape
+        self.doc.recompute()
+        name = next(f"Face{i + 1}" for i, f in enumerate(obj.Shape.Faces) if type(f.Surface).__name__ == "Cylinder" and f.Surface.Radius == R)
+        face = obj.Shape.getElement(name)
+        self.assertEqual(len(face.Wires), 4)  # the seam hole belongs to the outer wire
+        hole = quad(lambda z: 2 * R * math.asin(math.sqrt(r * r - z * z) / R), -r, r, epsabs=0, epsrel=1e-13, limit=200)[0]
+        exact = 2 * math.pi * R * H - 4 * hole
+        fp = flat_pattern.make_flat_pattern(obj, name, doc=self.doc)
+        self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        self.assertTrue(fp.Shape.isValid())
+        self.assertEqual(len(fp.Shape.Faces[0].Wires), 4)
+        pat = _pattern(fp)
+        self.assertAlmostEqual(pat.area, exact, delta=1e-9 * exact)
+        self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
+        np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [2 * math.pi * R, H], rtol=RTOL)
+        self.assertLess(pat.errors["max"], 1e-9)
+        _record("drilled_cylinder", face, pat, fp)
+
     def test_bspline_extrusion_with_cut_out(self):
         pts = [App.Vector(0, 0, 0), App.Vector(10, 5, 0), App.Vector(20, -3, 0), App.Vector(30, 0, 0)]
         sp = Part.BSplineCurve()
@@ -340,10 +368,21 @@ class FlatFacesTest(unittest.TestCase):
         self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
         with self.assertRaisesRegex(NotDevelopableError, "Sphere.Face1.*not ruled"):
             _pattern(fp)
+        # a full sphere cannot be flattened even with BestEffort: its meridians run between the
+        # poles, the ruled surface between the two boundary isolines (points) has no area
         fp.BestEffort = True
+        self.doc.recompute()
+        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        with self.assertRaisesRegex(DegenerateGeometryError, "run between two points"):
+            _pattern(fp)
+        # a gore (Angle3 = 45°) is flattened with BestEffort: rulings between its two meridians
+        sph.Angle3 = 45.0
         self.doc.recompute()
         self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
         self.assertTrue(fp.Shape.isValid())
+        exact = 2 * 25.0 * math.radians(45.0)
+        self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
+        self.assertGreater(fp.AreaFlat, 0.85 * exact)
         self.assertGreater(fp.MaxRelativeError, 1e-3)
 
     def test_twisted_face_is_refused_with_theta(self):
