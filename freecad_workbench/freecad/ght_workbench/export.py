@@ -82,8 +82,20 @@ def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[lis
 
     The outline is every edge of the planar face(s) of ``obj.Shape``; bend lines are the loose
     edges of the compound (not bounding a face).
+
+    Raises:
+        GHTError: the feature's last recompute failed (FreeCAD keeps the previous, stale shape) or
+            it has no planar face (never computed).
     """
+    state = [s for s in getattr(obj, "State", []) if s in ("Invalid", "Error")]
+    if state:
+        raise GHTError(
+            f"{obj.Label}: its last recompute failed (state {', '.join(state)}; see the report view), so its "
+            "shape is stale or empty; allowed: a flat pattern that recomputes without error"
+        )
     shape = obj.Shape
+    if not shape.Faces:
+        raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")
     outline = [_edge_points(e, deflection) for f in shape.Faces for w in f.Wires for e in w.OrderedEdges]
     face_edges = [e for f in shape.Faces for e in f.Edges]
     bends = [_edge_points(e, deflection) for e in shape.Edges if not any(e.isSame(fe) for fe in face_edges)]

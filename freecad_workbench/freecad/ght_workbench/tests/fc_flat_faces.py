@@ -23,9 +23,9 @@ from scipy.integrate import quad
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import flat_pattern
+from freecad.ght_workbench import export, flat_pattern
 from freecad.ght_workbench.tests.fc_features import _reopen  # save, close, reopen, recompute (into $GHT_FC_OUT)
-from ght_cad.errors import DegenerateGeometryError, NotDevelopableError
+from ght_cad.errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from ght_cad.face_unroll import unroll_face_data
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
@@ -384,6 +384,20 @@ class FlatFacesTest(unittest.TestCase):
         self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
         self.assertGreater(fp.AreaFlat, 0.85 * exact)
         self.assertGreater(fp.MaxRelativeError, 1e-3)
+        dxf = os.path.join(OUT, "gore.dxf")
+        export.export_flat_pattern_dxf(fp, dxf)
+        self.assertIn("OUTLINE", open(dxf).read().split("ENTITIES", 1)[1])
+        # back to a full sphere: the recompute fails and FreeCAD keeps the gore's old shape; DXF
+        # and SVG export refuse it (before: the stale gore, or an empty DXF for a feature that
+        # never computed) and write nothing
+        sph.Angle3 = 360.0
+        self.doc.recompute()
+        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        for fn, ext in ((export.export_flat_pattern_dxf, "dxf"), (export.export_flat_pattern_svg, "svg")):
+            target = os.path.join(OUT, f"stale.{ext}")
+            with self.assertRaisesRegex(GHTError, "recompute failed"):
+                fn(fp, target)
+            self.assertFalse(os.path.exists(target))
 
     def test_twisted_face_is_refused_with_theta(self):
         """A bilinear (twisted) B-spline face: ruled both ways, θ_max = 45°, DD = 0.75."""
