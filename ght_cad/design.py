@@ -3,7 +3,8 @@ r"""Design files (TOML): schema, validation and the pipeline runner behind ``ght
 A design file describes GHT-Bézier curves (control points and shape parameters, optional joins),
 one surface (an enveloping developable from control planes, spec 5.2, a ruled strip between two
 curves, or a composite of developable strips joined G1/G2/G3, spec 5.6), an optional
-shape-parameter optimization (single-strip surfaces) and the outputs to write. The schema is
+shape-parameter optimization (of one strip, or of every strip of a composite with its joints kept) and the
+outputs to write. The schema is
 documented in ``docs/design-files.md``; :func:`parse_design` validates a parsed file completely
 before anything is computed, and every error is one line naming the file, the key and the
 allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.errors.GHTError`, so
@@ -68,6 +69,7 @@ __all__ = [
     "plot_pattern",
     "run_design",
     "dual_curve_objectives",
+    "composite_dual_objectives",
 ]
 
 #: file outputs a design may request
@@ -496,26 +498,24 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     if ot is not None:
         if surface is None:
             raise ck.fail("optimize", "needs a [surface] table to optimize")
-        if surface.type == "composite":
-            raise ck.fail("optimize", "is not available for a composite surface (its strips are joined with "
-                          "their given shape parameters); allowed: [optimize] with surface.type planes or curves")
         ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
         method = ck.string(ot, "method", "optimize", "igwo", choices=METHODS)
-        objs = PLANE_OBJECTIVES if surface.type == "planes" else STRIP_OBJECTIVES
-        objective = ck.string(ot, "objective", "optimize", objs[2] if surface.type == "planes" else "R", choices=objs)
+        objs = _objectives_for(surface.type)
+        objective = ck.string(ot, "objective", "optimize", objs[0] if surface.type == "curves" else "CVEn", choices=objs)
         weights = [1.0, 0.0, 0.0]
         if "weights" in ot:
             w = ot["weights"]
             if (not isinstance(w, list) or len(w) != 3
-                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in w)
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x >= 0
+                               for x in w)
                     or not any(x > 0 for x in w)):
                 raise ck.fail("optimize.weights", f"{_short(w)} is not allowed; allowed: three numbers >= 0 (weights of AL, En, CVEn), not all 0")
             weights = [float(x) for x in w]
-        if surface.type == "planes":
-            pchoices: tuple[str, ...] = SHAPE_NAMES
+        pchoices = _shape_names(surface)
+        if surface.type == "composite":
+            params = _composite_parameters(ck, ot, surface)
         else:
-            pchoices = tuple(f"{s}.{k}" for s in ("a", "b") for k in SHAPE_NAMES)
-        params = ck.string_list(ot, "parameters", "optimize", list(pchoices), choices=pchoices)
+            params = ck.string_list(ot, "parameters", "optimize", list(pchoices), choices=pchoices)
         if not params:
             raise ck.fail("optimize.parameters", f"is empty; allowed: a non-empty subset of {', '.join(pchoices)}")
         pop = ck.integer(ot, "population", "optimize", 20, lo=4, hi=500)
@@ -562,6 +562,43 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     if not outputs.files and not outputs.figures:
         raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
     return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source)
+
+
+def _objectives_for(surface_type: str) -> tuple[str, ...]:
+    """Objectives allowed for a surface type: dual-curve fairness for planes and composites, R for
+    curve-pair strips."""
+    return STRIP_OBJECTIVES if surface_type == "curves" else PLANE_OBJECTIVES
+
+
+def _composite_parameters(ck: _Checker, ot: dict, surface: SurfaceSpec) -> list[str]:
+    """``optimize.parameters`` of a composite: ``"<segment name>.mu|nu|gamma"`` (default: all).
+
+    Raises:
+        DesignError: not an array of strings, an unknown segment or shape name, or an empty list.
+    """
+    segs = [g.name for g in surface.segments or []]
+    key = "optimize.parameters"
+    form = f"'<segment>.mu', '<segment>.nu' or '<segment>.gamma' with <segment> one of {', '.join(segs)}"
+    if "parameters" not in ot:
+        return list(_shape_names(surface))
+    v = ot["parameters"]
+    if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+        raise ck.fail(key, f"expected an array of strings {form}; got {_tname(v)} {_short(v)}")
+    out: list[str] = []
+    for x in v:
+        seg, dot, name = x.rpartition(".")
+        if not dot or seg not in segs:
+            what = f"unknown segment {seg!r} in {x!r}" if dot else f"{x!r} names no segment"
+            raise ck.fail(key, f"{what}; allowed: {form}")
+        match = [k for k in SHAPE_NAMES if k == name.lower()]
+        if not match:
+            raise ck.fail(key, f"unknown shape parameter {name!r} in {x!r}; allowed: {form}")
+        full = f"{seg}.{match[0]}"
+        if full not in out:
+            out.append(full)
+    if not out:
+        raise ck.fail(key, f"is empty; allowed: a non-empty array of {form}")
+    return out
 
 
 _SEGMENT_KEYS = ("name", "planes", "mu", "nu", "gamma", "continuity", "k", "beta2", "beta3")
@@ -914,8 +951,9 @@ def _composite_summary(built: BuiltSurface) -> dict[str, Any]:
         L = seg.ruling_lengths(u)
         strips.append({
             "name": g.name,
-            "shape_parameters": {k: float(getattr(g, k)) for k in SHAPE_NAMES},
+            "shape_parameters": {k: float(built.shape.get(f"{g.name}.{k}", getattr(g, k))) for k in SHAPE_NAMES},
             "control_planes": np.asarray(seg.planes).tolist(),
+            "dual_curve_fairness": dual_curve_objectives(seg.dual_curve),
             "area_3d": exact_area(seg),
             "ruling_length_min": float(np.min(L)),
             "ruling_length_max": float(np.max(L)),
@@ -999,9 +1037,20 @@ class OptimizationOutcome:
     time: float
     shape: dict[str, float]
     weights: list[float]
+    #: composite only: per strip ``name``, ``initial``/``best`` measures (AL, En, CVEn, value)
+    strips: list[dict[str, Any]] | None = None
+    #: composite only: per joint ``first``, ``second``, ``requested``, ``achieved_G`` (after), ``satisfied``
+    joints: list[dict[str, Any]] | None = None
 
     def summary(self) -> dict[str, Any]:
-        return {
+        """Plain-data form for the report (``optimization`` block); composites add ``strips``
+        (before/after per strip) and ``joints`` (requested vs measured order after optimization)."""
+        extra: dict[str, Any] = {}
+        if self.strips is not None:
+            extra["strips"] = [dict(x) for x in self.strips]
+        if self.joints is not None:
+            extra["joints"] = [dict(x) for x in self.joints]
+        return {**{
             "method": self.method,
             "objective": self.objective,
             "weights": list(self.weights) if self.objective == "weighted" else None,
@@ -1013,12 +1062,86 @@ class OptimizationOutcome:
             "iterations": int(self.nit),
             "time_s": float(self.time),
             "history": [float(h) for h in self.history],
-        }
+        }, **extra}
+
+
+def _fairness_value(vals: dict[str, float], objective: str, weights: Sequence[float]) -> float:
+    """``AL``, ``En``, ``CVEn`` or ``weighted`` = ``w0 AL + w1 En + w2 CVEn`` from the three measures."""
+    if objective == "weighted":
+        return float(weights[0] * vals["AL"] + weights[1] * vals["En"] + weights[2] * vals["CVEn"])
+    return float(vals[objective])
+
+
+def composite_dual_objectives(composite: Any, objective: str = "CVEn", weights: Sequence[float] = (1.0, 0.0, 0.0),
+                              nodes: int = 64) -> tuple[float, list[dict[str, float]]]:
+    r"""Fairness of a composite developable: the sum over strips of its dual curve's measure.
+
+    For strip ``s`` with dual curve ``U_s`` *as built* (strip 0 from its planes, strip i > 0 with
+    its first ``r+1`` control planes re-solved by the join; no rescaling afterwards, the plane
+    scale being a weight of the surface), ``AL_s = ∫_0^1 |U_s'|``, ``En_s = ∫_0^1 |U_s''|²``,
+    ``CVEn_s = ∫_0^1 |U_s'''|²`` (:func:`dual_curve_objectives`: ``nodes``-point Gauss–Legendre,
+    analytic derivatives) and ``F = Σ_s f(AL_s, En_s, CVEn_s)`` with ``f`` the chosen measure or
+    ``w0 AL + w1 En + w2 CVEn``.
+
+    Args:
+        composite: a :class:`ght_cad.developable.CompositeDevelopable` of enveloping developables.
+        objective: ``AL``, ``En``, ``CVEn`` or ``weighted``.
+        weights: ``(w0, w1, w2)`` for ``weighted``.
+        nodes: Gauss–Legendre nodes per strip.
+
+    Returns:
+        ``(F, per_strip)`` with ``per_strip[s] = {"AL", "En", "CVEn", "value"}``.
+
+    Raises:
+        GHTError: an objective that is not one of AL, En, CVEn, weighted.
+    """
+    if objective not in PLANE_OBJECTIVES:
+        raise GHTError(f"objective={objective!r} is not allowed for a composite; allowed: {', '.join(PLANE_OBJECTIVES)}")
+    per = []
+    for seg in composite.segments:
+        vals = dual_curve_objectives(seg.dual_curve, nodes)
+        vals["value"] = _fairness_value(vals, objective, weights)
+        per.append(vals)
+    return float(sum(v["value"] for v in per)), per
+
+
+def _composite_joint_rows(design: Design, composite: Any) -> list[dict[str, Any]]:
+    """Requested vs measured order (:func:`ght_cad.developable.measure_developable_joint`) per joint."""
+    segs = design.surface.segments if design.surface is not None else None
+    assert segs
+    rows = []
+    for i, (g, rep) in enumerate(zip(segs[1:], composite.joints())):
+        req = g.continuity or "G1"
+        rows.append({"first": segs[i].name, "second": g.name, "requested": req, "achieved_G": int(rep.order),
+                     "satisfied": bool(rep.satisfies(req))})
+    return rows
+
+
+def _composite_candidate(design: Design, shape: dict[str, float]) -> Any:
+    """The composite of ``shape`` (:func:`_make_composite`, every strip checked on construction),
+    refused unless every joint measures at least its requested order.
+
+    Raises:
+        GHTError: a singular join, a degenerate strip, or a joint below its requested order.
+    """
+    from .errors import SingularJoinError
+
+    comp = _make_composite(design, shape)
+    for row in _composite_joint_rows(design, comp):
+        if not row["satisfied"]:
+            raise SingularJoinError(f"joint {row['first']} -> {row['second']} measures G{row['achieved_G']}, "
+                                    f"requested {row['requested']}")
+    return comp
 
 
 def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) -> Callable[[dict[str, float]], float]:
     surf = design.surface
     assert surf is not None
+    if surf.type == "composite":
+        def fc(sh: dict[str, float]) -> float:
+            return composite_dual_objectives(_composite_candidate(design, sh), spec.objective, spec.weights)[0]
+
+        return fc
     if surf.type == "planes":
         from .curve import GHTCurve
         from .planes import normalize_planes
@@ -1050,8 +1173,13 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
 
     Objectives: for a ``planes`` surface the fairness of the dual curve of unit-normal control
     planes (``AL = ∫|U'|``, ``En = ∫|U''|²``, ``CVEn = ∫|U'''|²`` or ``w·(AL, En, CVEn)``); for a
-    ``curves`` strip the developability objective ``R = ∫(1 - n_a·n_b) du`` (spec 5, 7).
-    Optimizers: PSO, GWO, I-GWO of :mod:`ght_cad.optimize` (spec 8).
+    ``composite`` the sum over strips of the same measure of each strip's dual curve as built
+    (after the joins, :func:`composite_dual_objectives`), every joint keeping its requested
+    G1/G2/G3 order; for a ``curves`` strip the developability objective
+    ``R = ∫(1 - n_a·n_b) du`` (spec 5, 7). Optimizers: PSO, GWO, I-GWO of
+    :mod:`ght_cad.optimize` (spec 8). The start values (those of the file) are in the first
+    population and the result is never worse than them; candidates whose surface degenerates
+    (singular join, edge of regression inside a strip, ...) get ``+inf``.
 
     Args:
         design: validated design with a [surface] table.
@@ -1059,19 +1187,22 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         progress: progress bar on a terminal.
         curves: already built curves (joins applied).
 
+    Returns:
+        :class:`OptimizationOutcome` (for a composite with ``strips``: the measures of every strip
+        before and after, and ``joints``: requested vs measured order after optimization).
+
     Raises:
         DesignError: no [surface], or an override that is not allowed.
+        GHTError: no admissible shape parameters found.
     """
     from .optimize import minimize
     from .progress import Progress
 
     if design.surface is None:
         raise DesignError(f"{design.source}: key 'surface': missing; optimization needs a [surface] table")
-    if design.surface.type == "composite":
-        raise DesignError(f"{design.source}: key 'surface.type': 'composite' cannot be optimized (the strips keep "
-                          "their given shape parameters); allowed for optimization: planes, curves")
+    stype = design.surface.type
     spec = design.optimize or OptimizeSpec(
-        objective="CVEn" if design.surface.type == "planes" else "R",
+        objective="R" if stype == "curves" else "CVEn",
         parameters=list(_shape_names(design.surface)),
     )
     spec = OptimizeSpec(**{**spec.__dict__})
@@ -1079,12 +1210,14 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         setattr(spec, k, v)
     # validate overrides with the same rules as the file
     ck = _Checker(design.source + " (command-line override)")
-    objs = PLANE_OBJECTIVES if design.surface.type == "planes" else STRIP_OBJECTIVES
+    objs = _objectives_for(stype)
     spec.method = ck.string({"method": spec.method}, "method", "optimize", choices=METHODS)
     spec.objective = ck.string({"objective": spec.objective}, "objective", "optimize", choices=objs)
     spec.iterations = ck.integer({"iterations": spec.iterations}, "iterations", "optimize", 40, lo=1, hi=5000)
     spec.population = ck.integer({"population": spec.population}, "population", "optimize", 20, lo=4, hi=500)
     spec.seed = ck.integer({"seed": spec.seed}, "seed", "optimize", 1, lo=0, hi=2**32 - 1)
+    if stype == "composite":
+        spec.parameters = _composite_parameters(ck, {"parameters": list(spec.parameters)}, design.surface)
     if curves is None:
         curves, _ = build_curves(design)
     base = _initial_shape(design, curves)
@@ -1097,12 +1230,16 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         return sh
 
     def F(X: np.ndarray) -> np.ndarray:
+        # one candidate at a time: each builds (and checks) its own strips and joins
         out = np.empty(X.shape[0])
         for i, x in enumerate(X):
             try:
-                out[i] = f(shape_of(x))
-            except GHTError:
-                out[i] = np.inf  # a degenerate candidate (e.g. edge of regression) is rejected
+                with np.errstate(all="ignore"):
+                    out[i] = f(shape_of(x))
+            except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+                out[i] = np.inf  # a degenerate candidate (singular join, edge of regression, ...) is rejected
+            if not np.isfinite(out[i]):
+                out[i] = np.inf
         return out
 
     x0 = np.array([base[k] for k in names])
@@ -1116,10 +1253,38 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         raise GHTError(f"{design.source}: optimization found no admissible shape parameters")
     x = np.clip(np.asarray(res.x, dtype=float), -1.0, 1.0)
     best = float(res.fun)
-    if initial < best:  # never report something worse than the start
+    if initial <= best:  # never report something worse than the start
         x, best = x0, initial
-    return OptimizationOutcome(spec.method, spec.objective, names, x, best, initial, np.asarray(res.history),
-                               int(res.nfev), int(res.nit), float(res.time), shape_of(x), list(spec.weights))
+    out = OptimizationOutcome(spec.method, spec.objective, names, x, best, initial, np.asarray(res.history),
+                              int(res.nfev), int(res.nit), float(res.time), shape_of(x), list(spec.weights))
+    if stype == "composite":
+        out.strips, out.joints = _composite_before_after(design, spec, base, out.shape)
+    return out
+
+
+def _composite_before_after(design: Design, spec: OptimizeSpec, before: dict[str, float],
+                            after: dict[str, float]) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Per strip the measures before/after optimization; per joint requested vs measured order after."""
+    segs = design.surface.segments if design.surface is not None else None
+    assert segs
+    try:
+        _, per0 = composite_dual_objectives(_make_composite(design, before), spec.objective, spec.weights)
+    except GHTError:
+        per0 = [None] * len(segs)
+    comp = _make_composite(design, after)
+    _, per1 = composite_dual_objectives(comp, spec.objective, spec.weights)
+    strips = []
+    for g, a, b in zip(segs, per0, per1):
+        strips.append({
+            "name": g.name,
+            "initial_parameters": {k: float(before[f"{g.name}.{k}"]) for k in SHAPE_NAMES},
+            "best_parameters": {k: float(after[f"{g.name}.{k}"]) for k in SHAPE_NAMES},
+            "initial_value": None if a is None else a["value"],
+            "best_value": b["value"],
+            "initial_measures": None if a is None else {k: a[k] for k in ("AL", "En", "CVEn")},
+            "best_measures": {k: b[k] for k in ("AL", "En", "CVEn")},
+        })
+    return strips, _composite_joint_rows(design, comp)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1590,6 +1755,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if built is not None and design.surface is not None and design.surface.type == "composite":
                 deg = max(sg.dual_curve.degree for sg in built.surface.segments)
                 params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0)] + [(g.mu, g.nu, g.gamma) for g in design.surface.segments or []]
+                params += [tuple(built.shape[f"{g.name}.{k}"] for k in SHAPE_NAMES) for g in design.surface.segments or []]
             elif built is not None and design.surface is not None and design.surface.type == "planes":
                 deg = built.surface.dual_curve.degree
                 sh = built.shape
@@ -1703,6 +1869,21 @@ def report_markdown(r: dict[str, Any]) -> str:
               f"{o['method']} on {o['objective']}: {o['initial_value']:.8g} → {o['best_value']:.8g} in "
               f"{o['iterations']} iterations ({o['nfev']} evaluations, {o['time_s']:.2f} s); best "
               + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
+        if o.get("strips"):
+            L += [f"Per strip ({o['objective']} of its dual curve as built):", "",
+                  "| strip | before | after | μ, ν, γ before | μ, ν, γ after |", "|---|---|---|---|---|"]
+            for x in o["strips"]:
+                L.append(f"| {x['name']} | {_f(x['initial_value'], '.8g')} | {x['best_value']:.8g} | "
+                         + ", ".join(f"{v:.4g}" for v in x["initial_parameters"].values()) + " | "
+                         + ", ".join(f"{v:.4g}" for v in x["best_parameters"].values()) + " |")
+            L.append("")
+        if o.get("joints"):
+            L += ["Joints after optimization:", "", "| first → second | requested | measured | satisfied |",
+                  "|---|---|---|---|"]
+            for j in o["joints"]:
+                L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
+                         f"{'yes' if j['satisfied'] else 'NO'} |")
+            L.append("")
     if r.get("brep"):
         b = r["brep"]
         L += ["## B-rep", "", f"{b['faces']} face(s){' in one shell' if b.get('shape') == 'shell' else ''} "
