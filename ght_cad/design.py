@@ -70,6 +70,7 @@ __all__ = [
     "run_design",
     "dual_curve_objectives",
     "composite_dual_objectives",
+    "composite_objective",
 ]
 
 #: file outputs a design may request
@@ -1134,12 +1135,46 @@ def _composite_candidate(design: Design, shape: dict[str, float]) -> Any:
     return comp
 
 
+def composite_objective(design: Design, shape: dict[str, float], objective: str = "CVEn",
+                        weights: Sequence[float] = (1.0, 0.0, 0.0)) -> float:
+    r"""Objective of one candidate of a composite design: ``F`` of :func:`composite_dual_objectives`.
+
+    The strips are built exactly as for the geometry (strip 0 from its planes, strip i > 0 joined
+    G1/G2/G3 to strip i-1, every strip checked on construction) and every joint is measured
+    (:func:`ght_cad.developable.measure_developable_joint`).
+
+    Args:
+        design: a validated design with a ``composite`` surface.
+        shape: ``{"<segment>.mu|nu|gamma": value}``; missing names keep the file's values.
+        objective: ``AL``, ``En``, ``CVEn`` or ``weighted``.
+        weights: ``(w0, w1, w2)`` for ``weighted``.
+
+    Returns:
+        ``F``, or ``+inf`` for a candidate whose join is singular, whose strip degenerates (parallel
+        planes, stationary dual curve, edge of regression inside, ...) or whose joint measures
+        below its requested order.
+
+    Raises:
+        DesignError: the design's surface is not a composite.
+    """
+    if design.surface is None or design.surface.type != "composite":
+        raise DesignError(f"{design.source}: key 'surface.type': composite_objective needs type = \"composite\"")
+    sh = dict(_initial_shape(design, {}))
+    sh.update(shape)
+    try:
+        with np.errstate(all="ignore"):
+            value = composite_dual_objectives(_composite_candidate(design, sh), objective, weights)[0]
+    except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+        return math.inf
+    return value if math.isfinite(value) else math.inf
+
+
 def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) -> Callable[[dict[str, float]], float]:
     surf = design.surface
     assert surf is not None
     if surf.type == "composite":
         def fc(sh: dict[str, float]) -> float:
-            return composite_dual_objectives(_composite_candidate(design, sh), spec.objective, spec.weights)[0]
+            return composite_objective(design, sh, spec.objective, spec.weights)
 
         return fc
     if surf.type == "planes":
