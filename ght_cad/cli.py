@@ -598,7 +598,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="optimize the shape parameters of a design's surface",
         description="Minimize the design's objective (AL, En, CVEn of the dual curve, or R, the "
         "developability objective of a curve-pair strip) over the shape parameters with PSO, GWO or "
-        "I-GWO. Options override the design's [optimize] block.",
+        "I-GWO. For a composite surface the measure is summed over the strips and every joint keeps "
+        "its G1/G2/G3 order. Options override the design's [optimize] block.",
         epilog=_EPILOG,
     )
     design_arg(sp)
