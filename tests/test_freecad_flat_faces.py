@@ -93,7 +93,7 @@ def test_ocp_adapter_agrees_with_freecad_adapter(fc_run: tuple[Path, str], case:
     loops = sorted(sum(e.length_flat for e in loop) for loop in panel.loops)
     np.testing.assert_allclose(loops, fc["loop_lengths"], rtol=1e-9)
     lengths = sorted(float(e.length_3d) for loop in panel.loops for e in loop)
-    np.testing.assert_allclose(lengths, fc["edge_lengths_3d"], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(lengths, fc["edge_lengths_3d"], rtol=1e-12, atol=1e-12)
     # FreeCAD's own Area of the 3-D face (BRepGProp without eps) is an independent, coarser check
     # (on the twice-drilled cylinder it is 6.5e-6 off: 7426.3559 vs 7426.4042 exact)
     assert pat.area == pytest.approx(fc["face_area"], rel=1e-5 if case == "drilled_cylinder" else 1e-6)

@@ -157,7 +157,9 @@ def test_holes_and_planar_face_output() -> None:
                    epsabs=0, epsrel=1e-13, limit=200)
     exact = math.pi * 20 * 50 - hole
     assert pat.area == pytest.approx(exact, rel=1e-9)
-    assert pat.errors["max"] < 1e-10
+    # boundary lengths against the edges' own 3-D curves: the boolean's intersection curve lies
+    # within its tolerance 1e-7 of the surface, its length differs from the pcurve image's by 3.2e-10
+    assert pat.errors["max"] < 1e-9
     # bend lines are clipped by the hole: some rulings are split in two
     assert len(pat.bend_lines) > 20
     flat = pat.to_face()
