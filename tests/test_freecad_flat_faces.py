@@ -75,6 +75,7 @@ def test_flat_faces_inside_freecadcmd(fc_run: tuple[Path, str]) -> None:
         "test_sphere_is_refused_unless_best_effort",
         "test_twisted_face_is_refused_with_theta",
         "test_cylinder_drilled_radially_twice",
+        "test_bad_sources_are_named",
     ):
         assert name in text, f"{name} did not run"
     assert (out / "flat_faces.FCStd").stat().st_size > 0

@@ -198,7 +198,8 @@ def face_of_source(obj: Any) -> "Part.Face | None":
     or None when the Source is a developable feature of this workbench (its core surface is used).
 
     Raises:
-        ValueError: no Source, or a Source with several faces and no face selected.
+        ValueError: no Source; a Source without faces; a sub-element that is not a face or no
+            longer exists (the Source's topology changed); several faces and none selected.
     """
     src, subs = obj.Source if obj.Source else (None, [])
     if src is None:
@@ -206,11 +207,21 @@ def face_of_source(obj: Any) -> "Part.Face | None":
     subs = [s for s in (subs or []) if s]
     if not subs and hasattr(getattr(src, "Proxy", None), "surface"):
         return None
+    faces = src.Shape.Faces
+    if not faces:
+        raise ValueError(f"{src.Label} has no faces to unroll; allowed: a face or a developable feature of this workbench")
+    names = f"Face1..Face{len(faces)}"
     if subs:
-        return src.Shape.getElement(subs[0])
-    if len(src.Shape.Faces) == 1:
-        return src.Shape.Faces[0]
-    raise ValueError(f"{src.Label} has {len(src.Shape.Faces)} faces; select one face")
+        sub = subs[0]
+        if not sub.startswith("Face"):
+            raise ValueError(f"{src.Label}.{sub} is not a face; allowed: a face ({names})")
+        k = sub[4:]
+        if not k.isdigit() or not 1 <= int(k) <= len(faces):
+            raise ValueError(f"{src.Label} has no {sub}; allowed: {names} (did the source's topology change? select the face again)")
+        return faces[int(k) - 1]
+    if len(faces) == 1:
+        return faces[0]
+    raise ValueError(f"{src.Label} has {len(faces)} faces; select one face ({names})")
 
 
 def surface_of_source(obj: Any) -> Any:

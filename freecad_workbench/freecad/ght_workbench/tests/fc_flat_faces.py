@@ -399,6 +399,28 @@ class FlatFacesTest(unittest.TestCase):
                 fn(fp, target)
             self.assertFalse(os.path.exists(target))
 
+    def test_bad_sources_are_named(self):
+        """A sub-element that no longer exists (the source's topology changed), an edge instead of
+        a face, a source without faces: ValueError naming the source and what is allowed (before:
+        OCCError 'Index out of bound', AttributeError 'Part.Edge' object has no attribute
+        'Surface', 'Circ has 0 faces; select one face')."""
+        cyl = self._cylinder(10.0, 20.0)
+        self.doc.recompute()
+        fp = flat_pattern.make_flat_pattern(cyl, "Face1", doc=self.doc)
+        cases = (
+            ((cyl, ["Face9"]), r"Cyl has no Face9; allowed: Face1\.\.Face3"),
+            ((cyl, ["Edge1"]), r"Cyl\.Edge1 is not a face; allowed: a face \(Face1\.\.Face3\)"),
+        )
+        circle = self.doc.addObject("Part::Circle", "Circ")
+        self.doc.recompute()
+        cases += (((circle, []), r"Circ has no faces to unroll; allowed: a face or a developable feature"),)
+        for source, pattern in cases:
+            fp.Source = source
+            self.doc.recompute()
+            self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
+            with self.assertRaisesRegex(ValueError, pattern):
+                _pattern(fp)
+
     def test_twisted_face_is_refused_with_theta(self):
         """A bilinear (twisted) B-spline face: ruled both ways, θ_max = 45°, DD = 0.75."""
         s = Part.BSplineSurface()
