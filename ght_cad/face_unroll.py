@@ -476,7 +476,7 @@ def fd_derivative(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, breaks
 
 
 def chain_loop(
-    ends: list[tuple[np.ndarray, np.ndarray]], periods: tuple[float, float], tol: float
+    ends: list[tuple[np.ndarray, np.ndarray]], periods: tuple[float, float], tol: float | Sequence[float]
 ) -> list[tuple[bool, np.ndarray]]:
     r"""Make a wire's pcurves one continuous loop in (u, v).
 
@@ -488,7 +488,9 @@ def chain_loop(
     Args:
         ends: per edge its (start, end) uv points in the given direction.
         periods: (P_u, P_v), 0 for a non-periodic direction.
-        tol: matching tolerance in (u, v).
+        tol: matching tolerance in (u, v): one number, or ``(tol_u, tol_v)`` (u and v often have
+            different units, e.g. an angle and a length: give each a tolerance relative to its
+            own range).
 
     Returns:
         Per edge ``(reverse, shift)`` (an edge matching both ways, e.g. a closed isoline spanning a
@@ -501,7 +503,7 @@ def chain_loop(
         d = q - p
         k = np.where(P > 0, np.round(d / np.where(P > 0, P, 1.0)), 0.0)
         s = k * P
-        return s if np.all(np.abs(d - s) <= tol) else None
+        return s if np.all(np.abs(d - s) <= np.asarray(tol, dtype=float)) else None
 
     out: list[tuple[bool, np.ndarray]] = [(False, np.zeros(2))]
     if not ends:
@@ -679,6 +681,7 @@ def unroll_face_data(
         loops.insert(0, loops.pop(k_out))
         loops_uv.insert(0, loops_uv.pop(k_out))
         info["outer_wire_reordered"] = True
+    _check_holes_inside(loops_uv, label)
     # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
     u0, u1, v0, v1 = bounds
     bends = np.zeros((0, 2, 2))
@@ -717,6 +720,45 @@ def unroll_face_data(
     lo, _ = panel.bbox()
     panel.translate(-lo)
     return FlatPattern([panel], units=units)
+
+
+def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:
+    """(u, v) points of a loop, ``n`` per edge (end points excluded), shape (m, 2)."""
+    t = (np.arange(n) + 0.5) / n
+    return np.concatenate([np.stack([np.asarray(x, dtype=float) for x in uvf(t)], axis=1) for uvf, _ in loop])
+
+
+def _inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """Even-odd point-in-polygon test of (m, 2) points against a closed (k, 2) polygon."""
+    x, y = points[:, 0][:, None], points[:, 1][:, None]
+    x0, y0 = polygon[:, 0][None, :], polygon[:, 1][None, :]
+    x1, y1 = np.roll(polygon[:, 0], -1)[None, :], np.roll(polygon[:, 1], -1)[None, :]
+    crosses = (y0 > y) != (y1 > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xs = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
+    return (np.sum(crosses & (x < xs), axis=1) % 2) == 1
+
+
+def _check_holes_inside(loops_uv: list[list[tuple[Callable, Callable]]], label: str) -> None:
+    """Every hole loop must lie inside the outer loop in (u, v) (a face's holes do; a hole outside
+    means inconsistent pcurves, e.g. one shifted by a period, and would be drawn outside the
+    outline while the area stays right).
+
+    Raises:
+        DegenerateGeometryError: more than half of a hole's sample points lie outside the outer loop.
+    """
+    if len(loops_uv) < 2:
+        return
+    outer = _loop_points(loops_uv[0], 64)
+    for k, loop in enumerate(loops_uv[1:], start=1):
+        inside = _inside(_loop_points(loop, 8), outer)
+        if inside.mean() < 0.5:
+            raise DegenerateGeometryError(
+                f"face {label!r}: wire {k + 1} (a hole) lies outside the outer wire in the face's (u, v) "
+                f"parameters ({inside.mean():.0%} of its points inside; allowed: holes inside the outer wire): "
+                "the face's pcurves are inconsistent (one shifted by a period?); repair the face (e.g. "
+                "Part > Check geometry, or re-import it) before unrolling"
+            )
 
 
 def _with_breaks(duv: Callable[[np.ndarray], np.ndarray], breaks: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:

@@ -389,6 +389,23 @@ def test_hole_given_as_outer_wire_is_reordered(kind: str) -> None:
     assert pat.panels[0].info["outer_wire_reordered"] is True
 
 
+def test_hole_outside_the_outer_wire_is_refused() -> None:
+    """A hole pcurve shifted by a period (u + 2π, outside the face's box): refused naming the wire
+    (before: a pattern with the hole drawn beside the outline, area and errors still "right")."""
+    from ght_cad.errors import DegenerateGeometryError
+
+    R, H, r = 4.0, 10.0, 1.5
+    surf = Cylinder(R, "cylinder")
+    tau = 2 * math.pi
+    hole = [
+        _edge(surf, lambda t: (1.2 + tau + (r / R) * np.cos(tau * t), 5.0 + r * np.sin(tau * t)),
+              lambda t: (-(r / R) * tau * np.sin(tau * t), r * tau * np.cos(tau * t)), "hole")
+    ]
+    face = FaceData(surf, (0.0, 2.5, 0.0, H), [_box_loop(surf, 0.0, 2.5, 0.0, H), hole])
+    with pytest.raises(DegenerateGeometryError, match=r"wire 2 \(a hole\) lies outside the outer wire.*0% of its points"):
+        unroll_face_data(face)
+
+
 def test_sphere_is_refused_naming_isolines() -> None:
     surf = Sphere()
     face = FaceData(surf, (0.0, 1.0, -0.5, 0.5), [_box_loop(surf, 0.0, 1.0, -0.5, 0.5)])

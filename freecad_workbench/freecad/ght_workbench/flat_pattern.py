@@ -168,7 +168,9 @@ def face_data(face: "Part.Face") -> FaceData:
     surf = FreeCADSurface(face)
     u0, u1, v0, v1 = (float(x) for x in face.ParameterRange)
     periods = surf.periods()
-    tol = 1e-6 * max(1.0, abs(u1 - u0), abs(v1 - v0))
+    # matching tolerance per direction, relative to that direction's range: u of a cylinder is an
+    # angle, v a length (one tolerance of 1e-6 of the larger range was 6 rad on a 6e6 mm cylinder)
+    tol = 1e-6 * np.array([max(abs(u1 - u0), periods[0]) or 1.0, max(abs(v1 - v0), periods[1]) or 1.0])
     outer = face.OuterWire
     wires = [outer] + [w for w in face.Wires if not w.isSame(outer)]
     loops = []
@@ -184,7 +186,7 @@ def face_data(face: "Part.Face") -> FaceData:
         pts = np.concatenate([np.stack(e.uv(np.linspace(0.0, 1.0, 5)), axis=1) for e in edges])
         for i, (lo, P) in enumerate(((u0, periods[0]), (v0, periods[1]))):
             if P > 0:
-                k = np.floor((pts[:, i].min() - lo + tol) / P)
+                k = np.floor((pts[:, i].min() - lo + tol[i]) / P)
                 for e in edges:
                     e.shift[i] -= k * P
         loops.append(

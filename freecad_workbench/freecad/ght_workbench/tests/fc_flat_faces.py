@@ -264,29 +264,40 @@ class FlatFacesTest(unittest.TestCase):
         """Part.makeCylinder(20, 60) cut by two radial drills r=3 (along x at z=20, along y at z=40):
         four holes, one across the seam. FreeCAD's Face.OuterWire names a hole as the outer wire
         here (before the fix: negative area, IndexError in compute). Area 2π R H minus four holes,
-        each ∫ 2 R asin(√(r² - z²) / R) dz over z ∈ [-r, r]."""
-        R, H, r = 20.0, 60.0, 3.0
-        shape = Part.makeCylinder(R, H)
-        shape = shape.cut(Part.makeCylinder(r, 60.0, App.Vector(-30, 0, 20), App.Vector(1, 0, 0)))
-        shape = shape.cut(Part.makeCylinder(r, 60.0, App.Vector(0, -30, 40), App.Vector(0, 1, 0)))
-        obj = self.doc.addObject("Part::Feature", "Drilled")
-        obj.Shape = shape
-        self.doc.recompute()
-        name = next(f"Face{i + 1}" for i, f in enumerate(obj.Shape.Faces) if type(f.Surface).__name__ == "Cylinder" and f.Surface.Radius == R)
-        face = obj.Shape.getElement(name)
-        self.assertEqual(len(face.Wires), 4)  # the seam hole belongs to the outer wire
-        hole = quad(lambda z: 2 * R * math.asin(math.sqrt(r * r - z * z) / R), -r, r, epsabs=0, epsrel=1e-13, limit=200)[0]
-        exact = 2 * math.pi * R * H - 4 * hole
-        fp = flat_pattern.make_flat_pattern(obj, name, doc=self.doc)
-        self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
-        self.assertTrue(fp.Shape.isValid())
-        self.assertEqual(len(fp.Shape.Faces[0].Wires), 4)
-        pat = _pattern(fp)
-        self.assertAlmostEqual(pat.area, exact, delta=1e-9 * exact)
-        self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
-        np.testing.assert_allclose(np.ptp(pat.outlines[0], axis=0), [2 * math.pi * R, H], rtol=RTOL)
-        self.assertLess(pat.errors["max"], 1e-9)
-        _record("drilled_cylinder", face, pat, fp)
+        each ∫ 2 R asin(√(r² - z²) / R) dz over z ∈ [-r, r]. Scaled by 1e5 too: the seam matching
+        tolerance was 1e-6 of the largest parameter range, 6 (radians!) in u there, so the outer
+        loop was shifted by a period and the holes lay outside the flat outline (planar face
+        without holes, 1.1 % too large)."""
+        for sc in (1.0, 1e5):
+            R, H, r = 20.0 * sc, 60.0 * sc, 3.0 * sc
+            shape = Part.makeCylinder(R, H)
+            shape = shape.cut(Part.makeCylinder(r, H, App.Vector(-1.5 * R, 0, H / 3), App.Vector(1, 0, 0)))
+            shape = shape.cut(Part.makeCylinder(r, H, App.Vector(0, -1.5 * R, 2 * H / 3), App.Vector(0, 1, 0)))
+            obj = self.doc.addObject("Part::Feature", "Drilled")
+            obj.Shape = shape
+            self.doc.recompute()
+            name = next(f"Face{i + 1}" for i, f in enumerate(obj.Shape.Faces) if type(f.Surface).__name__ == "Cylinder" and f.Surface.Radius == R)
+            face = obj.Shape.getElement(name)
+            self.assertEqual(len(face.Wires), 4)  # the seam hole belongs to the outer wire
+            hole = quad(lambda z: 2 * R * math.asin(math.sqrt(r * r - z * z) / R), -r, r, epsabs=0, epsrel=1e-13, limit=200)[0]
+            exact = 2 * math.pi * R * H - 4 * hole
+            fp = flat_pattern.make_flat_pattern(obj, name, doc=self.doc)
+            self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+            self.assertTrue(fp.Shape.isValid())
+            self.assertEqual(len(fp.Shape.Faces[0].Wires), 4, sc)
+            pat = _pattern(fp)
+            self.assertAlmostEqual(pat.area, exact, delta=1e-9 * exact)
+            self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
+            outline = pat.outlines[0]
+            np.testing.assert_allclose(np.ptp(outline, axis=0), [2 * math.pi * R, H], rtol=RTOL)
+            for hole_loop in pat.outlines[1:]:  # the holes lie inside the outline's box
+                self.assertTrue(np.all(hole_loop.min(axis=0) > outline.min(axis=0)), sc)
+                self.assertTrue(np.all(hole_loop.max(axis=0) < outline.max(axis=0)), sc)
+            # the planar face FreeCAD built has the holes cut out (OCCT's Area is ~1e-5 here)
+            self.assertAlmostEqual(fp.Shape.Faces[0].Area, exact, delta=1e-4 * exact)
+            self.assertLess(pat.errors["max"], 1e-9)
+            if sc == 1.0:
+                _record("drilled_cylinder", face, pat, fp)
 
     def test_bspline_extrusion_with_cut_out(self):
         pts = [App.Vector(0, 0, 0), App.Vector(10, 5, 0), App.Vector(20, -3, 0), App.Vector(30, 0, 0)]
