@@ -609,9 +609,19 @@ def unroll_face_data(
             gives about 0.159) or its θ_max exceeds ``tol_deg`` (message gives θ_max and DD), and
             best_effort is False.
         DegenerateGeometryError: best_effort on a non-ruled face whose isolines are closed in both
-            directions (a full torus): no open boundary isolines to span rulings between.
+            directions (a full torus) or whose open isolines run between two points (a full
+            sphere); an unbounded face (infinite bounds, OCCT's 2e100) or one without wires; a
+            hole outside the outer wire in (u, v).
     """
     ev, bounds, kind = face.surface, face.bounds, face.surface.kind
+    if not all(math.isfinite(b) and abs(b) < 1e50 for b in bounds) or bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
+        raise DegenerateGeometryError(
+            f"face {label!r} is unbounded or empty: parameter bounds (u0, u1, v0, v1) = "
+            f"({', '.join(f'{b:.6g}' for b in bounds)}); allowed: a face trimmed by boundary wires, finite "
+            "bounds with u0 < u1 and v0 < v1"
+        )
+    if not any(face.wires):
+        raise DegenerateGeometryError(f"face {label!r} has no boundary wires; allowed: a face trimmed by boundary wires")
     info: dict[str, Any] = {"best_effort": bool(best_effort)}
     ruled_dir: str | None
     if kind == "plane":

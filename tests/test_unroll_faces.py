@@ -197,6 +197,22 @@ def test_face_input_errors() -> None:
         unroll_face(42)
 
 
+@pytest.mark.parametrize("which", ["plane", "cylinder"])
+def test_unbounded_face_is_refused(which: str) -> None:
+    """Faces of whole OCCT surfaces (BRepBuilderAPI_MakeFace(gp_Pln()), an infinite cylinder):
+    bounds ±2e100 (before: ZeroDivisionError for the plane, 'wire 2 (a hole) lies outside the
+    outer wire' for the cylinder)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.gp import gp_Ax3, gp_Cylinder, gp_Pln
+
+    from ght_cad.errors import DegenerateGeometryError
+
+    geom = gp_Pln() if which == "plane" else gp_Cylinder(gp_Ax3(), 5.0)
+    face = bd.Face(BRepBuilderAPI_MakeFace(geom).Face())
+    with pytest.raises(DegenerateGeometryError, match=r"unbounded or empty: parameter bounds .*2e\+100.*allowed: a face trimmed"):
+        unroll(face)
+
+
 def test_composite_of_cylinder_faces_marks_shared_edges() -> None:
     faces = bd.Cylinder(2.0, 5.0).faces()
     pat = unroll_composite(list(faces), rulings=4)
