@@ -9,6 +9,8 @@ from pathlib import Path
 import build123d as bd
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from conftest import freecadcmd_or_skip
@@ -195,6 +197,34 @@ def test_face_input_errors() -> None:
         unroll_face(bd.Box(1, 2, 3))
     with pytest.raises(GHTError, match="cannot unroll"):
         unroll_face(42)
+
+
+@settings(max_examples=6, deadline=None)
+@given(
+    R=st.floats(5.0, 40.0),
+    ratio=st.floats(0.05, 0.6),
+    phi=st.floats(0.0, 360.0),
+    z_frac=st.floats(0.2, 0.8),
+)
+def test_radially_drilled_cylinder_over_a_parameter_box(R: float, ratio: float, phi: float, z_frac: float) -> None:
+    """A cylinder R × 2R drilled through its axis (r = ratio R) at any angle φ, the holes
+    anywhere including across the seam: area 2π R H − 2 ∫ 2 R asin(√(r² − z²)/R) dz to 1e-9,
+    every hole inside the outline, boundary lengths to the model's edge tolerance (1e-8)."""
+    H, r = 2 * R, ratio * R
+    z = r + z_frac * (H - 2 * r)
+    drill = bd.Pos(0, 0, z) * bd.Rot(0, 0, phi) * bd.Cylinder(r, 3 * R, rotation=(0, 90, 0))
+    part = bd.Cylinder(R, H, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)) - drill
+    f = max((f for f in part.faces() if f.geom_type == bd.GeomType.CYLINDER), key=lambda f: f.area)
+    pat = unroll(f, rulings=2, samples=65)
+    hole = quad(lambda t: 2 * R * math.asin(math.sqrt(max(r * r - t * t, 0.0)) / R), -r, r, epsabs=0, epsrel=1e-13, limit=200)[0]
+    exact = 2 * math.pi * R * H - 2 * hole
+    assert pat.area == pytest.approx(exact, rel=1e-9)
+    assert pat.panels[0].area_3d == pytest.approx(exact, rel=1e-9)
+    outline = pat.outlines[0]
+    np.testing.assert_allclose(np.ptp(outline, axis=0), [2 * math.pi * R, H], rtol=1e-9)
+    for loop in pat.outlines[1:]:
+        assert np.all(loop.min(axis=0) > outline.min(axis=0)) and np.all(loop.max(axis=0) < outline.max(axis=0))
+    assert pat.errors["boundary_length"] < 1e-8 and pat.errors["area"] < 1e-9
 
 
 @pytest.mark.parametrize("which", ["plane", "cylinder"])
