@@ -36,7 +36,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
-from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
+from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, measure_panel
 from .ruled import RuledSurface
 from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
 
@@ -738,17 +738,6 @@ def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:
     return np.concatenate([np.stack([np.asarray(x, dtype=float) for x in uvf(t)], axis=1) for uvf, _ in loop])
 
 
-def _inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """Even-odd point-in-polygon test of (m, 2) points against a closed (k, 2) polygon."""
-    x, y = points[:, 0][:, None], points[:, 1][:, None]
-    x0, y0 = polygon[:, 0][None, :], polygon[:, 1][None, :]
-    x1, y1 = np.roll(polygon[:, 0], -1)[None, :], np.roll(polygon[:, 1], -1)[None, :]
-    crosses = (y0 > y) != (y1 > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xs = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
-    return (np.sum(crosses & (x < xs), axis=1) % 2) == 1
-
-
 def _check_holes_inside(loops_uv: list[list[tuple[Callable, Callable]]], label: str) -> None:
     """Every hole loop must lie inside the outer loop in (u, v) (a face's holes do; a hole outside
     means inconsistent pcurves, e.g. one shifted by a period, and would be drawn outside the
@@ -761,7 +750,7 @@ def _check_holes_inside(loops_uv: list[list[tuple[Callable, Callable]]], label: 
         return
     outer = _loop_points(loops_uv[0], 64)
     for k, loop in enumerate(loops_uv[1:], start=1):
-        inside = _inside(_loop_points(loop, 8), outer)
+        inside = _point_in_polygon(_loop_points(loop, 8), outer)
         if inside.mean() < 0.5:
             raise DegenerateGeometryError(
                 f"face {label!r}: wire {k + 1} (a hole) lies outside the outer wire in the face's (u, v) "
