@@ -2089,10 +2089,12 @@ def unroll_step(
             pat = unroll(face, best_effort=best_effort, **kw)
         except NotDevelopableError as exc:
             info_be: dict[str, Any] = {}
+            be_error = ""
             try:  # measure how far off it is (for a non-ruled face: the ruled surface between its boundary isolines)
                 info_be = unroll(face, best_effort=True, **kw).panels[0].info or {}
-            except GHTError:
+            except GHTError as be_exc:  # e.g. a full sphere: no two boundary curves to span rulings between
                 info_be = {}
+                be_error = " ".join(str(be_exc).split())
             dev = info_be.get("developability")
             straight = min(info_be.get("deviation_u", 0.0), info_be.get("deviation_v", 0.0))
             how = (f"theta_max={dev['theta_max']:.6g} deg, developability degree DD={dev['dd']:.12f} (1 = developable)"
@@ -2100,9 +2102,12 @@ def unroll_step(
             if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
                 how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
                        "relative to their lengths (allowed 1e-9), so it has no rulings to unroll along")
+            if be_error and "cannot be flattened" not in how and "cannot flatten" not in how:
+                how += f"; --best-effort cannot flatten it either: {be_error}"
+            allowed = ("allowed: developable faces" if be_error else
+                       "allowed: developable faces, or --best-effort to flatten it with a distortion report")
             raise NotDevelopableError(
-                f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; "
-                "allowed: developable faces, or --best-effort to flatten it with a distortion report"
+                f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; {allowed}"
             ) from None
         except GHTError as exc:
             raise type(exc)(f"{p}: face {k} of {n}: {' '.join(str(exc).split())}") from None

@@ -204,6 +204,11 @@ def test_full_sphere_is_refused_even_with_best_effort(tmp_path: Path, capsys) ->
     rc, out, _ = _run(["unroll", str(step), "--best-effort", "--dxf", str(tmp_path / "s.dxf")], capsys)
     assert rc == EXIT_USAGE and not (tmp_path / "s.dxf").exists()
     assert f"{step}: face 1 of 1" in out["error"] and "run between two points" in out["error"]
+    # without --best-effort the refusal must not suggest --best-effort, which cannot help here
+    rc, out, _ = _run(["unroll", str(step)], capsys)
+    assert rc == EXIT_USAGE and "not developable" in out["error"]
+    assert "or --best-effort to flatten" not in out["error"] and "cannot flatten it either" in out["error"]
+    assert out["error"].count("cannot flatten it either") == 1
 
 
 def _cli_json(argv: list[str]) -> tuple[int, dict, str]:
