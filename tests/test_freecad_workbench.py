@@ -165,6 +165,11 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert cancel["pressed"] and cancel["status"].startswith("cancelled") and cancel["unchanged"], cancel
     for name in ("GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"):
         assert steps[name]["value"]["exists"], name
+    # under the GUI the STEP export goes through ImportGui: the product is named by the Label and
+    # the curve's view line colour is written as a STEP COLOUR_RGB
+    exp = steps["GHT_ExportSTEP"]["value"]
+    assert exp["products"] == [exp["label"]], exp
+    assert exp["colours"] and exp["line_colour_written"], exp
     for name, s in steps.items():
         if isinstance(s["value"], dict) and "valid" in s["value"]:
             assert s["value"]["created"] >= 1 and s["value"]["valid"], (name, s["value"])

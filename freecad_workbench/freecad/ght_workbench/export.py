@@ -1,4 +1,4 @@
-"""Export commands: STEP of selected features, DXF/SVG of flat patterns (atomic writes).
+"""Export commands: STEP of selected features (named products via FreeCAD's XCAF exporter), DXF/SVG of flat patterns (atomic writes).
 
 FreeCAD's Python has no ezdxf, so DXF is written by :func:`write_dxf_r12`, a minimal AutoCAD R12
 ASCII writer (LINE and POLYLINE entities on layers OUTLINE and BEND), which every CAM/laser
@@ -40,13 +40,42 @@ def _shapes(objects: Iterable[Any]) -> list:
     return out
 
 
+def _step_writer() -> Any:
+    """FreeCAD's XCAF STEP exporter: ``ImportGui.export`` in the GUI (it also writes the view
+    colours), ``Import.export`` headless (names only)."""
+    if App.GuiUp:
+        try:
+            import ImportGui
+
+            return ImportGui.export
+        except ImportError:  # pragma: no cover - GUI builds without ImportGui
+            pass
+    import Import
+
+    return Import.export
+
+
 def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool = True) -> str:
-    """Write the shapes of ``objects`` (one, or a compound of several) to a STEP file atomically.
+    """Write ``objects`` to a STEP file (AP214, millimetres) atomically, one named product each.
+
+    FreeCAD's XCAF exporter writes every object as a STEP ``PRODUCT`` named by its ``Label``
+    (several objects: under a root product named after the document); under the GUI the view
+    colours are written too (``COLOUR_RGB``). The file is first written to a temporary
+    ``.step`` name beside ``path`` and renamed over it only when complete.
+
+    Args:
+        objects: FreeCAD objects with a non-null ``Shape``.
+        path: target file (``.step``/``.stp``; the content is STEP whatever the suffix).
+        check: refuse shapes for which ``shape.isValid()`` is False.
 
     Raises:
-        GHTError: nothing to export, an invalid shape (when ``check``), or a failed write (the
-            target file is then untouched).
+        GHTError: nothing to export, an object without shape, or an invalid shape (when ``check``).
+        OSError: the write failed; the target file is then untouched and no partial file is left.
+
+    Returns:
+        ``str(path)``.
     """
+    objects = list(objects)
     shapes = _shapes(objects)
     if not shapes:
         raise GHTError("nothing to export: no objects given")
@@ -54,9 +83,22 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
         for o, s in zip(objects, shapes):
             if not s.isValid():
                 raise GHTError(f"{o.Label} is not a valid shape (shape.isValid() is False); not exported to {path}")
-    shape = shapes[0] if len(shapes) == 1 else Part.makeCompound(shapes)
-    with atomic_path(path) as tmp:
-        shape.exportStep(str(tmp))
+    writer = _step_writer()
+    units = Part.exportUnits().get("write.step.unit", "MM")
+    Part.exportUnits("MM")  # FreeCAD's lengths are mm: write them as they are, whatever the user preference
+    try:
+        # the exporter picks the format from the suffix: the temporary name must end in .step
+        with atomic_path(path, suffix=".step") as tmp:
+            step_tmp = tmp.with_name(tmp.name[: -len(".part")])
+            try:
+                writer(objects, str(step_tmp))
+                if step_tmp.exists():
+                    os.replace(step_tmp, tmp)
+            finally:
+                if step_tmp.exists():
+                    step_tmp.unlink()
+    finally:
+        Part.exportUnits(units)
     return str(path)
 
 
@@ -205,7 +247,7 @@ class CommandExportSTEP(BaseCommand):
     name = "GHT_ExportSTEP"
     icon_name = "GHT_ExportSTEP"
     menu_text = "Export STEP"
-    tooltip = "Export the selected features (their shapes, as one compound) to a STEP file"
+    tooltip = "Export the selected features to a STEP file (one product per feature, named by its label; colours in the GUI)"
     #: set by tests/macros to skip the file dialog
     target: str | None = None
 

@@ -168,7 +168,20 @@ def main():
         Gui.Selection.clearSelection()
         Gui.Selection.addSelection(ctx["curve"])
         Gui.runCommand("GHT_ExportSTEP", 0)
-        return {"exists": os.path.getsize(export.CommandExportSTEP.target) > 0}
+        text = open(export.CommandExportSTEP.target, encoding="utf-8").read()
+        import re
+
+        # ImportGui.export writes the view colour (COLOUR_RGB) and the Label as the product name
+        colours = [tuple(float(x) for x in m) for m in re.findall(r"COLOUR_RGB\s*\(\s*'[^']*'\s*,\s*([-\d.Ee+]+)\s*,\s*([-\d.Ee+]+)\s*,\s*([-\d.Ee+]+)", text)]
+        line = tuple(ctx["curve"].ViewObject.LineColor[:3])
+        return {
+            "exists": os.path.getsize(export.CommandExportSTEP.target) > 0,
+            "products": re.findall(r"=\s*PRODUCT\s*\(\s*'((?:[^']|'')*)'", text),
+            "label": ctx["curve"].Label,
+            "colours": colours,
+            "line_colour": line,
+            "line_colour_written": any(max(abs(a - b) for a, b in zip(c, line)) < 1e-3 for c in colours),
+        }
 
     step("GHT_ExportSTEP", exp_step)
     for name, ext in (("GHT_ExportDXF", ".dxf"), ("GHT_ExportSVG", ".svg")):
