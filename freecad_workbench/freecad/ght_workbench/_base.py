@@ -23,6 +23,7 @@ __all__ = [
     "BaseCommand",
     "add_shape_parameters",
     "check_shape",
+    "tolerance_property",
     "restore_constraints",
     "set_read_only",
     "new_feature",
@@ -54,6 +55,31 @@ def check_shape(mu: float, nu: float, gamma: float) -> None:
 
     for n, v in (("mu", mu), ("nu", nu), ("gamma", gamma)):
         check_shape_parameter(n, v)
+
+
+def tolerance_property(obj: Any, name: str = "Tolerance", *, zero_means: str | None = None) -> float | None:
+    """The value of a tolerance property, refused unless finite and > 0.
+
+    Args:
+        obj: the feature.
+        name: property name.
+        zero_means: if given, 0 is allowed and documented as this (e.g. "automatic"); the
+            function then returns None for 0.
+
+    Raises:
+        ght_cad.errors.GHTError: NaN, ±inf, a negative value, or 0 when ``zero_means`` is None.
+    """
+    import math
+
+    from ght_cad.errors import GHTError
+
+    v = float(getattr(obj, name))
+    if zero_means is not None and v == 0.0:
+        return None
+    if not math.isfinite(v) or v <= 0.0:
+        allowed = f"a finite number >= 0 (0: {zero_means})" if zero_means is not None else "a finite number > 0"
+        raise GHTError(f"{obj.Label}.{name}={v!r} is not allowed; it must be {allowed}")
+    return v
 
 
 def restore_constraints(obj: Any) -> None:

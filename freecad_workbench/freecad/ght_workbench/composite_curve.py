@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import FreeCAD as App
 import Part
 
-from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, set_read_only
+from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, set_read_only, tolerance_property
 from .convert import DEFAULT_TOL, curve_data, edge_from_data
 from .ght_curve import core_curve
 
@@ -30,12 +30,21 @@ def joined_curves(obj: Any) -> list:
     segs = list(obj.Segments)
     if len(segs) < 2:
         raise ValueError(f"a composite curve needs >= 2 segments; {obj.Label} has {len(segs)}")
+    for i, seg in enumerate(segs):
+        if getattr(getattr(seg, "Proxy", None), "Type", "") != "GHT::Curve":
+            raise ValueError(f"{obj.Label}.Segments[{i}] = {seg.Label} is not a GHT curve; link GHT curve features only")
+    n = len(segs) - 1
     conts = list(obj.Continuity)
-    ks = list(obj.K)
+    ks = [float(x) for x in obj.K] or [1.0] * n
+    for name, vals in (("Continuity", conts), ("K", ks)):
+        if len(vals) != n:
+            raise ValueError(
+                f"{obj.Label}.{name} has {len(vals)} value{'s' if len(vals) != 1 else ''} for {n} joint{'s' if n != 1 else ''}; "
+                f"give exactly one per joint (segments - 1){' or none for k = 1' if name == 'K' else ''}"
+            )
     curves = [core_curve(segs[0])]
     for j, seg in enumerate(segs[1:]):
-        cont = conts[j] if j < len(conts) else "C1"
-        k = float(ks[j]) if j < len(ks) else 1.0
+        cont, k = conts[j], ks[j]
         b = core_curve(seg)
         kw = {"k": k} if cont.upper().startswith("G") and cont[1:] != "0" else {}
         curves.append(join(curves[-1], cont, b, **kw))
@@ -50,8 +59,8 @@ class CompositeCurveFeature(FeatureProxy):
     def setup(self, obj: Any) -> None:
         obj.addProperty("App::PropertyLinkList", "Segments", "Input", "GHT curve features, in order (each is joined to the previous one)")
         obj.addProperty("App::PropertyStringList", "Continuity", "Joints", "Continuity per joint: C0..C3 or G0..G3")
-        obj.addProperty("App::PropertyFloatList", "K", "Joints", "G-joint tangent ratio k > 0 per joint (R'(0) = k P'(1))")
-        obj.addProperty("App::PropertyFloat", "Tolerance", "Conversion", "Maximum deviation of each B-spline edge")
+        obj.addProperty("App::PropertyFloatList", "K", "Joints", "G-joint tangent ratio k > 0 per joint (R'(0) = k P'(1)); empty: k = 1 at every joint")
+        obj.addProperty("App::PropertyFloat", "Tolerance", "Conversion", "Maximum deviation (> 0) of each B-spline edge")
         obj.Tolerance = DEFAULT_TOL
         obj.addProperty("App::PropertyStringList", "JointOrders", "Output", "Measured continuity per joint, e.g. C1/G2")
         self.restored(obj)
@@ -63,7 +72,7 @@ class CompositeCurveFeature(FeatureProxy):
         from ght_cad.continuity import measure_continuity
 
         curves = joined_curves(obj)
-        tol = max(float(obj.Tolerance), 1e-12)
+        tol = tolerance_property(obj)
         edges = [edge_from_data(curve_data(c, tol=tol)) for c in curves]
         orders = []
         for a, b in zip(curves[:-1], curves[1:]):

@@ -27,6 +27,7 @@ from ._base import (
     new_feature,
     register_command,
     set_read_only,
+    tolerance_property,
 )
 from .convert import ruled_face
 
@@ -86,7 +87,7 @@ class SurfaceOutputs:
         set_read_only(obj, self.OUTPUTS)
 
     def build(self, obj: Any, surface: Any) -> None:
-        tol = float(obj.Tolerance) if float(obj.Tolerance) > 0 else None
+        tol = tolerance_property(obj, zero_means="1e-7 of the surface size")
         face, data = ruled_face(surface, tol)
         dev = surface.developability()
         obj.ThetaMax, obj.ThetaRms, obj.DD, obj.R = dev.theta_max, dev.theta_rms, dev.dd, dev.R

@@ -25,8 +25,10 @@ from ._base import (
     new_feature,
     register_command,
     set_read_only,
+    tolerance_property,
 )
 from .convert import DEFAULT_TOL, curve_data, edge_from_data, points_array
+from ght_cad.errors import GHTError
 
 __all__ = ["GHTCurveFeature", "make_ght_curve", "points_from_links", "core_curve"]
 
@@ -38,7 +40,10 @@ def points_from_links(links: Sequence[tuple[Any, Sequence[str]]]) -> list["App.V
     for obj, subs in links:
         subs = [s for s in (subs or []) if s]
         if subs:
+            nv = len(obj.Shape.Vertexes)
             for s in subs:
+                if s.startswith("Vertex") and s[6:].isdigit() and not 1 <= int(s[6:]) <= nv:
+                    raise ValueError(f"Source: {obj.Label} has no {s} (it has {nv} vertices); link existing vertices, a sketch or a shape")
                 el = obj.Shape.getElement(s)
                 if not isinstance(el, Part.Vertex):
                     raise ValueError(f"{obj.Label}.{s} is a {type(el).__name__}; select vertices or a sketch")
@@ -72,7 +77,7 @@ class GHTCurveFeature(FeatureProxy):
         obj.addProperty("App::PropertyLinkSubList", "Source", "Input", "Vertices, a sketch or a shape whose points become the control points (overrides ControlPoints)")
         obj.addProperty("App::PropertyVectorList", "ControlPoints", "Input", "Control points P_0..P_m (m >= 2)")
         add_shape_parameters(obj)
-        obj.addProperty("App::PropertyFloat", "Tolerance", "Conversion", "Maximum deviation of the B-spline edge from the exact GHT curve")
+        obj.addProperty("App::PropertyFloat", "Tolerance", "Conversion", "Maximum deviation (> 0) of the B-spline edge from the exact GHT curve")
         obj.Tolerance = DEFAULT_TOL
         obj.addProperty("App::PropertyInteger", "Degree", "Output", "Degree m = number of control points - 1")
         obj.addProperty("App::PropertyFloat", "CurveLength", "Output", "Arc length ∫|P'(t)|dt of the exact curve")
@@ -87,8 +92,17 @@ class GHTCurveFeature(FeatureProxy):
             pts = points_from_links(obj.Source)
             if [tuple(p) for p in pts] != [tuple(p) for p in obj.ControlPoints]:
                 obj.ControlPoints = pts
+        tol = tolerance_property(obj)
+        pts = points_array(obj.ControlPoints)
+        if len(pts) >= 2:
+            spread = float(np.max(np.linalg.norm(pts - pts[0], axis=1)))
+            if spread <= 1e-12 * max(1.0, float(np.max(np.abs(pts)))):
+                raise GHTError(
+                    f"{obj.Label}.ControlPoints: all {len(pts)} points coincide at {tuple(pts[0])}; the curve would be a "
+                    "single point (at least two control points must differ)"
+                )
         curve = core_curve(obj)
-        data = curve_data(curve, tol=max(float(obj.Tolerance), 1e-12))
+        data = curve_data(curve, tol=tol)
         obj.Shape = edge_from_data(data)
         obj.Degree = curve.degree
         obj.CurveLength = float(curve.arc_length())

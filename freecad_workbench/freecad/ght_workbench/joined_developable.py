@@ -39,6 +39,7 @@ from ._base import (
     check_shape,
     new_feature,
     set_read_only,
+    tolerance_property,
 )
 from .convert import face_from_data
 
@@ -109,7 +110,7 @@ class JoinedDevelopableFeature(FeatureProxy):
         obj.addProperty("App::PropertyFloatList", "BoundaryCoordinates", "Input", "Boundary planes E_a, E_b (8 numbers); empty: those of Previous (shared joint ruling)")
         obj.addProperty("App::PropertyBool", "Fuse", "Input", "Shape = shell of Previous's faces and the new face sewn along the shared ruling edge")
         add_shape_parameters(obj)
-        obj.addProperty("App::PropertyFloat", "JointTolerance", "Joint", "Relative tolerance of the measured joint order")
+        obj.addProperty("App::PropertyFloat", "JointTolerance", "Joint", "Relative tolerance (>= 0; 0: 1e-9) of the measured joint order")
         obj.JointTolerance = 1e-9
         obj.addProperty("App::PropertyInteger", "Degree", "Output", "Degree n of the new strip's dual curve")
         obj.addProperty("App::PropertyInteger", "JointOrder", "Joint", "Measured geometric order of the joint (measure_developable_joint)")
@@ -154,7 +155,7 @@ class JoinedDevelopableFeature(FeatureProxy):
 
         first = _surface_of(obj.Previous)
         surf = self.surface(obj)
-        rep = measure_developable_joint(first, surf, tol=float(obj.JointTolerance) if obj.JointTolerance > 0 else 1e-9)
+        rep = measure_developable_joint(first, surf, tol=tolerance_property(obj, "JointTolerance", zero_means="1e-9") or 1e-9)
         obj.JointOrder = int(rep.order)
         obj.JointResiduals = [float(x) if np.isfinite(x) else -1.0 for x in rep.residuals]
         obj.PlaneAngle = float(rep.plane_angle)

@@ -96,7 +96,19 @@ class OptimizationFeature(FeatureProxy):
             raise ValueError(f"{t.Label} is a {_kind(t) or t.TypeId}; Fairness drives a GHT curve or a developable from planes")
         return prob, [(t, p, p.lower()) for p in ("Mu", "Nu", "Gamma")]
 
+    def check_settings(self, obj: Any) -> None:
+        """Refuse optimizer settings the core would refuse, naming the property.
+
+        Raises:
+            ValueError: ``MaxIterations`` < 0 or ``PopulationSize`` < 4.
+        """
+        if int(obj.MaxIterations) < 0:
+            raise ValueError(f"{obj.Label}.MaxIterations={obj.MaxIterations} is not allowed; use an integer >= 0")
+        if int(obj.PopulationSize) < 4:
+            raise ValueError(f"{obj.Label}.PopulationSize={obj.PopulationSize} is not allowed; use an integer >= 4")
+
     def compute(self, obj: Any) -> None:
+        self.check_settings(obj)
         if not obj.Targets:
             return
         prob, _ = self.problem(obj)
@@ -115,6 +127,7 @@ class OptimizationFeature(FeatureProxy):
         """
         from ght_cad.optimize import minimize
 
+        self.check_settings(obj)
         prob, mapping = self.problem(obj)
         initial = prob.value(prob.x0)
 
@@ -238,7 +251,12 @@ class CommandRunOptimization(BaseCommand):
         for obj in [o for o in Gui.Selection.getSelection() if _kind(o) == "GHT::Optimization"]:
             doc = obj.Document
             doc.openTransaction("Run optimization")
-            res = run_optimization(obj)
+            try:
+                res = run_optimization(obj)
+            except Exception as exc:  # bad settings/targets: nothing was changed, say why
+                doc.abortTransaction()
+                App.Console.PrintError(f"GHT: {obj.Label}: {exc}\n")
+                continue
             doc.commitTransaction()
             App.Console.PrintMessage(f"GHT: {obj.Label}: {res}\n")
 

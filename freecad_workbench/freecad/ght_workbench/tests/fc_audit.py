@@ -1,0 +1,169 @@
+"""Bad property values inside FreeCAD (headless), as a user types them into the property editor.
+
+Every case: set the value, recompute; the feature must be in error (``Invalid``) with a status
+message naming the property and what is allowed, never silently build a shape from a replaced
+value. Then the good value is restored and the feature recomputes to the very same geometry.
+
+Run: ``PYTHONPATH=<repo>/freecad_workbench:<repo> freecadcmd -t freecad.ght_workbench.tests.fc_audit``
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import unittest
+
+import FreeCAD as App
+import Part
+
+from freecad.ght_workbench import composite_curve, developable, ght_curve, joined_developable, optimization
+
+OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_audit_")
+PTS = [(0, 0, 0), (10, 20, 0), (30, 20, 5), (40, 0, 0)]
+
+
+def _bad(obj) -> bool:
+    return "Invalid" in obj.State or "Error" in obj.State
+
+
+class BadValueCase(unittest.TestCase):
+    def setUp(self):
+        self.doc = App.newDocument("audit")
+
+    def tearDown(self):
+        for name in list(App.listDocuments()):
+            App.closeDocument(name)
+
+    def assert_refused(self, obj, prop, value, *words, measure=lambda s: (s.Length, s.Area)):
+        """Setting ``prop`` to ``value`` puts ``obj`` in error with a message holding ``words``;
+        restoring the old value recomputes the same geometry."""
+        good = getattr(obj, prop)
+        before = measure(obj.Shape) if hasattr(obj, "Shape") else None
+        setattr(obj, prop, value)
+        self.doc.recompute()
+        self.assertTrue(_bad(obj), f"{obj.Label}.{prop} = {value!r} was accepted (state {obj.State})")
+        msg = obj.getStatusString()
+        for w in words:
+            self.assertIn(w, msg, f"{obj.Label}.{prop} = {value!r}: message {msg!r} lacks {w!r}")
+        setattr(obj, prop, good)
+        self.doc.recompute()
+        self.assertFalse(_bad(obj), obj.getStatusString())
+        if before is not None:
+            after = measure(obj.Shape)
+            for a, b in zip(after, before):
+                self.assertLessEqual(abs(a - b), 1e-12 * max(1.0, abs(b)))
+
+
+class CurveBadValuesTest(BadValueCase):
+    def test_tolerance_must_be_positive(self):
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        for v in (-1.0, 0.0, float("nan"), float("inf")):
+            with self.subTest(v):
+                self.assert_refused(c, "Tolerance", v, "Tolerance", "> 0")
+
+    def test_coincident_control_points(self):
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        self.assert_refused(c, "ControlPoints", [App.Vector(1, 2, 3)] * 3, "ControlPoints", "coincide")
+
+    def test_nan_shape_parameter_and_too_few_points(self):
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        self.assert_refused(c, "Mu", float("nan"), "mu", "[-1, 1]")
+        self.assert_refused(c, "ControlPoints", [App.Vector(0, 0, 0), App.Vector(1, 0, 0)], "at least 3")
+
+    def test_source_vertex_out_of_range(self):
+        poly = self.doc.addObject("Part::Feature", "Poly")
+        poly.Shape = Part.makePolygon([App.Vector(*p) for p in PTS])
+        c = ght_curve.make_ght_curve(source=[(poly, ["Vertex1", "Vertex2", "Vertex3", "Vertex4"])], doc=self.doc)
+        self.assert_refused(c, "Source", [(poly, ["Vertex1", "Vertex2", "Vertex9"])], "Source", "Vertex9", "4 vertices")
+
+
+class CompositeBadValuesTest(BadValueCase):
+    def setUp(self):
+        super().setUp()
+        self.a = ght_curve.make_ght_curve([(0, 0, 0), (10, 15, 0), (25, 15, 0), (30, 0, 0)], doc=self.doc, name="SegA")
+        self.b = ght_curve.make_ght_curve([(30, 0, 0), (35, -10, 0), (50, -10, 0), (60, 0, 0)], doc=self.doc, name="SegB")
+        self.c = ght_curve.make_ght_curve([(60, 0, 0), (66, 6, 0), (70, 9, 4), (80, 10, 0)], doc=self.doc, name="SegC")
+        self.cc = composite_curve.make_composite_curve([self.a, self.b, self.c], ["G1", "G2"], k=[1.0, 2.0], doc=self.doc)
+        self.assertFalse(_bad(self.cc))
+
+    def test_one_value_per_joint(self):
+        self.assert_refused(self.cc, "Continuity", ["G1"], "Continuity", "1 value", "2 joints")
+        self.assert_refused(self.cc, "Continuity", ["G1", "G2", "C1"], "Continuity", "3 values", "2 joints")
+        self.assert_refused(self.cc, "K", [1.0], "K", "1 value", "2 joints")
+        self.assert_refused(self.cc, "K", [1.0, 2.0, 3.0], "K", "3 values", "2 joints")
+        self.assert_refused(self.cc, "K", [1.0, float("nan")], "k=nan")
+
+    def test_empty_k_means_one_everywhere(self):
+        self.cc.K = [1.0, 1.0]
+        self.doc.recompute()
+        ref = self.cc.Shape.Length
+        self.cc.K = []
+        self.doc.recompute()
+        self.assertFalse(_bad(self.cc), self.cc.getStatusString())
+        self.assertAlmostEqual(self.cc.Shape.Length, ref, delta=1e-12 * ref)
+
+    def test_segment_must_be_a_ght_curve(self):
+        box = self.doc.addObject("Part::Box", "Box")
+        self.assert_refused(self.cc, "Segments", [self.a, box], "Segments", "Box", "GHT curve")
+
+    def test_tolerance(self):
+        self.assert_refused(self.cc, "Tolerance", -1e-6, "Tolerance", "> 0")
+
+
+class SurfaceBadValuesTest(BadValueCase):
+    def test_developable_tolerance(self):
+        d = developable.make_developable(gamma=-1.0, doc=self.doc)
+        for v in (-1.0, float("nan")):
+            with self.subTest(v):
+                self.assert_refused(d, "Tolerance", v, "Tolerance", ">= 0")
+        d.Tolerance = 0.0  # 0 = automatic, documented
+        self.doc.recompute()
+        self.assertFalse(_bad(d))
+
+    def test_joined_joint_tolerance(self):
+        d = developable.make_developable(gamma=-1.0, doc=self.doc)
+        j = joined_developable.make_joined_developable(d, "G2", doc=self.doc)
+        self.assert_refused(j, "JointTolerance", -1.0, "JointTolerance", ">= 0")
+
+
+class OptimizationBadValuesTest(BadValueCase):
+    def test_optimizer_settings_named_by_property(self):
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        o = optimization.make_optimization([c], doc=self.doc)
+        self.assertFalse(_bad(o))
+        self.assert_refused(o, "MaxIterations", -1, "MaxIterations", ">= 0")
+        self.assert_refused(o, "PopulationSize", 2, "PopulationSize", ">= 4")
+        self.assert_refused(o, "WeightEn", float("nan"), "En=nan")
+        mu = (c.Mu, c.Nu, c.Gamma)
+        o.MaxIterations = -1
+        self.doc.recompute()
+        with self.assertRaisesRegex(ValueError, "MaxIterations"):
+            o.Proxy.run(o)
+        self.assertEqual((c.Mu, c.Nu, c.Gamma), mu)
+
+
+class ReopenInErrorTest(BadValueCase):
+    def test_a_feature_in_error_survives_save_and_reopen(self):
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        good, name = c.Shape.Length, c.Name
+        c.Tolerance = -1.0
+        self.doc.recompute()
+        self.assertTrue(_bad(c))
+        path = os.path.join(OUT, "audit_error.FCStd")
+        self.doc.saveAs(path)
+        App.closeDocument(self.doc.Name)
+        self.doc = App.openDocument(path)
+        c2 = self.doc.getObject(name)
+        c2.touch()
+        self.doc.recompute()
+        self.assertTrue(_bad(c2))
+        self.assertIn("Tolerance", c2.getStatusString())
+        c2.Tolerance = 1e-6
+        self.doc.recompute()
+        self.assertFalse(_bad(c2))
+        self.assertAlmostEqual(c2.Shape.Length, good, delta=1e-12 * good)
+
+
+if __name__ == "__main__":
+    unittest.main()
