@@ -67,7 +67,10 @@ def _planes(links: Sequence[Any], coords: Sequence[float], what: str) -> np.ndar
             out += [plane_from_link(obj, s) for s in subs]
         return np.array(out)
     arr = np.asarray(list(coords), dtype=float)
-    if arr.size == 0 or arr.size % 4:
+    if arr.size == 0:
+        link = "BoundaryPlanes" if what.startswith("Boundary") else "Planes"
+        raise ValueError(f"no planes: {link} links nothing (deleted?) and {what} is empty; link planes or give 4 numbers (u0, u1, u2, u3) per plane")
+    if arr.size % 4:
         raise ValueError(f"{what} has {arr.size} numbers; give 4 per plane (u0, u1, u2, u3)")
     return arr.reshape(-1, 4)
 

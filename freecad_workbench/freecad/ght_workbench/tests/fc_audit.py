@@ -127,6 +127,56 @@ class SurfaceBadValuesTest(BadValueCase):
         self.assert_refused(j, "JointTolerance", -1.0, "JointTolerance", ">= 0")
 
 
+class LinkedPlanesTest(BadValueCase):
+    def _linked(self):
+        def plane(normal, point, name):
+            p = self.doc.addObject("Part::Plane", name)
+            p.Length = p.Width = 5
+            p.Placement = App.Placement(App.Vector(*point), App.Rotation(App.Vector(0, 0, 1), App.Vector(*normal)))
+            return p
+
+        s = math.sqrt(0.5)
+        ps = [plane((1, 0, 0), (10, 0, 0), "P0"), plane((s, s, 0), (5, 5, 0), "P1"), plane((0, 1, 0), (0, 10, 0), "P2")]
+        ea, eb = plane((0, 0, 1), (0, 0, 0), "Ea"), plane((0, 0, 1), (0, 0, 20), "Eb")
+        self.doc.recompute()
+        d = developable.make_developable([(p, "") for p in ps], [(ea, ""), (eb, "")], gamma=-1.0, weights=[1.0, math.sqrt(2), 1.0], doc=self.doc)
+        self.assertFalse(_bad(d), d.getStatusString())
+        return d, ps
+
+    def test_reopen_identical_then_deleted_planes(self):
+        d, ps = self._linked()
+        area, name = d.Shape.Area, d.Name
+        self.assertAlmostEqual(area, 100 * math.pi, delta=1e-6 * area)  # exact quarter cylinder r = 10, H = 20
+        path = os.path.join(OUT, "audit_linked.FCStd")
+        self.doc.saveAs(path)
+        App.closeDocument(self.doc.Name)
+        self.doc = App.openDocument(path)
+        d = self.doc.getObject(name)
+        for o in self.doc.Objects:
+            o.touch()
+        self.doc.recompute()
+        self.assertFalse(_bad(d), d.getStatusString())
+        self.assertLessEqual(abs(d.Shape.Area - area), 1e-12 * area)
+        self.assertEqual(list(d.PlaneWeights), [1.0, math.sqrt(2), 1.0])
+        # a deleted control plane: the link drops out, the feature says how many planes are left
+        self.doc.removeObject("P1")
+        self.doc.recompute()
+        self.assertTrue(_bad(d))
+        self.assertIn("PlaneWeights has 3 values for 2 planes", d.getStatusString())
+        d.PlaneWeights = []
+        self.doc.recompute()
+        self.assertTrue(_bad(d))
+        self.assertIn("at least 3", d.getStatusString())
+        # every control plane deleted: no silent fall-back, the message names both inputs
+        self.doc.removeObject("P0")
+        self.doc.removeObject("P2")
+        self.doc.recompute()
+        self.assertTrue(_bad(d))
+        self.assertIn("Planes", d.getStatusString())
+        self.assertIn("PlaneCoordinates", d.getStatusString())
+        self.assertLessEqual(abs(d.Shape.Area - area), 1e-12 * area)  # the old shape stays, marked Invalid
+
+
 class OptimizationBadValuesTest(BadValueCase):
     def test_optimizer_settings_named_by_property(self):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
