@@ -30,9 +30,20 @@ __all__ = [
 ]
 
 
+def _stale(obj: Any) -> list[str]:
+    """The error states of ``obj`` (its last recompute failed: its shape is the old one)."""
+    return [s for s in getattr(obj, "State", []) if s in ("Invalid", "Error")]
+
+
 def _shapes(objects: Iterable[Any]) -> list:
     out = []
     for o in objects:
+        state = _stale(o)
+        if state:
+            raise GHTError(
+                f"{o.Label}: its last recompute failed (state {', '.join(state)}: {o.getStatusString()}), so its shape is "
+                "stale; fix the feature or leave it out of the export"
+            )
         shp = getattr(o, "Shape", None)
         if shp is None or shp.isNull():
             raise GHTError(f"{getattr(o, 'Label', o)} has no shape to export")
@@ -69,7 +80,8 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
         check: refuse shapes for which ``shape.isValid()`` is False.
 
     Raises:
-        GHTError: nothing to export, an object without shape, or an invalid shape (when ``check``).
+        GHTError: nothing to export, an object without shape, an object whose last recompute failed
+            (its shape is stale), or an invalid shape (when ``check``).
         OSError: the write failed; the target file is then untouched and no partial file is left.
 
     Returns:

@@ -116,8 +116,7 @@ class NamedStepExportTest(unittest.TestCase):
         self.assertAlmostEqual(export.read_step(path).Volume, 1000.0, delta=1e-9 * 1000)
 
     def test_failures_leave_the_existing_file_untouched(self):
-        folder = os.path.join(OUT, "fail")
-        os.makedirs(folder, exist_ok=True)
+        folder = tempfile.mkdtemp(prefix="fail_", dir=OUT)  # fresh: the listing must hold only our files
         path = os.path.join(folder, "part.step")
         export.export_step([self.box], path)
         original = open(path, "rb").read()
@@ -151,7 +150,15 @@ class NamedStepExportTest(unittest.TestCase):
         empty.Label = "Leer Ü"
         with self.assertRaisesRegex(Exception, "Leer Ü has no shape to export"):
             export.export_step([self.box, empty], path)
-        # 4. nothing selected
+        # 4. a feature whose last recompute failed keeps its old shape: refused, not exported stale
+        self.curve.Tolerance = -1.0
+        self.doc.recompute()
+        self.assertIn("Invalid", self.curve.State)
+        with self.assertRaisesRegex(Exception, "Curve: its last recompute failed"):
+            export.export_step([self.box, self.curve], path)
+        self.curve.Tolerance = 1e-6
+        self.doc.recompute()
+        # 5. nothing selected
         with self.assertRaisesRegex(Exception, "nothing to export"):
             export.export_step([], path)
         self.assertEqual(open(path, "rb").read(), original)
