@@ -155,6 +155,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     c = steps["GHT_Curve"]["value"]
     assert c["dialog_open"] and c["live_changed"] and c["slider_gamma"] == -1.0, c
     assert c["restored"] == [0.0, 0.0] and c["length_restored"], c
+    # a recompute error during the live preview is shown in the panel (and cleared when fixed)
+    assert "Tolerance=-1.0 is not allowed" in c["error_shown"] and c["error_cleared"], c
     v = steps["GHT_Curve from vertices"]["value"]
     assert v["degree"] == 3 and v["source"] == ["Vertex1", "Vertex2", "Vertex3", "Vertex4"], v
     r = steps["reopen"]["value"]

@@ -275,9 +275,19 @@ class ShapeParameterPanel:
         setattr(self.obj, name, float(value))
         try:
             self.obj.Document.recompute()
-            self.status.setText("")
+            self.status.setText(self.errors())
         except Exception as exc:  # keep the panel open on a bad combination
             self.status.setText(str(exc))
+
+    def errors(self) -> str:
+        """Status messages of the feature and its dependants whose recompute failed ("" if none).
+
+        A failing ``execute`` does not make ``Document.recompute()`` raise: FreeCAD marks the
+        object Invalid and keeps its old shape, so the panel has to look at the states.
+        """
+        objs = [self.obj] + list(getattr(self.obj, "InListRecursive", []))
+        bad = [o for o in objs if "Invalid" in o.State or "Error" in o.State]
+        return "\n".join(f"{o.Label}: {o.getStatusString()}" for o in bad)
 
     def accept(self) -> bool:
         import FreeCADGui as Gui

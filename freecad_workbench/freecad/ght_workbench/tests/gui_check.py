@@ -74,11 +74,19 @@ def main():
         live_length = obj.Shape.Length
         panel.sliders["Gamma"].setValue(-1000)
         live_gamma = obj.Gamma
+        # a bad value elsewhere: the live preview shows the feature's error in the panel
+        obj.Tolerance = -1.0
+        panel.spins["Nu"].setValue(0.25)
+        error_shown = panel.status.text()
+        obj.Tolerance = 1e-6
+        panel.spins["Nu"].setValue(0.0)
+        error_cleared = panel.status.text() == ""
         panel.reject()  # Cancel restores the values the feature had
         return {
             "created": len(created), "valid": ok, "dialog_open": dialog_open,
             "live_changed": abs(live_length - length0) > 1e-6, "slider_gamma": live_gamma,
             "restored": [obj.Mu, obj.Gamma], "length_restored": abs(obj.Shape.Length - length0) < 1e-9,
+            "error_shown": error_shown, "error_cleared": error_cleared,
         }
 
     def composite():
