@@ -172,6 +172,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     exp = steps["GHT_ExportSTEP"]["value"]
     assert exp["products"] == [exp["label"]], exp
     assert exp["colours"] and exp["line_colour_written"], exp
+    # ... also when the feature is hidden and the user's "export hidden objects" preference is off
+    assert exp["hidden_pref_kept"], exp
     for name, s in steps.items():
         if isinstance(s["value"], dict) and "valid" in s["value"]:
             assert s["value"]["created"] >= 1 and s["value"]["valid"], (name, s["value"])

@@ -175,7 +175,16 @@ def main():
         export.CommandExportSTEP.target = os.path.join(OUT, "gui_export.step")
         Gui.Selection.clearSelection()
         Gui.Selection.addSelection(ctx["curve"])
-        Gui.runCommand("GHT_ExportSTEP", 0)
+        # a user who switched off "export hidden objects": a selected hidden feature is exported anyway
+        pref = App.ParamGet("User parameter:BaseApp/Preferences/Mod/Import")
+        pref.SetBool("ExportHiddenObject", False)
+        ctx["curve"].ViewObject.Visibility = False
+        try:
+            Gui.runCommand("GHT_ExportSTEP", 0)
+        finally:
+            ctx["curve"].ViewObject.Visibility = True
+        hidden_pref_kept = pref.GetBool("ExportHiddenObject", True) is False
+        pref.RemBool("ExportHiddenObject")
         text = open(export.CommandExportSTEP.target, encoding="utf-8").read()
         import re
 
@@ -188,6 +197,7 @@ def main():
             "label": ctx["curve"].Label,
             "colours": colours,
             "line_colour": line,
+            "hidden_pref_kept": hidden_pref_kept,
             "line_colour_written": any(max(abs(a - b) for a, b in zip(c, line)) < 1e-3 for c in colours),
         }
 
