@@ -121,10 +121,18 @@ class DevelopableFeature(SurfaceOutputs, FeatureProxy):
     def control_planes(self, obj: Any) -> tuple[np.ndarray, np.ndarray]:
         """(control planes (m+1, 4), boundary planes (2, 4)) from links or coordinates."""
         planes = _planes(obj.Planes, obj.PlaneCoordinates, "PlaneCoordinates")
+        if len(obj.PlaneWeights) and not obj.Planes:
+            raise ValueError(
+                f"{obj.Label}.PlaneWeights scales linked Planes only; with PlaneCoordinates scale the 4 numbers of a "
+                "plane instead and clear PlaneWeights"
+            )
         if obj.Planes and len(obj.PlaneWeights):
             w = np.asarray(list(obj.PlaneWeights), dtype=float)
             if w.size != planes.shape[0]:
                 raise ValueError(f"PlaneWeights has {w.size} values for {planes.shape[0]} planes")
+            for i, x in enumerate(w):
+                if not np.isfinite(x) or x == 0.0:
+                    raise ValueError(f"{obj.Label}.PlaneWeights[{i}]={x!r} is not allowed; weights must be finite and non-zero")
             planes = planes * w[:, None]
         boundary = _planes(obj.BoundaryPlanes, obj.BoundaryCoordinates, "BoundaryCoordinates")
         return planes, boundary

@@ -128,6 +128,7 @@ class SurfaceBadValuesTest(BadValueCase):
 
 
 class LinkedPlanesTest(BadValueCase):
+    @staticmethod
     def _linked(self):
         def plane(normal, point, name):
             p = self.doc.addObject("Part::Plane", name)
@@ -144,7 +145,7 @@ class LinkedPlanesTest(BadValueCase):
         return d, ps
 
     def test_reopen_identical_then_deleted_planes(self):
-        d, ps = self._linked()
+        d, ps = self._linked(self)
         area, name = d.Shape.Area, d.Name
         self.assertAlmostEqual(area, 100 * math.pi, delta=1e-6 * area)  # exact quarter cylinder r = 10, H = 20
         path = os.path.join(OUT, "audit_linked.FCStd")
@@ -175,6 +176,16 @@ class LinkedPlanesTest(BadValueCase):
         self.assertIn("Planes", d.getStatusString())
         self.assertIn("PlaneCoordinates", d.getStatusString())
         self.assertLessEqual(abs(d.Shape.Area - area), 1e-12 * area)  # the old shape stays, marked Invalid
+
+
+class PlaneWeightsTest(BadValueCase):
+    def test_weights_named_and_not_silently_ignored(self):
+        d, _ = LinkedPlanesTest._linked(self)
+        self.assert_refused(d, "PlaneWeights", [1.0, float("nan"), 1.0], "PlaneWeights[1]=nan", "finite and non-zero")
+        self.assert_refused(d, "PlaneWeights", [1.0, 0.0, 1.0], "PlaneWeights[1]=0", "finite and non-zero")
+        # weights only scale linked planes: with plane coordinates they would be ignored, so refuse
+        c = developable.make_developable(gamma=-1.0, doc=self.doc, name="Coords")
+        self.assert_refused(c, "PlaneWeights", [1.0, 2.0, 1.0], "PlaneWeights", "linked Planes only")
 
 
 class OptimizationBadValuesTest(BadValueCase):
