@@ -188,6 +188,20 @@ class PlaneWeightsTest(BadValueCase):
         self.assert_refused(c, "PlaneWeights", [1.0, 2.0, 1.0], "PlaneWeights", "linked Planes only")
 
 
+class SpineBadValuesTest(BadValueCase):
+    def test_curve_link_and_ruling_range(self):
+        from freecad.ght_workbench import spine_developable
+
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        s = spine_developable.make_spine_developable(c, doc=self.doc)
+        self.assertFalse(_bad(s), s.getStatusString())
+        box = self.doc.addObject("Part::Box", "Box")
+        self.doc.recompute()
+        self.assert_refused(s, "Curve", box, "Curve", "Box", "GHT curve")
+        self.assert_refused(s, "V1", 2.0, "V0", "V1", "smaller")
+        self.assert_refused(s, "Tolerance", -1.0, "Tolerance", ">= 0")
+
+
 class OptimizationBadValuesTest(BadValueCase):
     def test_optimizer_settings_named_by_property(self):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
