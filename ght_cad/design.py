@@ -1185,6 +1185,9 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
         w = np.asarray(spec.weights, dtype=float)
 
         def f(sh: dict[str, float]) -> float:
+            # the surface is built (and checked) first: a candidate whose strip degenerates (stationary
+            # dual curve at a box corner, edge of regression inside, ...) raises and gets +inf in F
+            _make_surface(design, curves, sh)
             vals = dual_curve_objectives(GHTCurve(U, sh["mu"], sh["nu"], sh["gamma"]))
             if spec.objective == "weighted":
                 return float(w[0] * vals["AL"] + w[1] * vals["En"] + w[2] * vals["CVEn"])

@@ -389,3 +389,25 @@ def test_hull_plate_header_describes_its_join() -> None:
     # the stem really starts where the sheer ends (the join is at the sheer's end)
     sheer, stem = (next(c for c in d.curves if c.name == n) for n in ("sheer", "stem"))
     assert list(stem.control_points[0]) == list(sheer.control_points[-1])
+
+
+def test_planes_optimization_rejects_degenerate_candidates(tmp_path: Path, capsys) -> None:
+    """AL of the quarter cone's dual curve is smallest at mu = nu = gamma = -1, where the dual curve
+    is stationary at both ends and the surface cannot be built. PSO clips onto that corner; the
+    candidate must get +inf (docs: candidates whose surface degenerates are rejected) so that
+    `ght-cad optimize` and `ght-cad run` end with a surface that exists."""
+    from ght_cad.design import build_surface, optimize_design
+
+    text = Path(__file__).resolve().parents[1].joinpath("examples", "design_duct.toml").read_text()
+    text += '\n[optimize]\nmethod = "pso"\nobjective = "AL"\npopulation = 8\niterations = 12\nseed = 0\n'
+    design = parse_design_text(text)
+    o = optimize_design(design, progress=False)
+    assert math.isfinite(o.best_value) and o.best_value < o.initial_value
+    build_surface(design, o.shape)               # raises if the optimum degenerated
+    out = tmp_path / "run"
+    path = tmp_path / "d.toml"
+    path.write_text(text.replace('files = ["step", "dxf", "svg", "json", "md"]', 'files = ["json"]')
+                    .replace('figures = ["basis", "surface", "flat_pattern"]', 'figures = ["surface"]'))
+    assert main(["run", str(path), "--out", str(out), "--no-progress"]) == 0, capsys.readouterr().err
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["optimization"]["best_value"] == pytest.approx(o.best_value, rel=1e-12)
