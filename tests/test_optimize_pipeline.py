@@ -118,3 +118,22 @@ def test_plots_are_png(tmp_path):
     with pytest.raises(GHTError, match="x='time'"):
         plot_convergence(runs, tmp_path / "d.png", x="time")
     assert not (tmp_path / "d.png").exists()
+
+
+def test_degenerate_box_corner_is_rejected_and_never_crashes_the_build():
+    """Three control planes of the exact quarter cone: at mu = nu = gamma = -1 the dual curve is
+    stationary at both ends (U'(0) = U'(1) = 0) and the surface cannot be built, yet its AL is the
+    smallest in the box. PSO clips onto that corner; the objective must reject it (+inf) so that the
+    optimized design is one whose surface exists."""
+    from ght_cad.optimize.problems import DualCurveFairnessProblem
+
+    planes = [[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]]
+    p = DualCurveFairnessProblem(planes, [[0, 0, 0, 1], [-400, 0, 0, 1]], objective="AL", gamma=-1.0)
+    assert p(np.array([[-1.0, -1.0, -1.0]]))[0] == math.inf
+    assert math.isfinite(p.value(p.x0))
+    d = optimize_design(p, "pso", pop_size=8, max_iter=15, seed=0, cad=False, flat=False, plot=False)
+    assert math.isfinite(d.result.fun) and d.result.fun < p.value(p.x0)
+    assert d.after["theta_max"] < 1e-9          # the built surface exists and is developable
+    # without boundary planes there is no surface to check: the corner keeps its finite value
+    free = DualCurveFairnessProblem(planes, objective="AL", gamma=-1.0)
+    assert free(np.array([[-1.0, -1.0, -1.0]]))[0] == pytest.approx(1.2649110640673535, rel=1e-9)

@@ -525,21 +525,42 @@ class DualCurveFairnessProblem(FairnessProblem):
         objective: ``"AL"``, ``"En"``, ``"CVEn"`` or a dict of weights.
         free, bounds, nodes: as in :class:`CurveFairnessProblem`.
         mu, nu, gamma: base design.
+        check_surface: with boundary planes, build (and so check) the surface of every candidate
+            with a finite objective and give ``+inf`` to those that degenerate (stationary dual
+            curve, e.g. ``mu = nu = gamma = -1`` with three planes; an edge of regression inside the
+            strip; a boundary plane containing a ruling), so the optimum can always be built.
+            Costs one surface construction per candidate (about 10 ms).
     """
 
     label = "dual-curve fairness"
 
     def __init__(self, planes: Any, boundary_planes: Any = None, objective: Any = "En",
                  free: Sequence[str] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None,
-                 nodes: int = 64, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0) -> None:
+                 nodes: int = 64, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0,
+                 check_surface: bool = True) -> None:
         from ..planes import check_control_planes, normalize_planes
 
         U = check_control_planes(planes)
         self.raw_planes = U
         self.planes = normalize_planes(U)
         self.boundary_planes = None if boundary_planes is None else np.asarray(boundary_planes, dtype=float)
+        self.check_surface = bool(check_surface)
         self.degree = self.planes.shape[0] - 1
         self._init_fairness((mu, nu, gamma), objective, free, bounds, nodes)
+
+    def evaluate_full(self, F: np.ndarray) -> np.ndarray:
+        """Weighted fairness; ``+inf`` where the candidate's surface cannot be built (see
+        ``check_surface``)."""
+        val = super().evaluate_full(F)
+        if self.boundary_planes is None or not self.check_surface:
+            return val
+        for i in np.nonzero(np.isfinite(val))[0]:
+            try:
+                with np.errstate(all="ignore"):
+                    self._surface(*F[i, :3])
+            except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+                val[i] = np.inf
+        return val
 
     def control_points_for(self, F: np.ndarray) -> np.ndarray:
         return self.planes
@@ -558,11 +579,15 @@ class DualCurveFairnessProblem(FairnessProblem):
         if self.boundary_planes is None:
             raise GHTError("boundary_planes were not given; the surface needs two cutting planes E_a, E_b")
         p = self.parameters(x)
+        return self._surface(p["mu"], p["nu"], p["gamma"])
+
+    def _surface(self, mu: float, nu: float, gamma: float) -> RuledSurface:
+        """The enveloping developable for one full parameter set (checked on construction)."""
         try:
             from ..developable import developable_from_planes  # written by another engineer
         except ImportError:
-            return EnvelopeStrip(self.dual_curve(x), self.boundary_planes)
-        return developable_from_planes(self.planes, self.boundary_planes, p["mu"], p["nu"], p["gamma"])
+            return EnvelopeStrip(GHTCurve(self.planes, mu, nu, gamma), self.boundary_planes)
+        return developable_from_planes(self.planes, self.boundary_planes, float(mu), float(nu), float(gamma))
 
     def report(self, x: Any) -> dict[str, float]:
         """AL, En, CVEn, the objective and, with boundary planes, ``θ_max`` and the residual."""
