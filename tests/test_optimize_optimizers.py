@@ -200,3 +200,60 @@ def test_vectorize_wrapper():
     F = vectorize(lambda x: float(np.sum(x**2)))
     X = np.array([[1.0, 2.0], [0.0, 0.5]])
     assert np.allclose(F(X), sphere(X))
+
+
+def _reference_igwo_iteration(X, fX, lb, ub, a, rng):
+    """One I-GWO step written out loop by loop from spec section 8 (same random draws, same order)."""
+    N, D = X.shape
+    leaders = X[np.argsort(fX, kind="stable")[:3]]
+    Xg = np.zeros_like(X)
+    for L in leaders:
+        r1, r2 = rng.random(X.shape), rng.random(X.shape)
+        A, C = 2 * a * r1 - a, 2 * r2
+        Xg += (L - A * np.abs(C * L - X)) / 3.0
+    mid = lambda Y: np.where(Y < lb, (X + lb) / 2, np.where(Y > ub, (X + ub) / 2, Y))  # noqa: E731
+    Xg = mid(Xg)
+    u = rng.random((N, D))
+    rw = rng.permutation(N)
+    rand = rng.random((N, D))
+    Xd = np.empty_like(X)
+    for i in range(N):
+        R = np.linalg.norm(X[i] - Xg[i])
+        nbrs = [j for j in range(N) if np.linalg.norm(X[i] - X[j]) <= R or j == i]
+        for d in range(D):
+            n = nbrs[min(int(u[i, d] * len(nbrs)), len(nbrs) - 1)]
+            Xd[i, d] = X[i, d] + rand[i, d] * (X[n, d] - X[rw[i], d])
+    return Xg, mid(Xd)
+
+
+@pytest.mark.parametrize("pop,dim", [(4, 1), (9, 3), (40, 2)])
+def test_igwo_first_iteration_is_the_spec_step(pop, dim):
+    """The 2·pop points of I-GWO's first iteration equal X_GWO and X_DLH computed loop by loop."""
+    batches = []
+
+    def f(X):
+        batches.append(X.copy())
+        return rastrigin(X)
+
+    lb, ub = -np.full(dim, 1.0), np.full(dim, 2.0)
+    igwo(f, (lb, ub), pop_size=pop, max_iter=3, seed=11)
+    rng = np.random.default_rng(11)
+    X = lb + (ub - lb) * rng.random((pop, dim))
+    assert np.array_equal(X, batches[0])
+    Xg, Xd = _reference_igwo_iteration(X, rastrigin(X), lb, ub, 2.0, rng)
+    assert np.allclose(batches[1][:pop], Xg, rtol=0, atol=1e-14)
+    assert np.allclose(batches[1][pop:], Xd, rtol=0, atol=1e-14)
+
+
+def test_igwo_memory_stays_linear_in_a_huge_population():
+    """The DLH neighbourhoods of pop = 3000 wolves in 10-D must not hold a pop x pop x dim array
+    (720 MB); peak numpy memory of one iteration stays below 150 MB."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        r = igwo(sphere, box(10, 1.0), pop_size=3000, max_iter=1, seed=0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert r.nfev == 3000 * 3 and peak < 150e6, peak

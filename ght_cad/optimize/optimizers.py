@@ -530,15 +530,21 @@ def igwo(
         Xg = _midpoint_bounds(_gwo_candidates(X, leaders, a, rng), X, lb, ub)
         # dimension-learning-based hunting
         radius = np.sqrt(np.sum((X - Xg) ** 2, axis=1))
-        diff = X[:, None, :] - X[None, :, :]
-        dist = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
-        mask = dist <= radius[:, None]
-        np.fill_diagonal(mask, True)  # a wolf is always its own neighbour (R_i >= 0 = |X_i - X_i|)
-        count = mask.sum(axis=1)
-        # k-th True entry of row i, k drawn uniformly per dimension: stable argsort puts True first
-        members = np.argsort(~mask, axis=1, kind="stable")
-        k = np.minimum((rng.random((N, D)) * count[:, None]).astype(np.intp), count[:, None] - 1)
-        nb = members[rows, k]
+        u = rng.random((N, D))
+        nb = np.empty((N, D), dtype=np.intp)
+        # rows in chunks: memory O(chunk * N * D), never a pop x pop x dim array
+        chunk = max(1, min(N, (1 << 21) // max(N * D, 1)))
+        for r0 in range(0, N, chunk):
+            r1 = min(N, r0 + chunk)
+            diff = X[r0:r1, None, :] - X[None, :, :]
+            dist = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+            mask = dist <= radius[r0:r1, None]
+            mask[np.arange(r1 - r0), np.arange(r0, r1)] = True  # a wolf is always its own neighbour
+            count = mask.sum(axis=1)
+            # k-th True entry of row i, k drawn uniformly per dimension: stable argsort puts True first
+            members = np.argsort(~mask, axis=1, kind="stable")
+            k = np.minimum((u[r0:r1] * count[:, None]).astype(np.intp), count[:, None] - 1)
+            nb[r0:r1] = members[rows[: r1 - r0], k]
         rw = rng.permutation(N)  # one random wolf per i (a permutation, as in the reference code)
         cols = np.arange(D)[None, :]
         Xd = X + rng.random((N, D)) * (X[nb, cols] - X[rw])
