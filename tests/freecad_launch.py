@@ -50,3 +50,21 @@ def summary(proc: subprocess.CompletedProcess) -> str:
     """The last 80 non-blank output lines of a FreeCAD run, for assertion messages."""
     lines = [l for l in (proc.stdout + proc.stderr).splitlines() if l.strip() and not l.startswith("  #")]
     return "\n".join(lines[-80:])
+
+
+def run_fc_unittest(module: str, tmp_path: Path, min_tests: int, timeout: float = 120) -> str:
+    """Run ``freecadcmd -t module`` and assert it ran at least ``min_tests`` tests, all OK and none
+    skipped; return its whole output (stdout + stderr)."""
+    import re
+
+    from conftest import freecadcmd_or_skip
+
+    exe = freecadcmd_or_skip()
+    proc = run_process([exe, "-t", module], freecad_env(tmp_path), tmp_path, timeout)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, summary(proc)
+    ran = re.search(r"Ran (\d+) tests?", out)
+    assert ran and int(ran.group(1)) >= min_tests, summary(proc)
+    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
+    assert "skipped=" not in out, summary(proc)
+    return out

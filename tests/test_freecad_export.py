@@ -11,13 +11,11 @@ named by the feature's Label.
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import pytest
 
-from conftest import freecadcmd_or_skip
-from freecad_launch import freecad_env, run_process, summary
+from freecad_launch import run_fc_unittest
 
 pytestmark = pytest.mark.freecad
 
@@ -58,14 +56,7 @@ def _xcaf_tree(path: Path) -> tuple[list[str], list[str]]:
 
 
 def test_named_step_export_inside_freecadcmd(tmp_path: Path) -> None:
-    exe = freecadcmd_or_skip()
-    proc = run_process([exe, "-t", "freecad.ght_workbench.tests.fc_export"], freecad_env(tmp_path), tmp_path, 120)
-    out = proc.stdout + proc.stderr
-    assert proc.returncode == 0, summary(proc)
-    ran = re.search(r"Ran (\d+) tests?", out)
-    assert ran and int(ran.group(1)) >= 4, summary(proc)
-    assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
-    assert "skipped=" not in out, summary(proc)
+    run_fc_unittest("freecad.ght_workbench.tests.fc_export", tmp_path, min_tests=4)
     expected = json.loads((tmp_path / "export_named.json").read_text(encoding="utf-8"))
     roots, parts = _xcaf_tree(tmp_path / "export_named.step")
     assert roots == [expected["root"]]
