@@ -257,3 +257,29 @@ def test_igwo_memory_stays_linear_in_a_huge_population():
     finally:
         tracemalloc.stop()
     assert r.nfev == 3000 * 3 and peak < 150e6, peak
+
+
+@pytest.mark.parametrize("kw,needle", [
+    (dict(max_iter=float("nan")), "max_iter=nan"),
+    (dict(max_iter=float("inf")), "max_iter=inf"),
+    (dict(max_iter="3"), "max_iter='3'"),
+    (dict(max_nfev=float("inf")), "max_nfev=inf"),
+    (dict(patience="a"), "patience='a'"),
+    (dict(patience=float("nan")), "patience=nan"),
+    (dict(tol="x"), "tol='x'"),
+    (dict(target="a"), "target='a'"),
+    (dict(target=float("nan")), "target=nan"),
+    (dict(v_max=-0.2), "v_max=-0.2"),
+    (dict(v_max=0.0), "v_max=0"),
+    (dict(c1=float("nan")), "c1=nan"),
+    (dict(w_start="0.9"), "w_start='0.9'"),
+])
+def test_bad_options_are_named(kw, needle):
+    with pytest.raises(GHTError, match=needle.replace("(", r"\(").replace(")", r"\)")):
+        pso(sphere, box(2, 1.0), **kw)
+
+
+@pytest.mark.parametrize("bad", [lambda X: np.array(["a"] * len(X)), lambda X: np.zeros(len(X)) + 1j])
+def test_objective_values_must_be_real_numbers(bad):
+    with pytest.raises(GHTError, match="real numbers"):
+        igwo(bad, box(2, 1.0), max_iter=1)

@@ -188,6 +188,30 @@ def vectorize(fun: Callable[[np.ndarray], float]) -> Callable[[np.ndarray], np.n
     return F
 
 
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+
+
+def _short_repr(v: Any, n: int = 60) -> str:
+    r = repr(v)
+    return r if len(r) <= n else r[: n - 3] + "..."
+
+
+def _int_option(name: str, v: Any, lo: int, hint: str = "") -> int:
+    """``v`` as an int >= lo (integral floats accepted); GHTError naming ``name=v`` otherwise."""
+    if not _is_number(v) or not math.isfinite(v) or int(v) != v or v < lo:
+        raise GHTError(f"{name}={v!r} is not allowed; use an integer >= {lo}{hint}")
+    return int(v)
+
+
+def _float_option(name: str, v: Any, *, finite: bool = True, positive: bool = False) -> float:
+    """``v`` as a float (finite, and > 0 when ``positive``); GHTError naming ``name=v`` otherwise."""
+    if not _is_number(v) or math.isnan(v) or (finite and not math.isfinite(v)) or (positive and not v > 0):
+        what = "a finite number" if finite else "a number (not NaN)"
+        raise GHTError(f"{name}={v!r} is not allowed; use {what}{' > 0' if positive else ''}")
+    return float(v)
+
+
 class _Stop(Exception):
     """Internal: raised inside scipy's objective to end a DE run on our stopping rules."""
 
@@ -224,20 +248,17 @@ class _Run:
             raise GHTError(f"pop_size={pop_size!r} is not allowed; use an integer >= {min_pop}")
         self.pop = int(pop_size)
         self.rng = as_generator(seed)
-        tol = float(tol)
-        if not math.isfinite(tol) or tol < 0:
+        if not _is_number(tol) or not math.isfinite(tol) or tol < 0:
             raise GHTError(f"tol={tol!r} is not allowed; use a finite number >= 0 (0 disables it)")
-        self.tol = tol
-        if isinstance(patience, bool) or int(patience) != patience or patience < 1:
-            raise GHTError(f"patience={patience!r} is not allowed; use an integer >= 1")
-        self.patience = int(patience)
-        self.target = None if target is None else float(target)
+        self.tol = float(tol)
+        self.patience = _int_option("patience", patience, 1)
+        self.target = None if target is None else _float_option("target", target, finite=False)
         if callback is not None and not callable(callback):
             raise GHTError(f"callback={callback!r} is not callable")
         self.callback = callback
         self.per_iter = per_agent * self.pop
         self.max_iter = self._resolve_budget(max_iter, max_nfev, self.per_iter)
-        self.max_nfev = None if max_nfev is None else int(max_nfev)
+        self.max_nfev = None if max_nfev is None else int(max_nfev)  # checked by _resolve_budget
         self.x0 = None
         if x0 is not None:
             x0 = np.asarray(x0, dtype=float).reshape(-1)
@@ -255,16 +276,11 @@ class _Run:
     def _resolve_budget(self, max_iter: Any, max_nfev: Any, per_iter: int) -> int:
         limits = []
         if max_iter is not None:
-            if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 0:
-                raise GHTError(f"max_iter={max_iter!r} is not allowed; use an integer >= 0")
-            limits.append(int(max_iter))
+            limits.append(_int_option("max_iter", max_iter, 0))
         if max_nfev is not None:
-            if isinstance(max_nfev, bool) or int(max_nfev) != max_nfev or max_nfev < self.pop:
-                raise GHTError(
-                    f"max_nfev={max_nfev!r} is not allowed; it must be an integer >= pop_size={self.pop} "
-                    "(the initial population alone costs pop_size evaluations)"
-                )
-            limits.append((int(max_nfev) - self.pop) // per_iter)
+            n = _int_option("max_nfev", max_nfev, self.pop,
+                            " (= pop_size; the initial population alone costs pop_size evaluations)")
+            limits.append((n - self.pop) // per_iter)
         return min(limits) if limits else DEFAULT_MAX_ITER
 
     # -- population helpers ----------------------------------------------------------------
@@ -280,7 +296,18 @@ class _Run:
             raw = self.fun(X)
         except _Stop:
             raise
-        f = np.asarray(raw, dtype=float)
+        f = np.asarray(raw)
+        if f.dtype.kind not in "biuf":
+            try:
+                if f.dtype.kind in "cUSV":
+                    raise TypeError
+                f = f.astype(float)
+            except (TypeError, ValueError):
+                raise GHTError(
+                    f"the objective returned values of dtype {f.dtype} ({_short_repr(raw)}); "
+                    "it must return real numbers, one per row"
+                ) from None
+        f = f.astype(float, copy=False)
         if f.size != X.shape[0]:
             raise GHTError(
                 f"the objective returned shape {f.shape} for a population of shape {X.shape}; "
@@ -386,7 +413,9 @@ def pso(
                per_agent=1, tol=tol, patience=patience,
                target=target, seed=seed, callback=callback, x0=x0)
     rng, lb, ub = run.rng, run.lb, run.ub
-    vmax = float(v_max) * (ub - lb)
+    w_start, w_end = _float_option("w_start", w_start), _float_option("w_end", w_end)
+    c1, c2 = _float_option("c1", c1), _float_option("c2", c2)
+    vmax = _float_option("v_max", v_max, positive=True) * (ub - lb)
     x = run.initial_population()
     v = rng.uniform(-1.0, 1.0, x.shape) * vmax
     fx = run.evaluate(x)
