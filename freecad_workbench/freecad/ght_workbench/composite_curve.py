@@ -42,10 +42,10 @@ def joined_curves(obj: Any) -> list:
                 f"{obj.Label}.{name} has {len(vals)} value{'s' if len(vals) != 1 else ''} for {n} joint{'s' if n != 1 else ''}; "
                 f"give exactly one per joint (segments - 1){' or none for k = 1' if name == 'K' else ''}"
             )
-    curves = [core_curve(segs[0])]
+    curves = [core_curve(segs[0], placed=True)]
     for j, seg in enumerate(segs[1:]):
         cont, k = conts[j], ks[j]
-        b = core_curve(seg)
+        b = core_curve(seg, placed=True)
         kw = {"k": k} if cont.upper().startswith("G") and cont[1:] != "0" else {}
         curves.append(join(curves[-1], cont, b, **kw))
     return curves

@@ -61,11 +61,23 @@ def points_from_links(links: Sequence[tuple[Any, Sequence[str]]]) -> list["App.V
     return pts
 
 
-def core_curve(obj: Any) -> Any:
-    """The :class:`ght_cad.GHTCurve` a GHT curve feature describes (3-D control points)."""
+def core_curve(obj: Any, placed: bool = False) -> Any:
+    """The :class:`ght_cad.GHTCurve` a GHT curve feature describes (3-D control points).
+
+    Args:
+        obj: a GHT curve feature.
+        placed: move the control points by the feature's ``Placement`` (what the user sees after
+            moving the curve with the placement dialog). The GHT basis sums to 1 (spec section 1),
+            so moving the control points rigidly moves the curve: ``P(t; g·P_i) = g·P(t; P_i)``.
+            Features built on a curve (composite, spine, optimization) use ``placed=True``; the
+            curve's own shape is built unplaced and FreeCAD applies its Placement on top.
+    """
     from ght_cad import GHTCurve
 
-    return GHTCurve(points_array(obj.ControlPoints), float(obj.Mu), float(obj.Nu), float(obj.Gamma))
+    pts = obj.ControlPoints
+    if placed and hasattr(obj, "Placement") and not obj.Placement.isIdentity():
+        pts = [obj.Placement.multVec(App.Vector(p)) for p in pts]
+    return GHTCurve(points_array(pts), float(obj.Mu), float(obj.Nu), float(obj.Gamma))
 
 
 class GHTCurveFeature(FeatureProxy):

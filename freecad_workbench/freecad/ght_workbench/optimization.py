@@ -80,7 +80,7 @@ class OptimizationFeature(FeatureProxy):
         if obj.Problem == "Developability":
             if len(targets) != 2 or any(_kind(t) != "GHT::Curve" for t in targets):
                 raise ValueError(f"{obj.Label}: Developability needs exactly two GHT curve targets (the strip's boundaries)")
-            prob = StripProblem(core_curve(targets[0]), core_curve(targets[1]), free=free)
+            prob = StripProblem(core_curve(targets[0], placed=True), core_curve(targets[1], placed=True), free=free)
             mapping = [(targets[i], p, f"{s}.{p.lower()}") for i, s in enumerate("ab") for p in ("Mu", "Nu", "Gamma")]
             return prob, mapping
         if len(targets) != 1:
@@ -88,7 +88,7 @@ class OptimizationFeature(FeatureProxy):
         weights = {"AL": float(obj.WeightAL), "En": float(obj.WeightEn), "CVEn": float(obj.WeightCVEn)}
         t = targets[0]
         if _kind(t) == "GHT::Curve":
-            prob = CurveFairnessProblem(core_curve(t), objective=weights, free=free)
+            prob = CurveFairnessProblem(core_curve(t, placed=True), objective=weights, free=free)
         elif _kind(t) == "GHT::Developable":
             planes, boundary = t.Proxy.control_planes(t)
             prob = DualCurveFairnessProblem(planes, boundary, objective=weights, free=free, mu=float(t.Mu), nu=float(t.Nu), gamma=float(t.Gamma))

@@ -50,7 +50,7 @@ class SpineDevelopableFeature(SurfaceOutputs, FeatureProxy):
             raise ValueError(f"{obj.Label}: no Curve linked")
         if getattr(getattr(obj.Curve, "Proxy", None), "Type", "") != "GHT::Curve":
             raise ValueError(f"{obj.Label}.Curve = {obj.Curve.Label} is not a GHT curve; link a GHT curve feature")
-        curve = core_curve(obj.Curve)
+        curve = core_curve(obj.Curve, placed=True)
         v0, v1 = float(obj.V0.Value), float(obj.V1.Value)
         if not (np.isfinite(v0) and np.isfinite(v1) and v0 < v1):
             raise ValueError(f"{obj.Label}: V0={v0:g} mm and V1={v1:g} mm are not allowed; they must be finite with V0 smaller than V1")

@@ -202,6 +202,45 @@ class SpineBadValuesTest(BadValueCase):
         self.assert_refused(s, "Tolerance", -1.0, "Tolerance", ">= 0")
 
 
+class CurvePlacementTest(BadValueCase):
+    """A GHT curve moved with its Placement (Transform / placement dialog): what is built on it follows."""
+
+    def test_spine_follows_a_moved_curve(self):
+        from freecad.ght_workbench import spine_developable
+
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        s = spine_developable.make_spine_developable(c, doc=self.doc)
+        area, before = s.Shape.Area, s.Shape.copy()
+        pl = App.Placement(App.Vector(5, -7, 100), App.Rotation(App.Vector(0, 0, 1), 30))
+        c.Placement = pl
+        self.doc.recompute()
+        self.assertFalse(_bad(s), s.getStatusString())
+        # a rigid motion; the B-spline face is refitted within its tolerance (1e-7 of the size)
+        self.assertAlmostEqual(s.Shape.Area, area, delta=1e-6 * area)
+        # the spine of the moved curve is the old spine moved the same way
+        # (points of the new face lie on the moved old face within the two fits' tolerances)
+        expected = before.transformGeometry(pl.toMatrix())
+        face = s.Shape.Faces[0]
+        u0, u1, v0, v1 = face.ParameterRange
+        gaps = [expected.distToShape(Part.Vertex(face.valueAt(u0 + (u1 - u0) * i / 6, v0 + (v1 - v0) * j / 4)))[0]
+                for i in range(7) for j in range(5)]
+        self.assertLess(max(gaps), 1e-5)
+        self.assertGreater(s.Shape.BoundBox.ZMin, 90.0)
+
+    def test_composite_follows_a_moved_segment(self):
+        a = ght_curve.make_ght_curve([(0, 0, 0), (10, 15, 0), (25, 15, 0), (30, 0, 0)], doc=self.doc, name="SegA")
+        b = ght_curve.make_ght_curve([(30, 0, 0), (35, -10, 0), (50, -10, 0), (60, 0, 0)], doc=self.doc, name="SegB")
+        cc = composite_curve.make_composite_curve([a, b], "G1", doc=self.doc)
+        b.Placement = App.Placement(App.Vector(0, 0, 50), App.Rotation())
+        self.doc.recompute()
+        self.assertFalse(_bad(cc), cc.getStatusString())
+        # b's far end is where the user moved it (a join moves only b's first control points)
+        end = cc.Shape.OrderedVertexes[-1].Point
+        self.assertLess(end.distanceToPoint(b.Shape.Vertexes[-1].Point), 1e-9)
+        self.assertAlmostEqual(cc.Shape.BoundBox.ZMax, b.Shape.BoundBox.ZMax, delta=1e-6)
+        self.assertEqual(list(cc.JointOrders)[0].split("/")[1], "G1")
+
+
 class OptimizationBadValuesTest(BadValueCase):
     def test_optimizer_settings_named_by_property(self):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
