@@ -159,6 +159,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert "Tolerance=-1.0 is not allowed" in c["error_shown"] and c["error_cleared"], c
     v = steps["GHT_Curve from vertices"]["value"]
     assert v["degree"] == 3 and v["source"] == ["Vertex1", "Vertex2", "Vertex3", "Vertex4"], v
+    orphan = steps["panel without input"]["value"]
+    assert not orphan["dialog"], orphan
     r = steps["reopen"]["value"]
     assert r["objects"] == 9 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]

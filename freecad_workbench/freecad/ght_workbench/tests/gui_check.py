@@ -213,6 +213,26 @@ def main():
                 return {"exists": os.path.getsize(cls.target) > 0}
             step(name, exp_flat)
 
+    def panel_without_input():
+        # double-click on a spine whose Curve link is empty: no crash, no dialog, a message instead
+        from freecad.ght_workbench import spine_developable
+
+        orphan = spine_developable.make_spine_developable(ctx["curve"], doc=doc, name="Orphan")
+        orphan.Curve = None
+        doc.recompute()
+        try:
+            opened = Gui.ActiveDocument.setEdit(orphan.Name, 0)
+            dialog = bool(Gui.Control.activeDialog())
+        finally:
+            if Gui.Control.activeDialog():
+                Gui.Control.closeDialog()
+            Gui.ActiveDocument.resetEdit()
+            doc.removeObject(orphan.Name)
+            doc.recompute()
+        return {"opened": bool(opened), "dialog": dialog}
+
+    step("panel without input", panel_without_input)
+
     def screenshot():
         Gui.Selection.clearSelection()
         view = Gui.ActiveDocument.ActiveView
