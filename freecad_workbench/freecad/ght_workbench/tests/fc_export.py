@@ -49,6 +49,8 @@ class NamedStepExportTest(unittest.TestCase):
         self.flat = flat_pattern.make_flat_pattern(self.dev, bend_lines=4, doc=d)
         self.box = d.addObject("Part::Box", "Box")  # a solid, so volumes are compared too
         self.box.Placement.Base = App.Vector(100, 0, 0)
+        # a moved and turned feature: XCAF writes its placement as the product's location
+        self.curve.Placement = App.Placement(App.Vector(3, -40, 12), App.Rotation(App.Vector(1, 1, 0), 35))
         self.dev.Label = "Platte Ä"
         self.flat.Label = "Zuschnitt \"1\" 'A'"
         self.joined.Label = "Naht Ø-Blech"
@@ -74,7 +76,16 @@ class NamedStepExportTest(unittest.TestCase):
         # geometry equal to the old anonymous export (Part.makeCompound(...).exportStep)
         old = os.path.join(OUT, "export_compound.step")
         Part.makeCompound([o.Shape for o in self.objects]).exportStep(old)
-        new_m, old_m = _measures(export.read_step(path)), _measures(export.read_step(old))
+        new_s, old_s = export.read_step(path), export.read_step(old)
+        new_m, old_m = _measures(new_s), _measures(old_s)
+        # the same place too: bounding boxes and per-edge/face centres of mass, in file order
+        nb, ob = new_s.BoundBox, old_s.BoundBox
+        for k in ("XMin", "XMax", "YMin", "YMax", "ZMin", "ZMax"):
+            self.assertAlmostEqual(getattr(nb, k), getattr(ob, k), delta=1e-9 * 200, msg=k)
+        for got, ref in ((new_s.Faces, old_s.Faces), (new_s.Edges, old_s.Edges)):
+            gc = sorted((round(x.CenterOfMass.x, 6), round(x.CenterOfMass.y, 6), round(x.CenterOfMass.z, 6)) for x in got)
+            rc = sorted((round(x.CenterOfMass.x, 6), round(x.CenterOfMass.y, 6), round(x.CenterOfMass.z, 6)) for x in ref)
+            self.assertEqual(gc, rc)
         self.assertEqual(new_m[:2], old_m[:2])
         for got, ref in zip(new_m[2:], old_m[2:]):
             self.assertLessEqual(abs(got - ref), REL * max(1.0, abs(ref)), (new_m, old_m))
