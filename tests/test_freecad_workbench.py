@@ -176,6 +176,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert exp["colours"] and exp["line_colour_written"], exp
     # ... also when the feature is hidden and the user's "export hidden objects" preference is off
     assert exp["hidden_pref_kept"], exp
+    # ... and FreeCAD's own STEP import gives the feature back under its (non-ASCII) Label
+    assert exp["label"] == "Kurve Ä" and exp["reimported"] == ["Kurve Ä"], exp
     for name, s in steps.items():
         if isinstance(s["value"], dict) and "valid" in s["value"]:
             assert s["value"]["created"] >= 1 and s["value"]["valid"], (name, s["value"])

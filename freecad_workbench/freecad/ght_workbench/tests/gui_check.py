@@ -173,6 +173,7 @@ def main():
 
     def exp_step():
         export.CommandExportSTEP.target = os.path.join(OUT, "gui_export.step")
+        ctx["curve"].Label = "Kurve Ä"
         Gui.Selection.clearSelection()
         Gui.Selection.addSelection(ctx["curve"])
         # a user who switched off "export hidden objects": a selected hidden feature is exported anyway
@@ -185,6 +186,21 @@ def main():
             ctx["curve"].ViewObject.Visibility = True
         hidden_pref_kept = pref.GetBool("ExportHiddenObject", True) is False
         pref.RemBool("ExportHiddenObject")
+        # FreeCAD reads the names back (STEP import with "compound merge" off; its default on
+        # Debian merges everything into one compound named after the file)
+        import ImportGui
+
+        step_pref = App.ParamGet("User parameter:BaseApp/Preferences/Mod/Import/hSTEP")
+        merge = step_pref.GetBool("ReadShapeCompoundMode", True)
+        step_pref.SetBool("ReadShapeCompoundMode", False)
+        back = App.newDocument("StepBack")
+        try:
+            ImportGui.insert(export.CommandExportSTEP.target, back.Name)
+            reimported = [o.Label for o in back.Objects]
+        finally:
+            step_pref.SetBool("ReadShapeCompoundMode", merge)
+            App.closeDocument(back.Name)
+            App.setActiveDocument(doc.Name)
         text = open(export.CommandExportSTEP.target, encoding="utf-8").read()
         import re
 
@@ -198,6 +214,7 @@ def main():
             "colours": colours,
             "line_colour": line,
             "hidden_pref_kept": hidden_pref_kept,
+            "reimported": reimported,
             "line_colour_written": any(max(abs(a - b) for a, b in zip(c, line)) < 1e-3 for c in colours),
         }
 
