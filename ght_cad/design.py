@@ -691,21 +691,39 @@ GHT_DEFINITION = (
 )
 
 
-def build_curves(design: Design) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """GHT curves of the design with its joins applied, and a measured report per join.
 
     Joins are applied in file order: ``second`` gets its first ``r+1`` control points re-solved
     (:func:`ght_cad.continuity.join`) so that the joint ``first(1) → second(0)`` has the requested
     continuity; :func:`ght_cad.continuity.measure_continuity` then measures it independently.
 
+    Args:
+        design: a validated design.
+        shape: for a ``curves`` surface, strip shape parameters ``{"a.mu", ..., "b.gamma"}`` (any
+            subset) that replace the file's ``mu, nu, gamma`` of ``curve_a`` / ``curve_b``
+            *before* the joins, so that joined curves follow them (as after an optimization).
+
     Returns:
         ``({name: GHTCurve}, [join report dicts])``.
     """
+    return _joined_curves(design, shape, measure=True)
+
+
+def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: bool) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """:func:`build_curves`; ``measure=False`` skips the join reports (optimizer candidates)."""
     from .curve import GHTCurve
 
+    side_of: dict[str, str] = {}
+    if shape and design.surface is not None and design.surface.type == "curves":
+        side_of = {str(design.surface.curve_a): "a", str(design.surface.curve_b): "b"}
     curves: dict[str, Any] = {}
     for c in design.curves:
-        curves[c.name] = GHTCurve(c.control_points, c.mu, c.nu, c.gamma)
+        sh = {"mu": c.mu, "nu": c.nu, "gamma": c.gamma}
+        if c.name in side_of:
+            sh.update({k: float(shape[f"{side_of[c.name]}.{k}"]) for k in SHAPE_NAMES  # type: ignore[index]
+                       if f"{side_of[c.name]}.{k}" in shape})  # type: ignore[operator]
+        curves[c.name] = GHTCurve(c.control_points, sh["mu"], sh["nu"], sh["gamma"])
     reports = []
     for i, j in enumerate(design.joins):
         from .continuity import join, measure_continuity
@@ -724,6 +742,8 @@ def build_curves(design: Design) -> tuple[dict[str, Any], list[dict[str, Any]]]:
             raise
         except GHTError as exc:
             raise type(exc)(f"{design.source}: key 'joins[{i}]': {' '.join(str(exc).split())}") from None
+        if not measure:
+            continue
         rep = measure_continuity(a, curves[j.second])
         reports.append(
             {
@@ -1198,8 +1218,13 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
 
     t, wq = _gauss_legendre(64)
 
+    rejoin = bool({str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins})
+
     def g(sh: dict[str, float]) -> float:
-        s = _make_surface(design, curves, sh)
+        # a boundary curve that is a join's 'second' is re-solved for the candidate's shape
+        # parameters (as build_curves(design, shape) does for the result)
+        cv = _joined_curves(design, sh, measure=False) if rejoin else curves
+        s = _make_surface(design, cv, sh)
         return developability_from_jets(s.a(t), s.a(t, 1), s.b(t), s.b(t, 1), wq)[3]  # (θ_max, θ_rms, DD, R)
 
     return g
@@ -1648,6 +1673,24 @@ def _versions() -> dict[str, str]:
     return out
 
 
+def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
+    """Per curve: degree, dimension, shape parameters, control points, arc length, max curvature."""
+    return [
+        {
+            "name": k,
+            "degree": c.degree,
+            "dim": c.dim,
+            "mu": c.mu,
+            "nu": c.nu,
+            "gamma": c.gamma,
+            "control_points": c.control_points.tolist(),
+            "arc_length": c.arc_length(),
+            "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
+        }
+        for k, c in curves.items()
+    ]
+
+
 def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True) -> dict[str, Any]:
     """Run the whole pipeline of a design and write its outputs into ``out_dir``.
 
@@ -1704,20 +1747,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         # 1. curves
         step("curves")
         curves, joins = build_curves(design)
-        report["curves"] = [
-            {
-                "name": k,
-                "degree": c.degree,
-                "dim": c.dim,
-                "mu": c.mu,
-                "nu": c.nu,
-                "gamma": c.gamma,
-                "control_points": c.control_points.tolist(),
-                "arc_length": c.arc_length(),
-                "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
-            }
-            for k, c in curves.items()
-        ]
+        report["curves"] = _curves_report(curves)
         report["joins"] = joins
 
         built = None
@@ -1731,6 +1761,12 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if design.optimize is not None:
                 step("optimize")
                 opt = optimize_design(design, progress=progress, curves=curves)
+                if design.surface.type == "curves":
+                    # the strip's boundary curves (and the curves joined to them) take the optimized
+                    # shape parameters: STEP curve edges, figures and the report show those
+                    curves, joins = build_curves(design, opt.shape)
+                    report["curves"] = _curves_report(curves)
+                    report["joins"] = joins
                 built = build_surface(design, opt.shape, curves=curves)
                 report["optimization"] = opt.summary()
             # 4. measures

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ght_cad.cli import main
@@ -411,3 +412,56 @@ def test_planes_optimization_rejects_degenerate_candidates(tmp_path: Path, capsy
     assert main(["run", str(path), "--out", str(out), "--no-progress"]) == 0, capsys.readouterr().err
     rep = json.loads((out / "report.json").read_text())
     assert rep["optimization"]["best_value"] == pytest.approx(o.best_value, rel=1e-12)
+
+
+def test_optimized_curve_strip_exports_the_optimized_curves(tmp_path: Path) -> None:
+    """After optimizing a 'curves' strip, the curves in model.step and in the report are the strip's
+    optimized boundary curves (not the file's), and a curve joined to a boundary curve is re-joined
+    to the optimized one. A G2 join makes the difference visible: re-solving keeps G2."""
+    from ght_cad.cad.occ import read_step
+    from ght_cad.design import build_curves, build_surface
+
+    text = (EXAMPLES / "design_hull_plate.toml").read_text()
+    text = text.replace('continuity = "G1"\nk = 0.8', 'continuity = "G2"\nk = 0.8')
+    text = text.replace("population = 16\niterations = 25", "population = 8\niterations = 6")
+    text = text.replace('files = ["step", "dxf", "svg", "json", "md"]', 'files = ["step", "json"]')
+    text = text.replace('figures = ["curve", "curvature", "surface", "flat_pattern", "convergence"]', 'figures = ["curve"]')
+    path = tmp_path / "hull.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-progress"]) == 0
+    r = json.loads((out / "report.json").read_text())
+    shape = r["surface"]["shape_parameters"]
+    curves = {c["name"]: c for c in r["curves"]}
+    for side, name in (("a", "chine"), ("b", "sheer")):
+        assert [curves[name][k] for k in ("mu", "nu", "gamma")] == [shape[f"{side}.{k}"] for k in ("mu", "nu", "gamma")]
+    (j,) = r["joins"]
+    assert (j["first"], j["second"], j["achieved_G"], j["satisfied"]) == ("sheer", "stem", 2, True)
+    # the strip's boundary edges and the exported sheer/chine curves coincide (to 1e-6 mm)
+    d = load_design(path)
+    cv, _ = build_curves(d, shape)
+    surf = build_surface(d, shape, curves=cv).surface
+    t = np.linspace(0.0, 1.0, 101)
+    assert np.max(np.linalg.norm(cv["sheer"].evaluate(t) - surf.b(t), axis=1)) < 1e-6
+    assert np.max(np.linalg.norm(cv["chine"].evaluate(t) - surf.a(t), axis=1)) < 1e-6
+    assert r["optimization"]["best_value"] == pytest.approx(surf.developability().R, rel=1e-9)
+    # every curve edge in the STEP lies on one of the rebuilt curves
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    from ght_cad.cad.occ import unwrap
+
+    pts = np.concatenate([c.evaluate(np.linspace(0, 1, 2001)) for c in cv.values()])
+    exp, far = TopExp_Explorer(unwrap(read_step(out / "model.step")), TopAbs_EDGE), 0.0
+    while exp.More():
+        ad = BRepAdaptor_Curve(TopoDS.Edge_s(exp.Current()))
+        Q = np.array([[p.X(), p.Y(), p.Z()] for p in
+                      (ad.Value(float(s)) for s in np.linspace(ad.FirstParameter(), ad.LastParameter(), 7))])
+        chord = (Q[-1] - Q[0]) / np.linalg.norm(Q[-1] - Q[0])
+        off_line = np.linalg.norm(np.cross(Q - Q[0], chord), axis=1).max()
+        if off_line > 1e-6:  # not a straight end ruling of the face: a boundary or a design curve
+            far = max(far, max(float(np.min(np.linalg.norm(pts - q, axis=1))) for q in Q))
+        exp.Next()
+    assert far < 2.0, far  # mm; sampled nearest point, the file's curves were 23 mm / 242 mm away
