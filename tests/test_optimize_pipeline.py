@@ -137,3 +137,50 @@ def test_degenerate_box_corner_is_rejected_and_never_crashes_the_build():
     # without boundary planes there is no surface to check: the corner keeps its finite value
     free = DualCurveFairnessProblem(planes, objective="AL", gamma=-1.0)
     assert free(np.array([[-1.0, -1.0, -1.0]]))[0] == pytest.approx(1.2649110640673535, rel=1e-9)
+
+
+def test_degenerate_base_design_is_reported_not_a_crash(tmp_path):
+    """The base design mu = nu = gamma = -1 of three planes cannot be built (stationary dual curve):
+    the run still optimizes, 'before' holds NaN with a note, and the JSON file is strict JSON
+    (NaN/inf written as null)."""
+    from ght_cad.optimize.problems import DualCurveFairnessProblem
+
+    planes = [[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]]
+    p = DualCurveFairnessProblem(planes, [[0, 0, 0, 1], [-400, 0, 0, 1]], objective="CVEn",
+                                 mu=-1.0, nu=-1.0, gamma=-1.0)
+    assert p.value(p.x0) == math.inf
+    d = optimize_design(p, "igwo", pop_size=6, max_iter=5, seed=0, cad=False, flat=False, plot=False,
+                        out_dir=tmp_path)
+    assert math.isfinite(d.result.fun) and d.after["theta_max"] < 1e-9
+    assert set(d.before) == set(d.after) and all(math.isnan(v) for v in d.before.values())
+    assert any("base design" in n for n in d.notes)
+
+    def strict(c):
+        raise ValueError(f"non-standard JSON constant {c}")
+
+    data = json.loads(d.files["json"].read_text(), parse_constant=strict)
+    assert data["before"]["CVEn"] is None and data["after"]["CVEn"] == pytest.approx(d.result.fun)
+
+
+def test_no_finite_value_is_a_clear_error():
+    """An objective that is +inf everywhere: the pipeline says so instead of building, meshing and
+    unrolling the midpoint of the box as if it were a result."""
+    p = default_strip_problem()
+    p.evaluate_full = lambda F: np.full(len(F), np.inf)
+    with pytest.raises(GHTError, match="no parameters with a finite objective in 15 evaluations"):
+        optimize_design(p, "pso", pop_size=5, max_iter=2, seed=0, plot=False)
+
+
+def test_strip_that_cannot_be_unrolled_keeps_the_result(tmp_path):
+    """A strip between a curve and itself with other shape parameters: the two boundary curves meet
+    at both ends, R is finite but the unroll refuses the pinched strip. The optimization result is
+    returned with a note (no crash after the optimization), the other files are written."""
+    from ght_cad import GHTCurve
+    from ght_cad.optimize.problems import StripProblem
+
+    A = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 1], [3, 1, 1.0]])
+    d = optimize_design(StripProblem(A, A), "pso", pop_size=5, max_iter=3, seed=0, cad=False, out_dir=tmp_path)
+    assert math.isfinite(d.result.fun) and d.flat is None
+    assert any(n.startswith("flat pattern failed") for n in d.notes), d.notes
+    assert set(d.files) == {"png", "json"}
+    assert json.loads(d.files["json"].read_text())["notes"] == d.notes

@@ -13,8 +13,9 @@ optimized object (``problem.build(x)``: a ruled/developable surface or a curve),
   distortion is reported in the notes);
 * ``<stem>_convergence.png`` and ``<stem>.json`` (parameters, measures before/after, run data).
 
-CAD pieces are imported lazily; a missing piece is skipped with a note (never a crash of the
-optimization result).
+CAD pieces are imported lazily; a missing piece is skipped with a note, and a flat pattern the
+unroll refuses (e.g. a strip whose boundary curves meet) is a note too (never a crash of the
+optimization result). Non-finite numbers are written as ``null`` in the JSON file.
 """
 
 from __future__ import annotations
@@ -78,6 +79,19 @@ class DesignResult:
         return "\n".join(lines)
 
 
+def _strict(o: Any) -> Any:
+    """Plain JSON data: numpy scalars as Python numbers, NaN/inf as None (strict JSON)."""
+    if isinstance(o, dict):
+        return {str(k): _strict(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_strict(v) for v in o]
+    if hasattr(o, "item") and not isinstance(o, (str, bytes)):  # numpy scalar
+        o = o.item()
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    return o
+
+
 def _brep(obj: Any, notes: list[str]) -> Any:
     try:
         if isinstance(obj, RuledSurface):
@@ -137,8 +151,8 @@ def optimize_design(
         DesignResult.
 
     Raises:
-        GHTError: bad optimizer arguments, a bad ``stem``, or a failed export (the target file is
-            left untouched: all writes are atomic).
+        GHTError: bad optimizer arguments, a bad ``stem``, no candidate with a finite objective,
+            or a failed export (the target file is left untouched: all writes are atomic).
     """
     if not stem or any(c in stem for c in "/\\") or stem in (".", ".."):
         raise GHTError(f"stem={stem!r} is not allowed; use a plain file name without directories")
@@ -152,9 +166,18 @@ def optimize_design(
 
         res = minimize(problem, problem.bounds, method, pop_size=pop_size, max_iter=max_iter,
                        max_nfev=max_nfev, seed=seed, callback=cb, x0=problem.x0, **options)
+    if not res.success:
+        raise GHTError(
+            f"{method} found no parameters with a finite objective in {res.nfev} evaluations "
+            f"({getattr(problem, 'label', 'problem')}: every candidate, the base design included, is degenerate)"
+        )
     obj = problem.build(res.x)
-    before = problem.report(problem.x0)
     after = problem.report(res.x)
+    try:
+        before = problem.report(problem.x0)
+    except GHTError as exc:  # the base design itself is degenerate: nothing to compare with
+        before = {k: math.nan for k in after}
+        notes.append(f"the base design cannot be built ({' '.join(str(exc).split())[:200]}); 'before' is NaN")
     out = DesignResult(problem, res, problem.parameters(res.x), before, after, obj, notes=notes)
     folder = None if out_dir is None else Path(out_dir)
     if folder is not None:
@@ -186,6 +209,8 @@ def optimize_design(
                 out.files["dxf"] = folder / f"{stem}.dxf"
         except ImportError as exc:
             notes.append(f"flat pattern skipped: {exc}")
+        except GHTError as exc:  # e.g. a pinched strip: the optimization result stands, no DXF
+            notes.append(f"flat pattern failed: {' '.join(str(exc).split())}")
     elif flat:
         notes.append("no flat pattern: the optimized object is a curve")
     if folder is not None:
@@ -209,6 +234,6 @@ def optimize_design(
             "history_nfev": res.history_nfev.tolist(),
             "notes": notes,
         }
-        write_text_atomic(folder / f"{stem}.json", json.dumps(data, indent=1, default=float))
+        write_text_atomic(folder / f"{stem}.json", json.dumps(_strict(data), indent=1, allow_nan=False))
         out.files["json"] = folder / f"{stem}.json"
     return out
