@@ -22,6 +22,7 @@ from ght_cad.io import atomic_path, write_text_atomic
 __all__ = [
     "export_step",
     "read_step",
+    "stale_reason",
     "flat_pattern_polylines",
     "write_dxf_r12",
     "write_svg",
@@ -30,20 +31,34 @@ __all__ = [
 ]
 
 
-def _stale(obj: Any) -> list[str]:
-    """The error states of ``obj`` (its last recompute failed: its shape is the old one)."""
+def _bad_states(obj: Any) -> list[str]:
     return [s for s in getattr(obj, "State", []) if s in ("Invalid", "Error")]
+
+
+def stale_reason(obj: Any) -> str | None:
+    """Why the shape of ``obj`` may not match its inputs, or None if it is current.
+
+    FreeCAD keeps the old shape of a feature whose recompute failed, and does not recompute the
+    features that depend on a failed one (they keep their old shape and look fine); a feature
+    with pending changes (state ``Touched``) has not been rebuilt yet either.
+    """
+    bad = _bad_states(obj)
+    if bad:
+        return f"its last recompute failed (state {', '.join(bad)}: {obj.getStatusString()}), so its shape is stale"
+    for dep in getattr(obj, "OutListRecursive", []):
+        if _bad_states(dep):
+            return f"its input {dep.Label} failed to recompute ({dep.getStatusString()}), so its shape is stale"
+    if "Touched" in getattr(obj, "State", []) or any("Touched" in getattr(d, "State", []) for d in getattr(obj, "OutListRecursive", [])):
+        return "it has changes not yet recomputed; recompute the document first"
+    return None
 
 
 def _shapes(objects: Iterable[Any]) -> list:
     out = []
     for o in objects:
-        state = _stale(o)
-        if state:
-            raise GHTError(
-                f"{o.Label}: its last recompute failed (state {', '.join(state)}: {o.getStatusString()}), so its shape is "
-                "stale; fix the feature or leave it out of the export"
-            )
+        why = stale_reason(o)
+        if why:
+            raise GHTError(f"{o.Label}: {why}; fix it or leave it out of the export")
         shp = getattr(o, "Shape", None)
         if shp is None or shp.isNull():
             raise GHTError(f"{getattr(o, 'Label', o)} has no shape to export")
@@ -80,8 +95,9 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
         check: refuse shapes for which ``shape.isValid()`` is False.
 
     Raises:
-        GHTError: nothing to export, an object without shape, an object whose last recompute failed
-            (its shape is stale), or an invalid shape (when ``check``).
+        GHTError: nothing to export, an object without shape, a stale shape (:func:`stale_reason`:
+            its or an input's last recompute failed, or changes are pending), or an invalid shape
+            (when ``check``).
         OSError: the write failed; the target file is then untouched and no partial file is left.
 
     Returns:
@@ -138,15 +154,12 @@ def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[lis
     edges of the compound (not bounding a face).
 
     Raises:
-        GHTError: the feature's last recompute failed (FreeCAD keeps the previous, stale shape) or
-            it has no planar face (never computed).
+        GHTError: the shape is stale (:func:`stale_reason`: its or an input's last recompute failed,
+            or changes are pending) or it has no planar face (never computed).
     """
-    state = [s for s in getattr(obj, "State", []) if s in ("Invalid", "Error")]
-    if state:
-        raise GHTError(
-            f"{obj.Label}: its last recompute failed (state {', '.join(state)}; see the report view), so its "
-            "shape is stale or empty; allowed: a flat pattern that recomputes without error"
-        )
+    why = stale_reason(obj)
+    if why:
+        raise GHTError(f"{obj.Label}: {why}; allowed: a flat pattern that recomputes without error")
     shape = obj.Shape
     if not shape.Faces:
         raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")

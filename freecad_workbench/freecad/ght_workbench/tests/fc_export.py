@@ -181,5 +181,33 @@ class NamedStepExportTest(unittest.TestCase):
         self.assertEqual(listing(), ["part.step", "part.stp"])
 
 
+    def test_stale_inputs_are_refused(self):
+        """A shape that does not match its inputs is never written: pending changes (Touched), or an
+        input whose recompute failed (FreeCAD then skips the dependants, which keep their old shape)."""
+        from freecad.ght_workbench import export as ex
+
+        step = os.path.join(OUT, "stale.step")
+        dxf = os.path.join(OUT, "stale.dxf")
+        ex.export_step([self.flat], step)
+        ex.export_flat_pattern_dxf(self.flat, dxf)
+        originals = [open(f, "rb").read() for f in (step, dxf)]
+        self.dev.Gamma = 0.5  # changed, not yet recomputed
+        with self.assertRaisesRegex(Exception, "Platte Ä: it has changes not yet recomputed"):
+            ex.export_step([self.dev], step)
+        self.dev.Tolerance = -1.0
+        self.doc.recompute()
+        self.assertIn("Invalid", self.dev.State)
+        self.assertNotIn("Invalid", self.flat.State)  # the flat pattern keeps the pattern of γ = -1
+        for fn, path in ((ex.export_step, step), (ex.export_flat_pattern_dxf, dxf), (ex.export_flat_pattern_svg, dxf)):
+            with self.subTest(fn.__name__):
+                with self.assertRaisesRegex(Exception, "input Platte Ä failed to recompute"):
+                    fn([self.flat] if fn is ex.export_step else self.flat, path)
+        self.assertEqual([open(f, "rb").read() for f in (step, dxf)], originals)
+        self.dev.Tolerance = 0.0
+        self.doc.recompute()
+        ex.export_step([self.flat], step)  # fixed: exported again, the new pattern
+        self.assertNotEqual(open(step, "rb").read(), originals[0])
+
+
 if __name__ == "__main__":
     unittest.main()
