@@ -41,6 +41,12 @@ def stale_reason(obj: Any) -> str | None:
     FreeCAD keeps the old shape of a feature whose recompute failed, and does not recompute the
     features that depend on a failed one (they keep their old shape and look fine); a feature
     with pending changes (state ``Touched``) has not been rebuilt yet either.
+
+    Args:
+        obj: a document object; its ``State`` and those of its ``OutListRecursive`` are read.
+
+    Returns:
+        A sentence for an error message (the failed object and its status string), or None.
     """
     bad = _bad_states(obj)
     if bad:
@@ -82,7 +88,8 @@ def _step_writer() -> Any:
 
 
 def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool = True) -> str:
-    """Write ``objects`` to a STEP file (AP214, millimetres) atomically, one named product each.
+    """Write ``objects`` to a STEP file (AP214 schema as FreeCAD 0.20 writes it, millimetres)
+    atomically, one named product each.
 
     FreeCAD's XCAF exporter writes every object as a STEP ``PRODUCT`` named by its ``Label``
     (several objects: under a root product named after the document); under the GUI the view
