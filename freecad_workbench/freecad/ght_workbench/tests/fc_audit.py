@@ -130,15 +130,10 @@ class SurfaceBadValuesTest(BadValueCase):
 class LinkedPlanesTest(BadValueCase):
     @staticmethod
     def _linked(self):
-        def plane(normal, point, name):
-            p = self.doc.addObject("Part::Plane", name)
-            p.Length = p.Width = 5
-            p.Placement = App.Placement(App.Vector(*point), App.Rotation(App.Vector(0, 0, 1), App.Vector(*normal)))
-            return p
+        from freecad.ght_workbench.tests.fc_features import plane_feature, quarter_cylinder_planes
 
-        s = math.sqrt(0.5)
-        ps = [plane((1, 0, 0), (10, 0, 0), "P0"), plane((s, s, 0), (5, 5, 0), "P1"), plane((0, 1, 0), (0, 10, 0), "P2")]
-        ea, eb = plane((0, 0, 1), (0, 0, 0), "Ea"), plane((0, 0, 1), (0, 0, 20), "Eb")
+        ps = quarter_cylinder_planes(self.doc)
+        ea, eb = plane_feature(self.doc, (0, 0, 1), (0, 0, 0), "Ea"), plane_feature(self.doc, (0, 0, 1), (0, 0, 20), "Eb")
         self.doc.recompute()
         d = developable.make_developable([(p, "") for p in ps], [(ea, ""), (eb, "")], gamma=-1.0, weights=[1.0, math.sqrt(2), 1.0], doc=self.doc)
         self.assertFalse(_bad(d), d.getStatusString())

@@ -47,6 +47,22 @@ def _reopen(doc):
     return doc2
 
 
+def plane_feature(doc, normal, point, name: str):
+    """A 5 x 5 ``Part::Plane`` through ``point`` with unit normal ``normal``."""
+    p = doc.addObject("Part::Plane", name)
+    p.Length = p.Width = 5
+    p.Placement = App.Placement(App.Vector(*point), App.Rotation(App.Vector(0, 0, 1), App.Vector(*normal)))
+    return p
+
+
+def quarter_cylinder_planes(doc) -> list:
+    """Plane features P0, P1, P2 of the quarter cylinder r = 10 about z (P1: the chord plane
+    x + y = r, weight sqrt(2) for the exact circle at γ = -1)."""
+    s = math.sqrt(0.5)
+    return [plane_feature(doc, (1, 0, 0), (10, 0, 0), "P0"), plane_feature(doc, (s, s, 0), (5, 5, 0), "P1"),
+            plane_feature(doc, (0, 1, 0), (0, 10, 0), "P2")]
+
+
 class GHTCurveTest(unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("ght_curve")
@@ -233,17 +249,8 @@ class DevelopableTest(unittest.TestCase):
         self.assertLess(obj.ThetaMax.Value, 1e-6)
 
     def test_linked_planes_and_weights(self):
-        # the same cylinder from App::Plane features: the middle plane needs the weight sqrt(2)
-        def plane(normal, point, name):
-            p = self.doc.addObject("Part::Plane", name)
-            p.Length = p.Width = 5
-            p.Placement = App.Placement(App.Vector(*point), App.Rotation(App.Vector(0, 0, 1), App.Vector(*normal)))
-            return p
-
-        s = math.sqrt(0.5)
-        p0 = plane((1, 0, 0), (10, 0, 0), "P0")
-        p1 = plane((s, s, 0), (5, 5, 0), "P1")  # x + y = r: the chord plane
-        p2 = plane((0, 1, 0), (0, 10, 0), "P2")
+        # the same cylinder from plane features: the middle plane needs the weight sqrt(2)
+        p0, p1, p2 = quarter_cylinder_planes(self.doc)
         box = self.doc.addObject("Part::Box", "Box")  # boundary planes from faces: bottom z=0, top z=20
         box.Length, box.Width, box.Height = 3, 3, 20
         self.doc.recompute()
