@@ -91,3 +91,19 @@ def test_pareto_front_of_dual_fairness():
 def test_pareto_front_needs_measures():
     with pytest.raises(GHTError, match="no measures"):
         pareto_front(object())
+
+
+def test_front_has_no_degenerate_design():
+    """Three planes of the quarter cone: AL is smallest at the corner mu = nu = gamma = -1 where the
+    dual curve is stationary and no surface exists. The front (every point of it) must be buildable;
+    PSO clips onto that corner, so it was the AL-extreme point of the front."""
+    from ght_cad.optimize.problems import DualCurveFairnessProblem
+
+    planes = [[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]]
+    p = DualCurveFairnessProblem(planes, [[0, 0, 0, 1], [-400, 0, 0, 1]], gamma=-1.0)
+    assert p.admissible(np.array([[-1.0, -1.0, -1.0], [0.0, 0.0, -1.0]])).tolist() == [False, True]
+    res = pareto_front(p, "pso", divisions=2, pop_size=8, max_iter=10, seed=0)
+    assert len(res.f) >= 3
+    for x in res.x:
+        p.build(x)                                  # raises for a degenerate design
+    assert not np.any(np.all(np.isclose(res.x, -1.0), axis=1))

@@ -211,7 +211,9 @@ def pareto_front(
     :class:`ParetoArchive` (see the module docstring).
 
     Args:
-        problem: a fairness problem (has ``measures(X) -> (pop, 3)``, ``bounds``, ``x0``, ``names``).
+        problem: a fairness problem (has ``measures(X) -> (pop, 3)``, ``bounds``, ``x0``, ``names``);
+            with an ``admissible(X) -> bool mask`` method (e.g. a dual-curve problem with boundary
+            planes) rows whose surface cannot be built get ``+inf`` and never enter the front.
         method: optimizer name for :func:`~ght_cad.optimize.minimize`.
         divisions: lattice divisions (3 objectives: 4 -> 15 runs).
         pop_size, max_iter: per run.
@@ -233,6 +235,7 @@ def pareto_front(
     ref = np.asarray(problem.measures(x_ref[None])[0], dtype=float)
     if not (np.all(np.isfinite(ref)) and np.all(ref > 0)):
         raise GHTError(f"measures at the base design are {ref.tolist()}; they must be finite and > 0 to scale the weights")
+    check = getattr(problem, "admissible", None)
     W = simplex_weights(len(ref), divisions)
     archive = ParetoArchive(len(ref), max_size)
     archive.add(x_ref[None], ref[None])
@@ -242,9 +245,13 @@ def pareto_front(
     nfev = 1
     for w, child in zip(W, children):
         def f(X: np.ndarray, w: np.ndarray = w) -> np.ndarray:
-            M = problem.measures(X)
+            M = np.asarray(problem.measures(X), dtype=float)
+            if check is not None:  # designs whose surface cannot be built never enter the front
+                M = np.where(check(X)[:, None], M, np.inf)
             archive.add(X, M)
-            return (M / ref) @ w
+            with np.errstate(invalid="ignore"):  # inf * weight 0 -> NaN, counted as +inf
+                v = (M / ref) @ w
+            return np.where(np.all(np.isfinite(M), axis=1), v, np.inf)
 
         r = minimize(f, problem.bounds, method, pop_size=pop_size, max_iter=max_iter, seed=int(child),
                      callback=callback, **options)

@@ -552,15 +552,26 @@ class DualCurveFairnessProblem(FairnessProblem):
         """Weighted fairness; ``+inf`` where the candidate's surface cannot be built (see
         ``check_surface``)."""
         val = super().evaluate_full(F)
+        return np.where(self._admissible_full(F, np.isfinite(val)), val, np.inf)
+
+    def admissible(self, X: Any) -> np.ndarray:
+        """Boolean mask over the rows of ``X`` (free parameters): True where the surface can be
+        built (always True without boundary planes or with ``check_surface=False``)."""
+        F = self.full(X)
+        return self._admissible_full(F, np.ones(F.shape[0], dtype=bool))
+
+    def _admissible_full(self, F: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Construction check of the rows selected by ``rows`` (others are returned False)."""
+        ok = np.array(rows, dtype=bool)
         if self.boundary_planes is None or not self.check_surface:
-            return val
-        for i in np.nonzero(np.isfinite(val))[0]:
+            return ok
+        for i in np.nonzero(ok)[0]:
             try:
                 with np.errstate(all="ignore"):
                     self._surface(*F[i, :3])
             except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
-                val[i] = np.inf
-        return val
+                ok[i] = False
+        return ok
 
     def control_points_for(self, F: np.ndarray) -> np.ndarray:
         return self.planes
