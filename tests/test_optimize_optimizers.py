@@ -283,3 +283,18 @@ def test_bad_options_are_named(kw, needle):
 def test_objective_values_must_be_real_numbers(bad):
     with pytest.raises(GHTError, match="real numbers"):
         igwo(bad, box(2, 1.0), max_iter=1)
+
+
+def test_de_polish_really_polishes():
+    """polish=True adds an L-BFGS-B finish from the best point (counted in nfev, within max_nfev);
+    before, the budget stop ended the run inside scipy and the polish never ran."""
+    f = lambda X: np.sum((np.asarray(X) - 0.3) ** 2, axis=1)  # noqa: E731
+    plain = differential_evolution(f, box(2, 1.0), pop_size=6, max_iter=5, seed=0)
+    pol = differential_evolution(f, box(2, 1.0), pop_size=6, max_iter=5, seed=0, polish=True)
+    assert plain.fun > 1e-4 and pol.fun < 1e-12 and pol.nfev > plain.nfev
+    assert np.allclose(pol.x, 0.3, atol=1e-6) and pol.history[-1] == pol.fun
+    capped = differential_evolution(f, box(2, 1.0), pop_size=6, max_nfev=40, seed=0, polish=True)
+    assert capped.nfev <= 40
+    stopped = differential_evolution(f, box(2, 1.0), pop_size=6, max_iter=5, seed=0, polish=True,
+                                     callback=lambda s: s.nit >= 2)
+    assert stopped.message == "stopped by callback" and stopped.nfev == 18
