@@ -277,7 +277,9 @@ class FlatPatternFeature(FeatureProxy):
         """The core :class:`ght_cad.flat_pattern.FlatPattern` of the source."""
         from ght_cad import unroll
 
-        opts = dict(rulings=max(int(obj.BendLines), 0), best_effort=bool(obj.BestEffort), samples=65)
+        if int(obj.BendLines) < 0:
+            raise ValueError(f"{obj.Label}: BendLines={int(obj.BendLines)} is not allowed; allowed: 0 or more bend lines")
+        opts = dict(rulings=int(obj.BendLines), best_effort=bool(obj.BestEffort), samples=65)
         face = face_of_source(obj)
         if face is None:
             return unroll(surface_of_source(obj), **opts)

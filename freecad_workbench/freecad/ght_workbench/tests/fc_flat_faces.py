@@ -432,6 +432,23 @@ class FlatFacesTest(unittest.TestCase):
             with self.assertRaisesRegex(ValueError, pattern):
                 _pattern(fp)
 
+    def test_negative_bend_lines_are_refused_by_name(self):
+        """BendLines = -1 was silently treated as 0 (feature Up-to-date): now an error naming it;
+        0 is allowed (no bend lines, the outline only)."""
+        cyl = self._cylinder(10.0, 20.0)
+        self.doc.recompute()
+        fp = flat_pattern.make_flat_pattern(cyl, "Face1", doc=self.doc)
+        fp.BendLines = 0
+        self.doc.recompute()
+        self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        self.assertEqual(len(fp.Shape.Faces), 1)
+        self.assertEqual(len(fp.Shape.Edges), 4)  # the rectangle alone
+        fp.BendLines = -1
+        self.doc.recompute()
+        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        with self.assertRaisesRegex(ValueError, r"BendLines=-1 is not allowed; allowed: 0 or more"):
+            _pattern(fp)
+
     def test_twisted_face_is_refused_with_theta(self):
         """A bilinear (twisted) B-spline face: ruled both ways, θ_max = 45°, DD = 0.75."""
         s = Part.BSplineSurface()
