@@ -1223,7 +1223,7 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
     def g(sh: dict[str, float]) -> float:
         # a boundary curve that is a join's 'second' is re-solved for the candidate's shape
         # parameters (as build_curves(design, shape) does for the result)
-        cv = _joined_curves(design, sh, measure=False) if rejoin else curves
+        cv = _joined_curves(design, sh, measure=False)[0] if rejoin else curves
         s = _make_surface(design, cv, sh)
         return developability_from_jets(s.a(t), s.a(t, 1), s.b(t), s.b(t, 1), wq)[3]  # (θ_max, θ_rms, DD, R)
 

@@ -465,3 +465,21 @@ def test_optimized_curve_strip_exports_the_optimized_curves(tmp_path: Path) -> N
             far = max(far, max(float(np.min(np.linalg.norm(pts - q, axis=1))) for q in Q))
         exp.Next()
     assert far < 2.0, far  # mm; sampled nearest point, the file's curves were 23 mm / 242 mm away
+
+
+def test_boundary_curve_that_is_a_join_second_is_rejoined_per_candidate() -> None:
+    """The sheer (curve_b) continues a stem with G2: its first control points are re-solved by the
+    join from its own shape parameters, so every candidate re-applies the join; the reported value
+    is R of the strip rebuilt from build_curves(design, shape), and the join stays G2."""
+    from ght_cad.design import build_curves, build_surface, optimize_design
+
+    text = (EXAMPLES / "design_hull_plate.toml").read_text()
+    text = text.replace('first = "sheer"\nsecond = "stem"\ncontinuity = "G1"', 'first = "stem"\nsecond = "sheer"\ncontinuity = "G2"')
+    text = text.replace("[[4500, -1100, 1300], [5200, -800, 1450], [5800, -200, 1600]]",
+                        "[[-1500, -700, 1000], [-800, -850, 1150], [0, -900, 1200]]")
+    d = parse_design_text(text, "hull2.toml")
+    o = optimize_design(d, {"iterations": 5, "population": 6}, progress=False)
+    assert o.best_value < o.initial_value
+    cv, joins = build_curves(d, o.shape)
+    assert [(j["achieved_G"], j["satisfied"]) for j in joins] == [(2, True)]
+    assert build_surface(d, o.shape, curves=cv).surface.developability().R == pytest.approx(o.best_value, rel=1e-9)
