@@ -911,7 +911,10 @@ def build_surface(design: Design, shape: dict[str, float] | None = None,
     except DesignError:
         raise
     except GHTError as exc:
-        raise type(exc)(f"{design.source}: key 'surface': {' '.join(str(exc).split())}") from None
+        msg = " ".join(str(exc).split())
+        if msg.startswith(f"{design.source}: key 'surface"):  # already names the file and key (a strip)
+            raise
+        raise type(exc)(f"{design.source}: key 'surface': {msg}") from None
     return BuiltSurface(design, surf, curves, sh)
 
 
@@ -1755,8 +1758,15 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         if design.surface is not None:
             # 2. surface
             step("surface")
-            built = build_surface(design, curves=curves)
-            report["developability_initial"] = _developability_dict(built.surface)
+            try:
+                built = build_surface(design, curves=curves)
+                report["developability_initial"] = _developability_dict(built.surface)
+            except GHTError as exc:
+                if design.optimize is None:
+                    raise
+                # the file's values are one rejected candidate; the optimization may find admissible ones
+                report["developability_initial"] = None
+                report["initial_surface_error"] = " ".join(str(exc).split())
             # 3. optimization
             if design.optimize is not None:
                 step("optimize")
@@ -1921,6 +1931,9 @@ def report_markdown(r: dict[str, Any]) -> str:
             if d:
                 L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
         L.append("")
+        if r.get("initial_surface_error"):
+            L += [f"The file's shape parameters give no surface ({r['initial_surface_error']}); the values above "
+                  "are those of the optimized parameters.", ""]
         if s.get("strips"):
             L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
             for x in s["strips"]:
@@ -1940,7 +1953,7 @@ def report_markdown(r: dict[str, Any]) -> str:
     if r.get("optimization"):
         o = r["optimization"]
         L += ["## Shape-parameter optimization", "",
-              f"{o['method']} on {o['objective']}: {o['initial_value']:.8g} → {o['best_value']:.8g} in "
+              f"{o['method']} on {o['objective']}: {_f(o['initial_value'], '.8g')} → {o['best_value']:.8g} in "
               f"{o['iterations']} iterations ({o['nfev']} evaluations, {o['time_s']:.2f} s); best "
               + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
         if o.get("strips"):

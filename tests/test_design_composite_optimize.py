@@ -311,3 +311,28 @@ def test_objective_override_R_refused_for_composite() -> None:
     rc, stdout, _ = cli_json(["optimize", str(EXAMPLE), "--objective", "R", "--no-progress", "--json"])
     r = json.loads(stdout)
     assert rc == 2 and "'optimize.objective'" in r["error"] and "AL, En, CVEn, weighted" in r["error"]
+
+
+def test_run_from_a_degenerate_start_optimizes_and_reports_it(tmp_path: Path) -> None:
+    """`ght-cad run` on a composite whose file values are degenerate (strip a stationary at t = 1)
+    with [optimize]: the start is a rejected candidate like any other, the run goes on (docs: "the
+    run goes on"), developability_initial is null with the reason; without [optimize] it is a
+    one-line exit-2 error that names the file and the strip once."""
+    text = deg2(nu_a=-1.0, gamma_a=-1.0) + '\n[outputs]\nfiles = ["json", "md"]\nfigures = ["surface"]\n'
+    bad = tmp_path / "deg.toml"
+    bad.write_text(text)
+    rc, _, err = cli_json(["run", str(bad), "--out", str(tmp_path / "o1"), "--no-progress"])
+    lines = err.strip().splitlines()
+    assert rc == 2 and len(lines) == 1 and lines[0].count(str(bad)) == 1, err
+    assert "key 'surface.segments[0]'" in lines[0] and not (tmp_path / "o1").exists()
+    good = tmp_path / "deg_opt.toml"
+    good.write_text(text + "\n[optimize]\npopulation = 6\niterations = 4\n")
+    rc, _, err = cli_json(["run", str(good), "--out", str(tmp_path / "o2"), "--no-progress"])
+    assert rc == 0, err
+    r = json.loads((tmp_path / "o2" / "report.json").read_text())
+    assert r["developability_initial"] is None and "stationary" in r["initial_surface_error"]
+    o = r["optimization"]
+    assert o["initial_value"] is None and math.isfinite(o["best_value"])
+    assert [(j["requested"], j["achieved_G"]) for j in r["surface"]["joints"]] == [("G1", 1)]
+    md = (tmp_path / "o2" / "report.md").read_text()
+    assert "| final |" in md and "give no surface" in md
