@@ -298,3 +298,12 @@ def test_de_polish_really_polishes():
     stopped = differential_evolution(f, box(2, 1.0), pop_size=6, max_iter=5, seed=0, polish=True,
                                      callback=lambda s: s.nit >= 2)
     assert stopped.message == "stopped by callback" and stopped.nfev == 18
+
+
+@pytest.mark.parametrize("method", ["pso", "gwo", "igwo", "de"])
+def test_callback_numpy_true_cancels(method):
+    """A callback built from numpy comparisons returns numpy.bool_(True): that cancels too
+    (before, only the Python object True did and such a run went on to max_iter)."""
+    r = minimize(sphere, box(2, 1.0), method, pop_size=6, max_iter=50, seed=0,
+                 callback=lambda s: (np.linalg.norm(s.x) >= 0.0) & (s.nit >= 2))
+    assert r.message == "stopped by callback" and r.nit == 2

@@ -334,7 +334,8 @@ class _Run:
                 return f"converged: improvement <= tol={self.tol:g} over {self.patience} iterations"
         if self.callback is not None:
             state = OptimizerState(nit, self.nfev, self.best_x.copy(), self.best_f, self.max_iter, self.method)
-            if self.callback(state) is True:
+            stop = self.callback(state)
+            if stop is True or (isinstance(stop, np.bool_) and bool(stop)):  # None/other objects: go on
                 return "stopped by callback"
         if nit >= self.max_iter:
             if self.max_nfev is not None and self.nfev + self.per_iter > self.max_nfev:
