@@ -219,7 +219,7 @@ def test_embedded_default_design_validates() -> None:
     assert set(d.outputs.figures) == {"basis", "curve", "curvature", "surface", "flat_pattern", "convergence"}
 
 
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 
@@ -483,3 +483,31 @@ def test_boundary_curve_that_is_a_join_second_is_rejoined_per_candidate() -> Non
     cv, joins = build_curves(d, o.shape)
     assert [(j["achieved_G"], j["satisfied"]) for j in joins] == [(2, True)]
     assert build_surface(d, o.shape, curves=cv).surface.developability().R == pytest.approx(o.best_value, rel=1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.sampled_from([-1.0, 0.0, 1.0]) | st.floats(-1.0, 1.0), min_size=3, max_size=3))
+def test_planes_objective_is_inf_exactly_when_the_surface_degenerates(x: list[float]) -> None:
+    """Over the whole box of the quarter cone: the optimizer's objective is +inf iff the surface
+    cannot be built, else En of the unit-normal dual curve (recomputed here with 80 nodes; En's
+    integrand is smooth. AL's |U'| has a near-kink where U' almost vanishes on this design, and
+    64-node Gauss–Legendre AL is only within ~1e-4 relative of the converged integral there)."""
+    from ght_cad.design import OptimizeSpec, _objective_fn, build_surface
+    from ght_cad.errors import GHTError
+    from ght_cad.planes import normalize_planes
+
+    d = parse_design_text((EXAMPLES / "design_duct.toml").read_text(), "duct.toml")
+    f = _objective_fn(d, {}, OptimizeSpec(objective="En", parameters=["mu", "nu", "gamma"]))
+    sh = dict(zip(("mu", "nu", "gamma"), x))
+    try:
+        build_surface(d, sh)
+    except GHTError:
+        with pytest.raises(GHTError):
+            f(sh)
+        return
+    from ght_cad import GHTCurve
+
+    U = GHTCurve(normalize_planes(np.asarray(d.surface.planes, dtype=float)), *x)
+    t, w = np.polynomial.legendre.leggauss(80)
+    en = 0.5 * w @ np.sum(U.derivative(0.5 * (t + 1.0), 2) ** 2, axis=1)
+    assert f(sh) == pytest.approx(en, rel=1e-9)
