@@ -184,3 +184,13 @@ def test_strip_that_cannot_be_unrolled_keeps_the_result(tmp_path):
     assert any(n.startswith("flat pattern failed") for n in d.notes), d.notes
     assert set(d.files) == {"png", "json"}
     assert json.loads(d.files["json"].read_text())["notes"] == d.notes
+
+
+def test_out_dir_that_is_a_file_is_refused_before_the_run(tmp_path):
+    f = tmp_path / "file.txt"
+    f.write_text("keep")
+    calls = []
+    with pytest.raises(GHTError, match="out_dir=.*is a file"):
+        optimize_design(default_dual_problem("CVEn"), pop_size=5, max_iter=2, out_dir=f,
+                        callback=lambda s: calls.append(s.nit))
+    assert calls == [] and f.read_text() == "keep"

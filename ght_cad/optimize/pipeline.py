@@ -151,11 +151,14 @@ def optimize_design(
         DesignResult.
 
     Raises:
-        GHTError: bad optimizer arguments, a bad ``stem``, no candidate with a finite objective,
+        GHTError: bad optimizer arguments, a bad ``stem``, an ``out_dir`` that is a file (checked
+            before the run), no candidate with a finite objective,
             or a failed export (the target file is left untouched: all writes are atomic).
     """
     if not stem or any(c in stem for c in "/\\") or stem in (".", ".."):
         raise GHTError(f"stem={stem!r} is not allowed; use a plain file name without directories")
+    if out_dir is not None and Path(out_dir).exists() and not Path(out_dir).is_dir():
+        raise GHTError(f"out_dir={str(out_dir)!r} is a file; allowed: a folder or a new path")
     notes: list[str] = []
     total = max_iter if max_iter is not None else None
     with Progress(total, f"{method} {getattr(problem, 'label', '')}".strip(),
