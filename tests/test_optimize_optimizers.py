@@ -307,3 +307,9 @@ def test_callback_numpy_true_cancels(method):
     r = minimize(sphere, box(2, 1.0), method, pop_size=6, max_iter=50, seed=0,
                  callback=lambda s: (np.linalg.norm(s.x) >= 0.0) & (s.nit >= 2))
     assert r.message == "stopped by callback" and r.nit == 2
+
+
+def test_box_whose_width_overflows_is_refused():
+    """lb = -1e308, ub = 1e308 are finite but ub - lb = inf: every initial point was +-inf/NaN."""
+    with pytest.raises(GHTError, match="width"):
+        pso(sphere, ([-1e308, 0.0], [1e308, 1.0]), max_iter=1)

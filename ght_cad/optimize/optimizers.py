@@ -142,7 +142,8 @@ def as_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
         ``(lb, ub)`` as float arrays of shape (dim,), with ``lb < ub`` componentwise.
 
     Raises:
-        GHTError: wrong shape, non-finite values or ``lb >= ub``.
+        GHTError: wrong shape, non-finite values, ``lb >= ub`` or a width ``ub - lb`` that
+            overflows.
     """
     if hasattr(bounds, "lb") and hasattr(bounds, "ub"):
         lb, ub = bounds.lb, bounds.ub
@@ -173,6 +174,11 @@ def as_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
     if bad.size:
         i = int(bad[0])
         raise GHTError(f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub")
+    with np.errstate(over="ignore"):
+        wide = np.nonzero(~np.isfinite(ub - lb))[0]
+    if wide.size:
+        i = int(wide[0])
+        raise GHTError(f"bounds component {i}: the width ub - lb = {ub[i]:g} - ({lb[i]:g}) overflows; use a finite box")
     return lb, ub
 
 
