@@ -313,3 +313,9 @@ def test_box_whose_width_overflows_is_refused():
     """lb = -1e308, ub = 1e308 are finite but ub - lb = inf: every initial point was +-inf/NaN."""
     with pytest.raises(GHTError, match="width"):
         pso(sphere, ([-1e308, 0.0], [1e308, 1.0]), max_iter=1)
+
+
+def test_two_low_high_pairs_get_a_hint():
+    """[(0, 1), (0, 1)] reads as lb = (0, 1), ub = (0, 1): the error says how bounds are given."""
+    with pytest.raises(GHTError, match=r"lb=0 >= ub=0; need lb < ub \(bounds are \(lb, ub\)"):
+        pso(sphere, [(0, 1), (0, 1)], max_iter=1)

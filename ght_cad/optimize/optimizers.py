@@ -173,7 +173,8 @@ def as_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
     bad = np.nonzero(lb >= ub)[0]
     if bad.size:
         i = int(bad[0])
-        raise GHTError(f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub")
+        raise GHTError(f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub "
+                       "(bounds are (lb, ub), two arrays of length dim, not a list of (low, high) pairs)")
     with np.errstate(over="ignore"):
         wide = np.nonzero(~np.isfinite(ub - lb))[0]
     if wide.size:
