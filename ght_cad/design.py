@@ -1636,8 +1636,18 @@ class _Stage:
     def __init__(self, out_dir: Path) -> None:
         self.out = out_dir
         parent = out_dir.parent
-        parent.mkdir(parents=True, exist_ok=True)
-        self.tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".ght-cad-tmp", dir=parent))
+        # folders created for out_dir's parent: removed again by cleanup() after a failed run
+        self.made_parents = [d for d in (parent, *parent.parents) if not d.exists()][::-1]
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".ght-cad-tmp", dir=parent))
+        except OSError as exc:  # e.g. a part of the path is a regular file, or a read-only folder
+            self._remove_made_parents()
+            raise GHTError(
+                f"cannot create the output folder {out_dir}: {exc.strerror or exc}"
+                f"{f' ({exc.filename})' if exc.filename else ''}; allowed: a folder or a new path "
+                "whose parent folders can be created"
+            ) from None
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(self.tmp, 0o777 & ~umask)  # mkdtemp makes 0700; the result is an ordinary folder
@@ -1654,11 +1664,20 @@ class _Stage:
             raise GHTError(f"{self.out} exists and is not a folder; allowed: a folder or a new path")
         for n in names:
             os.replace(self.tmp / n, self.out / n)
-        self.cleanup()
+        shutil.rmtree(self.tmp, ignore_errors=True)
         return names
 
     def cleanup(self) -> None:
+        """Remove the temporary folder and the parent folders created for it (after a failure)."""
         shutil.rmtree(self.tmp, ignore_errors=True)
+        self._remove_made_parents()
+
+    def _remove_made_parents(self) -> None:
+        for d in reversed(self.made_parents):
+            try:
+                d.rmdir()  # only if still empty
+            except OSError:
+                pass
 
 
 def _versions() -> dict[str, str]:

@@ -363,3 +363,27 @@ def test_ctrl_c_that_surfaces_as_another_error_still_exits_130(monkeypatch, caps
     # the same ImportError without a Ctrl-C is an internal failure
     monkeypatch.setattr(cli, "cmd_plot_basis", lambda args: (_ for _ in ()).throw(ImportError("boom")))
     assert cli.main(["plot-basis", "--out", "b.png"]) == cli.EXIT_FAILURE
+
+
+@pytest.mark.parametrize("command", ["run", "demo"])
+def test_out_folder_under_a_file_is_bad_input_not_internal_failure(command: str, cone: Path, tmp_path: Path,
+                                                                   capsys) -> None:
+    """``--out blocker/sub`` where ``blocker`` is a regular file: exit 2 naming the path (was exit 1,
+    "internal failure: FileExistsError"), nothing written, the file untouched."""
+    (tmp_path / "blocker").write_text("a file\n")
+    argv = ["run", str(cone)] if command == "run" else ["demo", "--quick"]
+    rc, res, err = run_json([*argv, "--out", str(tmp_path / "blocker" / "sub" / "out")], capsys)
+    assert rc == EXIT_USAGE and res["exit_code"] == EXIT_USAGE, err
+    assert "blocker" in res["error"] and "internal failure" not in res["error"]
+    assert len(err.strip().splitlines()) == 1
+    assert (tmp_path / "blocker").read_text() == "a file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker", "cone.toml"]
+
+
+def test_failed_run_removes_the_folders_it_created(tmp_path: Path, capsys) -> None:
+    """A run that fails (degenerate design) into ``--out new/a/b`` leaves no ``new`` folder behind."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(CONE.replace("[-4, 0, 1, 0.5]]", "[-4, 1, 0, 0.5]]"))  # two equal planes
+    rc, res, err = run_json(["run", str(bad), "--out", str(tmp_path / "new" / "a" / "b")], capsys)
+    assert rc == EXIT_USAGE, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
