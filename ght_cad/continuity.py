@@ -50,6 +50,8 @@ __all__ = [
 
 #: ``|c_r|`` at or below this (relative to the 1-norm of the basis-derivative row) is singular.
 _SINGULAR_REL = 1e-12
+#: relative size of A's end tangent |P'(1)| (against the sum of the terms) below which G1..G3 joins are refused
+_TANGENT_REL = 1e-9
 
 
 class Continuity(str, enum.Enum):
@@ -303,7 +305,8 @@ def join(
     Raises:
         SingularJoinError: ``k <= 0``; B's degree is below the order (it has fewer than r+1
             points to solve); a newest-point coefficient ``c_r`` is zero (e.g. degree 2 with
-            γ = -1, μ = -1 has ``c_1 = 0``).
+            γ = -1, μ = -1 has ``c_1 = 0``); G1..G3 when A's end tangent vanishes
+            (``|P'(1)| <= 1e-9 Σ_i |a'_i(1)| |P_i|``, e.g. degree 2 with ν = γ = -1).
         GHTError: segments of different dimension, bad continuity, bad shape parameters,
             G parameters with a C order.
 
@@ -329,6 +332,21 @@ def join(
             f"segment B has degree {b.degree} ({b.degree + 1} points); {cont.value} needs degree >= {r_max}"
         )
     targets = join_targets(segment_a, cont, k=k, beta2=beta2, beta3=beta3)
+    if cont.geometric and r_max >= 1:
+        # G1..G3 need A's unit tangent at t = 1; with P'(1) = 0 (e.g. degree 2, nu = gamma = -1,
+        # or P_{m-1} = P_m) the condition R'(0) = k P'(1) would only build a cusp R_1 = R_0
+        P = segment_a.control_points
+        row1 = _end_rows_fast(segment_a, 1, 1)[1]
+        scale = max(float(np.abs(row1) @ np.linalg.norm(P, axis=1)), float(np.ptp(P, axis=0).max()), 1e-300)
+        d1 = float(np.linalg.norm(row1 @ P))
+        if not d1 > _TANGENT_REL * scale:
+            raise SingularJoinError(
+                f"cannot impose {cont.value}: the end tangent P'(1) of segment A vanishes (|P'(1)| = {d1:.3g}, "
+                f"relative {d1 / scale:.3g} <= {_TANGENT_REL:g}) for segment A of degree {segment_a.degree} with "
+                f"mu={segment_a.mu:g}, nu={segment_a.nu:g}, gamma={segment_a.gamma:g}; a geometric joint needs a "
+                "unit tangent: change A's shape parameters (degree 2 with nu = gamma = -1 has P'(1) = 0) or "
+                "separate P_(m-1) from P_m, or join with C0/C1"
+            )
     rows = _end_rows_fast(b, 0, r_max)
     pts = np.array(b.control_points, dtype=float)
     pts[0] = targets[0]  # R(0) = R_0 exactly (b_{i,n}(0) = δ_i0, c_0 = 1)
@@ -489,7 +507,8 @@ def measure_continuity(a: GHTCurve, b: GHTCurve, *, tol: float = 1e-9) -> JointR
         k = beta2 = beta3 = float("nan")
         g1 = g2 = g3 = float("inf")
     g_res = (c_res[0], g1, g2, g3)
-    if degenerate:
+    if degenerate:  # the G parameters of a vanishing tangent are fits of rounding noise: undefined
+        k = beta2 = beta3 = float("nan")
         notes.append("an end tangent vanishes: G1 and higher are undefined (g_order capped at c_order)")
     elif not k > 0:
         notes.append(f"tangents are antiparallel or orthogonal (k={k:.3g} <= 0): not G1")

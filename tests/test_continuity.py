@@ -238,3 +238,21 @@ def test_join_end_rows_match_full_basis_evaluation():
             for end in (0, 1):
                 for x, y in zip(_end_rows(curve, end, 3), _end_rows_fast(curve, end, 3)):
                     np.testing.assert_allclose(y, x, rtol=1e-13, atol=1e-13 * max(1.0, np.abs(x).max()))
+
+
+@pytest.mark.parametrize("cont", ["G1", "G2", "G3"])
+def test_geometric_join_refuses_a_vanishing_end_tangent_of_segment_a(cont):
+    # degree 2 with nu = -1, gamma = -1: P'(1) = (n + e_1^2)(P_2 - P_1) = 0 for any points (spec 1, 3),
+    # so G1 (unit tangent continuity) is undefined; before the fix join returned B with R_1 = R_0
+    # (a cusp) that measure_continuity then reported as G1 with k = 3.15 from rounding noise
+    a = GHTCurve([(0, 0), (1, 1), (2, 0)], mu=0.3, nu=-1.0, gamma=-1.0)
+    assert np.linalg.norm(a.derivative([1.0])[0]) < 1e-14
+    with pytest.raises(SingularJoinError, match=rf"{cont}.*tangent P'\(1\) of segment A vanishes.*nu=-1, gamma=-1"):
+        join(a, cont, [(0, 0), (0, 0), (3, 1), (4, 0)], k=2.0)
+    # parametric C1 stays allowed (R'(0) = P'(1) = 0 holds exactly)
+    b = join(a, "C1", [(0, 0), (0, 0), (3, 1), (4, 0)])
+    rep = measure_continuity(a, b)
+    assert rep.c_order >= 1
+    # the G parameters are undefined there: NaN, as documented, not least-squares fits of noise
+    assert math.isnan(rep.k) and math.isnan(rep.beta2) and math.isnan(rep.beta3)
+    assert any("vanishes" in n for n in rep.notes)
