@@ -244,24 +244,29 @@ def cmd_curve(args: argparse.Namespace) -> int:
         "end_tangent": curve.derivative(1.0, 1).tolist(),
         "outputs": {},
     }
-    if args.step:
+    if args.step and curve.dim not in (2, 3):
+        raise UsageError(f"--step needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
+
+    def write_step_edge(path: Path) -> None:
         from .bspline import curve_to_bspline
         from .cad.occ import make_edge, write_step
 
-        if curve.dim not in (2, 3):
-            raise UsageError(f"--step needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
         data = curve_to_bspline(curve)
-        write_step(make_edge(data), args.step)
-        result["outputs"]["step"] = str(args.step)
+        write_step(make_edge(data), path)
         result["bspline"] = {"degree": data.degree, "poles": int(data.poles.shape[0]), "max_deviation": data.max_deviation}
-    if args.plot:
+
+    def write_curve_png(path: Path) -> None:
         from .plotting import plot_curve
 
-        result["outputs"]["curve_png"] = str(plot_curve(curve, args.plot))
-    if args.curvature_plot:
+        plot_curve(curve, path)
+
+    def write_curvature_png(path: Path) -> None:
         from .plotting import plot_curvature
 
-        result["outputs"]["curvature_png"] = str(plot_curvature(curve, args.curvature_plot))
+        plot_curvature(curve, path)
+
+    result["outputs"] = _write_staged([("step", args.step, write_step_edge), ("curve_png", args.plot, write_curve_png),
+                                       ("curvature_png", args.curvature_plot, write_curvature_png)])
 
     def text(r: dict[str, Any]) -> str:
         s = (
@@ -273,6 +278,28 @@ def cmd_curve(args: argparse.Namespace) -> int:
 
     _emit(args, result, text)
     return EXIT_OK
+
+
+def _write_staged(outputs: Sequence[tuple[str, str | None, Callable[[Path], Any]]]) -> dict[str, str]:
+    """Write the requested outputs all or nothing; returns ``{kind: path}`` in the given order.
+
+    Each ``(kind, target, writer)`` with a target calls ``writer(temporary path)``; the files are
+    staged beside their targets and moved into place only when every writer succeeded (a failure
+    leaves no new file and every existing target as it was).
+    """
+    from .design import _FileStage
+
+    wanted = [(kind, Path(target), writer) for kind, target, writer in outputs if target]
+    if not wanted:
+        return {}
+    stage = _FileStage([t for _, t, _ in wanted])
+    try:
+        for _, target, writer in wanted:
+            writer(stage.path(target))
+        stage.commit()
+    finally:
+        stage.cleanup()
+    return {kind: str(target) for kind, target, _ in wanted}
 
 
 def _load(args: argparse.Namespace) -> Any:
@@ -335,14 +362,18 @@ def cmd_surface(args: argparse.Namespace) -> int:
     design = _load(args)
     built = build_surface(design)
     result = {"command": "surface", "name": design.name, **surface_summary(built), "outputs": {}}
-    if args.step:
+
+    def write_step_face(path: Path) -> None:
         from .design import export_step
 
-        result["outputs"]["step"] = str(export_step(built, args.step))
-    if args.plot:
+        export_step(built, path)
+
+    def write_surface_png(path: Path) -> None:
         from .plotting import plot_surface
 
-        result["outputs"]["surface_png"] = str(plot_surface(surface_view(built), args.plot, title=design.name))
+        plot_surface(surface_view(built), path, title=design.name)
+
+    result["outputs"] = _write_staged([("step", args.step, write_step_face), ("surface_png", args.plot, write_surface_png)])
 
     def text(r: dict[str, Any]) -> str:
         d = r["developability"]
@@ -804,8 +835,10 @@ def _dispatch(args: argparse.Namespace) -> int:
         return _fail(args, EXIT_USAGE, str(exc))
     except GHTError as exc:
         return _fail(args, EXIT_USAGE, str(exc))
-    except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
-        return _fail(args, EXIT_USAGE, f"{exc.strerror or exc}: {exc.filename}")
+    except (FileNotFoundError, IsADirectoryError, NotADirectoryError, FileExistsError, PermissionError) as exc:
+        # a path the user gave cannot be read or written: bad input (the message names the path)
+        reason = exc.strerror or str(exc)
+        return _fail(args, EXIT_USAGE, reason if exc.filename is None else f"{reason}: {exc.filename}")
     except Exception as exc:  # noqa: BLE001 - exit code 1 for every internal failure
         if _SIGINT_SEEN[0]:  # e.g. an ImportError of a module Ctrl-C cut off half-way
             return _fail(args, EXIT_INTERRUPTED, "interrupted")

@@ -24,6 +24,12 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
     """
     target = Path(path)
     sfx = target.suffix if suffix is None else suffix
+    blocker = _file_in_the_way(target.parent)
+    if blocker is not None:
+        raise NotADirectoryError(
+            20, f"cannot write {target}: {blocker} is a file, not a folder; allowed: a path whose folders "
+            "are folders or can be created"
+        )
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp_name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=sfx + ".part", dir=target.parent)
@@ -46,6 +52,14 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def _file_in_the_way(folder: Path) -> Path | None:
+    """The nearest existing ancestor of ``folder`` (itself included) if it is not a folder, else None."""
+    for p in (folder, *folder.parents):
+        if os.path.lexists(p):
+            return None if p.is_dir() else p
+    return None
 
 
 def _named(exc: OSError, target: Path) -> OSError:

@@ -387,3 +387,34 @@ def test_failed_run_removes_the_folders_it_created(tmp_path: Path, capsys) -> No
     rc, res, err = run_json(["run", str(bad), "--out", str(tmp_path / "new" / "a" / "b")], capsys)
     assert rc == EXIT_USAGE, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["curve", "--points", "1,0 1,1 0,1", "--step", "{d}/ok.step", "--plot", "{d}/ok.png",
+     "--curvature-plot", "{d}/blocker/k.png"],
+    ["surface", "{cone}", "--step", "{d}/ok.step", "--plot", "{d}/blocker/s.png"],
+])
+def test_curve_and_surface_outputs_are_all_or_nothing(argv: list[str], cone: Path, tmp_path: Path, capsys) -> None:
+    """The last output of ``curve``/``surface`` cannot be written (its folder is a file): exit 2 naming
+    it, and the STEP/PNG written before it do not appear (they did: ok.step, ok.png were left)."""
+    d = tmp_path / "out"
+    d.mkdir()
+    (d / "blocker").write_text("a file\n")
+    (d / "ok.step").write_text("old\n")  # an existing target keeps its content
+    argv = [a.format(d=d, cone=cone) for a in argv]
+    rc, res, err = run_json(argv, capsys)
+    assert rc == EXIT_USAGE and "blocker" in res["error"] and "internal failure" not in res["error"], err
+    assert sorted(p.name for p in d.iterdir()) == ["blocker", "ok.step"]
+    assert (d / "ok.step").read_text() == "old\n" and (d / "blocker").read_text() == "a file\n"
+    rc, res, err = run_json([a.replace("blocker/", "") for a in argv], capsys)  # and now it works
+    assert rc == EXIT_OK, err
+    assert (d / "ok.step").read_text().startswith("ISO-10303-21") and sorted(res["outputs"].values()) == sorted(
+        a.replace("blocker/", "") for a in argv if a.endswith((".step", ".png")))
+
+
+def test_single_png_under_a_file_is_bad_input(tmp_path: Path, capsys) -> None:
+    """``plot-basis --out blocker/b.png`` with ``blocker`` a file: exit 2 naming it (was exit 1)."""
+    (tmp_path / "blocker").write_text("a file\n")
+    rc, res, err = run_json(["plot-basis", "--out", str(tmp_path / "blocker" / "b.png")], capsys)
+    assert rc == EXIT_USAGE and "blocker is a file, not a folder" in res["error"], err
+    assert "None" not in res["error"] and len(err.strip().splitlines()) == 1

@@ -43,3 +43,18 @@ def test_unwritable_folder_names_the_target_not_the_temporary() -> None:
         write_text_atomic(target, "x")
     msg = str(exc.value)
     assert f"cannot write {target}" in msg and ".part" not in msg
+
+
+@pytest.mark.parametrize("depth", [1, 2])
+def test_target_under_a_regular_file_names_that_file(tmp_path, depth: int) -> None:
+    """``blocker/x.png`` (or ``blocker/sub/x.png``) where ``blocker`` is a file: NotADirectoryError
+    naming the target and the file in the way (was FileExistsError/NotADirectoryError "File exists"
+    without saying which path is the file); nothing is created, the file is untouched."""
+    blocker = tmp_path / "blocker"
+    blocker.write_text("keep\n")
+    target = blocker / "sub" / "x.png" if depth == 2 else blocker / "x.png"
+    with pytest.raises(NotADirectoryError) as exc:
+        write_text_atomic(target, "x")
+    msg = str(exc.value)
+    assert f"cannot write {target}" in msg and f"{blocker} is a file, not a folder" in msg, msg
+    assert blocker.read_text() == "keep\n" and sorted(p.name for p in tmp_path.iterdir()) == ["blocker"]
