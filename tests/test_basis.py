@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from ght_cad import GBTSeed, GHTCurve, GHTSeed, basis, bernstein
@@ -76,10 +76,28 @@ def test_closed_form_equals_recursion(m: int, mu: float, nu: float, gamma: float
 
 
 @given(degrees, params, params, params)
+@example(2, -1.0, -1.0, -1.0)
+@example(2, -1.0, -1.0, -0.9999999999999999)
+@example(10, -1.0, -1.0, -1.0)
 def test_linear_independence(m: int, mu: float, nu: float, gamma: float) -> None:
+    """Linearly independent on the whole box for m >= 3; for m = 2 everywhere but one corner.
+
+    At m = 2, mu = nu = gamma = -1 the seed is (c², 0, s²): f1 ≡ 0 and b_{1,2} vanishes, so the
+    spec's independence claim fails exactly there (found by hypothesis with a random seed; the old
+    bound 1e-8 also failed within ~1e-8 of that corner). Near it the conditioning degrades
+    linearly in the distance d = 3 + mu + nu + gamma (measured: sigma_min/sigma_max >= 0.063 d).
+    """
     tt = (np.arange(m + 1) + 0.5) / (m + 1)
-    sv = np.linalg.svd(basis(tt, m, mu, nu, gamma), compute_uv=False)
-    assert sv.min() > 1e-8 * sv.max()
+    B = basis(tt, m, mu, nu, gamma)
+    sv = np.linalg.svd(B, compute_uv=False)
+    if m >= 3:
+        assert sv.min() > 1e-5 * sv.max()  # measured >= 6.4e-5 (m = 10 at the corner)
+    else:
+        d = min(1.0, 3.0 + mu + nu + gamma)
+        assert sv.min() > 0.03 * d * sv.max() - 1e-15
+        if d == 0.0:
+            t = np.linspace(0.0, 1.0, 101)
+            assert np.abs(basis(t, 2, mu, nu, gamma)[:, 1]).max() < 1e-15  # f1 ≡ 0: P_1 has no influence
 
 
 def _fd4(f, t: np.ndarray, h: float) -> np.ndarray:
