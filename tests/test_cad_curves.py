@@ -331,3 +331,17 @@ def test_adapter_errors():
         ght_face(a)
     with pytest.raises(GHTError, match="GHTCurve"):
         ght_wire([a, "not a curve"])
+
+
+def test_cadquery_plugin_refuses_curves_of_more_than_three_dimensions():
+    # a 4-D curve (e.g. a dual curve of planes) handed to Workplane.ghtCurve raised numpy's
+    # "could not broadcast input array from shape (4,) into shape (3,)" (a bare ValueError)
+    import cadquery as cq
+
+    import ght_cad.cad.cq_plugin  # noqa: F401
+
+    four = GHTCurve(np.zeros((3, 4)) + np.arange(3)[:, None])
+    with pytest.raises(GHTError, match=r"curve has dimension 4; .*2-D or 3-D"):
+        cq.Workplane("XY").ghtCurve(four)
+    with pytest.raises(GHTError, match=r"2-D or 3-D; got 4 coordinates"):
+        cq.Workplane("XY").ghtBezier([(0, 0, 0, 0), (1, 1, 1, 1), (2, 0, 0, 0)])

@@ -127,8 +127,17 @@ def ghtCurve(
 
     Returns:
         A new Workplane holding the edges (or one wire with ``makeWire``).
+
+    Raises:
+        GHTError: not a curve / chain, a segment that is not 2-D or 3-D, bad tol.
     """
     segs, _ = segments_of(curve)
+    for i, seg in enumerate(segs):
+        if seg.dim not in (2, 3):
+            raise GHTError(
+                f"segment {i}: the curve has dimension {seg.dim}; a Workplane edge needs 2-D or 3-D "
+                "control points (local workplane coordinates)"
+            )
     edges = []
     for seg in segs:
         world = seg.with_control_points(_to_world(self, seg.control_points))
