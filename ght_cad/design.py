@@ -1448,6 +1448,28 @@ def unroll_surface(built: BuiltSurface) -> Any:
                   units=d.units, label=d.name[:24])
 
 
+def pattern_report(pattern: Any) -> dict[str, Any]:
+    """The ``flat_pattern`` entry of a report: area, errors, distortion report, outline and bend-line
+    counts, bounding box, per-panel areas and the edge-mark labels (``E<n>``, panel labels excluded)."""
+    import re
+
+    panel_labels = {pn.label for pn in pattern.panels}
+    return {
+        "area": float(pattern.area),
+        "errors": pattern_errors(pattern),
+        "report": pattern.report.as_dict(),
+        "outline_points": int(sum(len(o) for o in pattern.outlines)),
+        "bend_lines": int(len(pattern.bend_lines)),
+        "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
+                 np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
+        "panels": [{"label": pn.label, "area_flat": float(pn.area_flat), "area_3d": float(pn.area_3d),
+                    "max_error": float(pn.report.max_relative_error) if pn.report is not None else None}
+                   for pn in pattern.panels],
+        "edge_marks": sorted({t[2] for t in pattern.labels
+                              if t[2] not in panel_labels and re.fullmatch(r"E\d+", t[2])}, key=lambda m: int(m[1:])),
+    }
+
+
 def pattern_errors(pattern: Any) -> dict[str, float]:
     """Max relative length/area errors of a flat pattern (``FlatPattern.errors``) as floats."""
     return {k: float(v) for k, v in pattern.errors.items()}
@@ -1466,7 +1488,8 @@ def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None
 def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str, str]:
     """Build the design with its given shape parameters and write each file by its suffix.
 
-    ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: summary;
+    ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: name, units,
+    surface summary, curves and (with a surface) the ``flat_pattern`` entry of :func:`pattern_report`;
     ``.png``: rendered surface (or the curves when the design has no surface).
 
     All or nothing: every file is first written into a temporary folder beside its target
@@ -1530,8 +1553,12 @@ def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | No
         pattern = pattern or unroll_surface(built)
         (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp)
     elif suf == ".json":
-        summ = surface_summary(built) if built is not None else {}
+        summ = {"name": design.name, "units": design.units}
+        summ.update(surface_summary(built) if built is not None else {})
         summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
+        if built is not None:
+            pattern = pattern or unroll_surface(built)
+            summ["flat_pattern"] = pattern_report(pattern)
         write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
     else:
         from .plotting import plot_curve, plot_surface
@@ -1826,19 +1853,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             # 6. flat pattern
             step("flat pattern")
             pattern = unroll_surface(built)
-            report["flat_pattern"] = {
-                "area": float(pattern.area),
-                "errors": pattern_errors(pattern),
-                "report": pattern.report.as_dict(),
-                "outline_points": int(sum(len(o) for o in pattern.outlines)),
-                "bend_lines": int(len(pattern.bend_lines)),
-                "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
-                         np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
-                "panels": [{"label": pn.label, "area_flat": float(pn.area_flat), "area_3d": float(pn.area_3d),
-                            "max_error": float(pn.report.max_relative_error) if pn.report is not None else None}
-                           for pn in pattern.panels],
-                "edge_marks": sorted({t[2] for t in pattern.labels if t[2].startswith("E")}),
-            }
+            report["flat_pattern"] = pattern_report(pattern)
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
             if "svg" in want_files:

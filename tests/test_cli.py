@@ -418,3 +418,24 @@ def test_single_png_under_a_file_is_bad_input(tmp_path: Path, capsys) -> None:
     rc, res, err = run_json(["plot-basis", "--out", str(tmp_path / "blocker" / "b.png")], capsys)
     assert rc == EXIT_USAGE and "blocker is a file, not a folder" in res["error"], err
     assert "None" not in res["error"] and len(err.strip().splitlines()) == 1
+
+
+def test_export_json_is_a_report_with_units_and_the_flat_pattern(tmp_path: Path, capsys) -> None:
+    """``export D.toml r.json`` next to a DXF: the JSON states the units and the flat pattern's area,
+    errors and edge marks, the same numbers as ``run``'s report.json (it had only surface,
+    developability and curves). A strip named "Elbow" is a panel, not an edge mark (labels starting
+    with "E" were all counted as edge marks)."""
+    text = (EXAMPLES / "design_duct_two_strips.toml").read_text().replace('name = "quarter"', 'name = "Elbow"')
+    design = tmp_path / "two.toml"
+    design.write_text(text)
+    rc, res, err = run_json(["export", str(design), str(tmp_path / "p.dxf"), str(tmp_path / "r.json")], capsys)
+    assert rc == EXIT_OK, err
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["units"] == "m" and rep["name"] == "duct-two-strips"
+    fp = rep["flat_pattern"]
+    assert fp["edge_marks"] == ["E1"] and [p["label"] for p in fp["panels"]] == ["Elbow", "second-quarter"]
+    assert fp["area"] == pytest.approx(rep["surface"]["area_3d"], rel=1e-12) and fp["errors"]["max"] < 1e-12
+    rc, res, err = run_json(["run", str(design), "--out", str(tmp_path / "out")], capsys)
+    assert rc == EXIT_OK, err
+    run_fp = json.loads((tmp_path / "out" / "report.json").read_text())["flat_pattern"]
+    assert run_fp["edge_marks"] == ["E1"] and run_fp["area"] == pytest.approx(fp["area"], rel=1e-14)

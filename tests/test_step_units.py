@@ -47,3 +47,35 @@ def test_unknown_unit_is_refused_and_nothing_written(tmp_path) -> None:
     with pytest.raises(GHTError, match=r"units='furlong' is not a STEP length unit; allowed: mm, cm, m, in, ft"):
         write_step(Box(1, 1, 1), tmp_path / "x.step", units="furlong")
     assert not (tmp_path / "x.step").exists()
+
+
+def test_design_step_declares_the_design_units_and_reads_back_at_true_size(tmp_path) -> None:
+    """``units = "ft"``: ``ght-cad export`` writes a STEP declaring feet (docs/design-files.md said
+    "declares millimetres whatever units says"); unrolled from the STEP file, the pattern is in ft
+    with the design pattern's area (1e-7 relative: certified B-spline face), and in mm it is that
+    area times 304.8²."""
+    import json
+    from pathlib import Path
+
+    from ght_cad.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    design = (root / "examples" / "design_duct.toml").read_text().replace('units = "mm"', 'units = "ft"')
+    assert 'units = "ft"' in design
+    toml = tmp_path / "duct ft.toml"
+    toml.write_text(design)
+    step, rep = tmp_path / "d.step", tmp_path / "r.json"
+    assert main(["export", str(toml), str(step), str(rep)]) == 0
+    assert "'FOOT'" in step.read_text()
+    area = json.loads(rep.read_text())["flat_pattern"]["area"]
+    for units, scale in (("ft", 1.0), ("mm", 304.8**2)):
+        out = tmp_path / f"u_{units}.json"
+        import contextlib
+        import io
+
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            assert main(["unroll", str(step), "--units", units, "--json"]) == 0
+        res = json.loads(buf.getvalue())
+        assert res["units"] == units and abs(res["area"] / (area * scale) - 1) < 1e-7, (units, res["area"], area)
+    assert "declares millimetres whatever" not in (root / "docs" / "design-files.md").read_text()
