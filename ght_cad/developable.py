@@ -255,6 +255,9 @@ class EnvelopeDevelopable(RuledSurface):
     def dual_parameter(self, u: Any) -> np.ndarray:
         """Dual-curve parameter ``t = t0 + u (t1 - t0)`` of surface parameter ``u``."""
         uu, _ = as_parameter_array(u, "u")
+        # checked on u itself: for a trimmed surface an out-of-range u maps to a t inside [0, 1]
+        # and would silently evaluate the envelope beyond the face
+        check_unit_interval("u", uu, slack=1e-9)
         t0, t1 = self.t_range
         return t0 + uu * (t1 - t0)
 
@@ -699,10 +702,19 @@ def developable_bspline(
         raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")
     if end_order not in (0, 1, 2):
         raise GHTError(f"end_order={end_order!r} is not allowed; use 0, 1 or 2")
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer, float)) or int(degree) != degree \
+            or not 1 <= int(degree) <= 25:
+        raise GHTError(f"degree={degree!r} is not allowed; B-spline degrees are integers 1..25")
+    degree = int(degree)
     size = _size(surface)
     if tol is None:
         tol = 1e-7 * max(size, 1e-300)
-    tol = float(tol)
+    try:
+        tol = float(tol)
+        theta_tol_deg = float(theta_tol_deg)
+    except (TypeError, ValueError):
+        bad = "tol" if not isinstance(tol, float) else "theta_tol_deg"
+        raise GHTError(f"{bad}={(tol if bad == 'tol' else theta_tol_deg)!r} is not a number; it must be a positive float") from None
     if not (math.isfinite(tol) and tol > 0):
         raise GHTError(f"tol={tol!r} must be a positive finite number")
 
@@ -721,7 +733,6 @@ def developable_bspline(
             [np.concatenate([surface.a(np.array([e]), r)[0], surface.b(np.array([e]), r)[0]]) for r in range(top + 1)]
             for e in (0.0, 1.0)
         )
-    theta_tol_deg = float(theta_tol_deg)
     if not theta_tol_deg > 0:
         raise GHTError(f"theta_tol_deg={theta_tol_deg!r} must be > 0 (use inf to skip the check)")
     exact_theta = None
@@ -987,7 +998,14 @@ class CanalSurface:
             except (TypeError, ValueError):
                 raise GHTError(f"radius={radius!r} must be a 1-D GHTCurve or a positive number") from None
             self.radius = GHTCurve([[r]] * 3)
-        self.phi_range = (float(phi_range[0]), float(phi_range[1]))
+        try:
+            self.phi_range = (float(phi_range[0]), float(phi_range[1]))
+        except (TypeError, ValueError, IndexError):
+            raise GHTError(f"phi_range={phi_range!r} must be a pair of angles (phi0, phi1) in radians") from None
+        if not (all(math.isfinite(x) for x in self.phi_range) and self.phi_range[0] != self.phi_range[1]):
+            raise GHTError(
+                f"phi_range={self.phi_range!r} is not allowed; it must be two finite, different angles (radians)"
+            )
         u = np.linspace(0.0, 1.0, samples)
         rv = self.radius.evaluate(u)[:, 0]
         if not np.all(rv > 0):

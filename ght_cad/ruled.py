@@ -219,8 +219,11 @@ class RuledSurface(ABC):
         Gauss–Legendre quadrature (>= 64); ``θ_max`` over the quadrature nodes and ``samples``
         uniform parameters (ends included).
         """
-        if nodes < 64:
-            raise GHTError(f"nodes={nodes} is too few; the developability integrals use >= 64 Gauss–Legendre nodes")
+        if isinstance(nodes, bool) or not isinstance(nodes, (int, np.integer)) or nodes < 64:
+            raise GHTError(
+                f"nodes={nodes!r} is not allowed; the developability integrals use an integer >= 64 of "
+                "Gauss–Legendre nodes"
+            )
         t, w = gauss_legendre(nodes)
         _, theta_rms, dd, R = developability_from_jets(self.a(t), self.a(t, 1), self.b(t), self.b(t, 1), w)
         uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])

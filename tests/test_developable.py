@@ -563,3 +563,33 @@ def test_curve_derivatives_of_a_custom_seed_stop_at_order_three():
         np.testing.assert_allclose(d[r], c.derivative(u, r), rtol=0, atol=1e-13 * max(1.0, np.abs(d[r]).max()))
     with pytest.raises(GHTError, match="derivative order 4 of the seed .* only guarantee orders 0..3"):
         curve_derivatives(c, u, 4)
+
+
+def test_trimmed_surface_refuses_u_outside_its_domain():
+    # t_range (0.2, 0.7): u = -0.1 and 1.2 map to t = 0.15 and 0.8, inside the dual curve's [0, 1];
+    # before the fix they silently evaluated the untrimmed envelope beyond the face, and u = 1.5
+    # raised an error naming t = 0.95 instead of the u the user gave
+    part = ship(t_range=(0.2, 0.7))
+    for u in (-0.1, 1.2, 1.5):
+        with pytest.raises(GHTError, match=rf"u={u:g} is outside the parameter domain \[0, 1\]"):
+            part.evaluate(u, 0.5)
+        with pytest.raises(GHTError, match=rf"u={u:g} is outside"):
+            part.a([0.5, u], 1)
+    np.testing.assert_allclose(part.evaluate([0.0, 1.0], [0.0, 1.0]), ship().evaluate([0.2, 0.7], [0.0, 1.0]), atol=1e-12)
+
+
+def test_conversion_and_measure_arguments_are_checked_by_name():
+    s = cylinder(2.0, 3.0)
+    for bad in (0, 2.5, "5"):
+        with pytest.raises(GHTError, match=rf"degree={bad!r} is not allowed; B-spline degrees are integers 1..25"):
+            s.to_face(degree=bad) if bad == "5" else ght_cad.developable.developable_bspline(s, degree=bad)
+    with pytest.raises(GHTError, match=r"tol='x' is not a number"):
+        ght_cad.developable.developable_bspline(s, tol="x")
+    with pytest.raises(GHTError, match=r"theta_tol_deg='x' is not a number"):
+        ght_cad.developable.developable_bspline(s, theta_tol_deg="x")
+    with pytest.raises(GHTError, match=r"nodes='64' is not allowed; .*integer >= 64"):
+        s.developability(nodes="64")
+    with pytest.raises(GHTError, match=r"phi_range=\(0.0, nan\) is not allowed"):
+        CanalSurface(SPACE, 0.1, phi_range=(0.0, float("nan")))
+    with pytest.raises(GHTError, match=r"phi_range=\(1.0, 1.0\) is not allowed"):
+        CanalSurface(SPACE, 0.1, phi_range=(1.0, 1.0))
