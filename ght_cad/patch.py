@@ -79,6 +79,16 @@ def _net(control_points: Any) -> np.ndarray:
     return P
 
 
+def _direction_seed(seed: str, direction: str, mu: Any, nu: Any, gamma: Any) -> Seed:
+    """``make_seed`` for one direction; a bad shape parameter's message names ``mu_u``, ``gamma_v``, ..."""
+    from ._validate import check_shape_parameter
+
+    if isinstance(seed, str) and seed.lower() in ("ght", "gbt", "bernstein"):  # built-in seeds: [-1, 1]
+        for name, value in (("mu", mu), ("nu", nu), ("gamma", gamma)):
+            check_shape_parameter(f"{name}_{direction}", value)
+    return make_seed(seed, mu, nu, gamma)
+
+
 class GHTSurface:
     r"""Tensor-product GHT-Bézier patch ``S(u,v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P_ij`` on [0,1]².
 
@@ -112,8 +122,8 @@ class GHTSurface:
     ) -> None:
         self._P = _net(control_points)
         self._seed_name = seed
-        self._seed_u = make_seed(seed, mu_u, nu_u, gamma_u)
-        self._seed_v = make_seed(seed, mu_v, nu_v, gamma_v)
+        self._seed_u = _direction_seed(seed, "u", mu_u, nu_u, gamma_u)
+        self._seed_v = _direction_seed(seed, "v", mu_v, nu_v, gamma_v)
 
     # -- attributes --------------------------------------------------------------------------
     @property

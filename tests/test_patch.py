@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
 from ght_cad import basis
-from ght_cad.errors import GHTError, SingularJoinError
+from ght_cad.errors import GHTError, ShapeParameterError, SingularJoinError
 from ght_cad.patch import GHTSurface, join_patches, measure_patch_continuity, patches_to_bspline
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)
@@ -186,3 +186,10 @@ def test_patch_errors():
         join_patches(s, "C1", other)
     with pytest.raises(SingularJoinError):
         join_patches(s, "G1", s, k=-1.0)
+
+
+@pytest.mark.parametrize("name, value", [("mu_u", 1.5), ("nu_u", -2.0), ("gamma_v", 1.5), ("mu_v", float("nan"))])
+def test_patch_shape_parameter_errors_name_the_argument(name, value):
+    # the message said "gamma=1.5" for gamma_v=1.5: which of the two directions was wrong was lost
+    with pytest.raises(ShapeParameterError, match=rf"^{name}={value:g} "):
+        GHTSurface(np.zeros((3, 3, 3)), **{name: value})
