@@ -1689,6 +1689,10 @@ class _Stage:
             return names
         if not self.out.is_dir():
             raise GHTError(f"{self.out} exists and is not a folder; allowed: a folder or a new path")
+        for n in names:  # checked before the first move: a failure must not leave a mixed folder
+            if (self.out / n).is_dir():
+                raise GHTError(f"cannot write {self.out / n}: it is a folder; allowed: a file path "
+                               "(remove or rename the folder)")
         for n in names:
             os.replace(self.tmp / n, self.out / n)
         shutil.rmtree(self.tmp, ignore_errors=True)

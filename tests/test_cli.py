@@ -439,3 +439,17 @@ def test_export_json_is_a_report_with_units_and_the_flat_pattern(tmp_path: Path,
     assert rc == EXIT_OK, err
     run_fp = json.loads((tmp_path / "out" / "report.json").read_text())["flat_pattern"]
     assert run_fp["edge_marks"] == ["E1"] and run_fp["area"] == pytest.approx(fp["area"], rel=1e-14)
+
+
+def test_run_into_a_folder_where_an_output_name_is_a_folder_changes_nothing(cone: Path, tmp_path: Path,
+                                                                            capsys) -> None:
+    """``--out`` holds a folder named ``report.md``: exit 2 naming it, and no file of the run is moved
+    in (model.step, flat_pattern.* and report.json were moved before the rename of report.md failed)."""
+    out = tmp_path / "out"
+    (out / "report.md").mkdir(parents=True)
+    (out / "model.step").write_text("old\n")
+    rc, res, err = run_json(["run", str(cone), "--out", str(out)], capsys)
+    assert rc == EXIT_USAGE and "report.md" in res["error"] and "internal failure" not in res["error"], err
+    assert sorted(p.name for p in out.iterdir()) == ["model.step", "report.md"]
+    assert (out / "model.step").read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cone.toml", "out"]  # no staging folder left
