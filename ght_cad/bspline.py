@@ -177,6 +177,19 @@ def _end_basis(knots: np.ndarray, degree: int, n_poles: int, end: int, orders: i
     return np.array(rows)
 
 
+def _forward_substitution(D: np.ndarray, rhs: Any) -> np.ndarray:
+    """Solve the lower-triangular ``D X = rhs`` row by row.
+
+    ``D[0, 0] = N_0(end) = 1``, so the end pole is the end value bit for bit (an LU solve with
+    pivoting mixed rounding of the derivative rows into it).
+    """
+    B = np.asarray(rhs, dtype=float)
+    X = np.zeros_like(B)
+    for k in range(D.shape[0]):
+        X[k] = (B[k] - D[k, :k] @ X[:k]) / D[k, k]
+    return X
+
+
 def _call(func: Callable[[np.ndarray], np.ndarray], t: np.ndarray, dim: int | None) -> np.ndarray:
     vals = np.asarray(func(t), dtype=float)
     if vals.ndim == 1:
@@ -397,10 +410,10 @@ def fit_function(
         fixed = np.zeros((n, dim))
         is_fixed = np.zeros(n, dtype=bool)
         if r0:
-            fixed[:r0] = np.linalg.solve(_end_basis(knots, p, n, 0, r0), ends[0])
+            fixed[:r0] = _forward_substitution(_end_basis(knots, p, n, 0, r0), ends[0])
             is_fixed[:r0] = True
         if r1:
-            fixed[n - r1 :] = np.linalg.solve(_end_basis(knots, p, n, 1, r1), ends[1])[::-1]
+            fixed[n - r1 :] = _forward_substitution(_end_basis(knots, p, n, 1, r1), ends[1])[::-1]
             is_fixed[n - r1 :] = True
         poles = fixed.copy()
         free = ~is_fixed
@@ -616,6 +629,12 @@ def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 
         ends = ([jets[k][0] for k in range(r + 1)], [jets[k][1] for k in range(r + 1)])
     else:
         ends = ([curve.derivative(0.0, k) for k in range(r + 1)], [curve.derivative(1.0, k) for k in range(r + 1)])
+    from .curve import GHTCurve
+
+    if isinstance(curve, GHTCurve):  # P(0) = P_0, P(1) = P_m exactly (b_{i,m}(0) = δ_i0, spec 2)
+        cp = curve.control_points
+        ends[0][0] = np.array(cp[0], dtype=float)
+        ends[1][0] = np.array(cp[-1], dtype=float)
     out = fit_function(curve.evaluate, tol=tol, degree=int(degree), end_derivatives=ends)
     out.info["source"] = repr(curve)
     return out

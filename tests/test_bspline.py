@@ -229,3 +229,23 @@ def test_each_round_calls_func_once_and_never_repeats_a_span():
     flat = np.concatenate(rounds)
     assert flat.size - np.unique(flat).size <= sum(c.size // nodes + 1 for c in rounds)
     assert bs.info["samples_checked"] == sum(c.size for c in calls)
+
+
+@given(st.integers(2, 12), shape, shape, shape, st.integers(0, 2**32 - 1), st.sampled_from([2, 3, 5, 8]))
+@settings(max_examples=40)
+def test_end_poles_are_the_end_control_points_exactly(degree, mu, nu, gamma, seed, p):
+    # C(0) = P_0 and C(1) = P_m bit for bit (b_{i,m}(0) = δ_i0): edges of a wire then meet in the
+    # user's exact points. The end poles were solved by LU with pivoting and came out as
+    # (-4.0e-16, -6.0e-16, 0) for P_0 = (0, 0, 0) (GHTCurve [(0,0,0),(5,5,0),(10,0,0)], p = 5).
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(degree + 1, 3)) * rng.choice([1e-3, 1.0, 1e3])
+    pts[0] = 0.0
+    c = GHTCurve(pts, mu, nu, gamma)
+    b = curve_to_bspline(c, degree=p)
+    assert np.array_equal(b.poles[0], c.control_points[0])
+    assert np.array_equal(b.poles[-1], c.control_points[-1])
+
+
+def test_end_poles_exact_for_the_reported_case():
+    b = curve_to_bspline(GHTCurve([(0, 0, 0), (5, 5, 0), (10, 0, 0)]))
+    assert np.array_equal(b.poles[0], [0.0, 0.0, 0.0]) and np.array_equal(b.poles[-1], [10.0, 0.0, 0.0])
