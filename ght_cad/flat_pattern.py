@@ -57,6 +57,12 @@ SVG_UNITS = {
     "ft": ("in", 12.0),
 }
 
+#: millimetres per model unit (the SVG's physical stroke width and dash lengths)
+_MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
+
+#: SVG stroke width of every line at true scale, millimetres
+SVG_STROKE_MM = 0.25
+
 _ROMBERG_N = 128
 
 #: 3-D arc-length fractions of the edge-mark ticks (double tick near the start)
@@ -683,7 +689,9 @@ class FlatPattern:
 
         The viewBox is in model units; ``width``/``height`` are the same extent in an SVG length
         unit (:data:`SVG_UNITS`: ``width = (extent + 2 margin) × scale`` with m → mm × 1000,
-        ft → in × 12, mm/cm/in × 1), so the drawing prints at true scale.
+        ft → in × 12, mm/cm/in × 1), so the drawing prints at true scale. Lines are
+        :data:`SVG_STROKE_MM` (0.25 mm) wide at that scale and bend-line dashes ``span / 130``
+        long, kept within 1..10 mm (a unitless pattern: width ``span / 800``, dashes ``6×`` that).
 
         Args:
             margin: blank border in model units (default 3 % of the larger extent).
@@ -700,8 +708,13 @@ class FlatPattern:
         def tr(p: np.ndarray) -> tuple[float, float]:
             return float(p[0] - lo[0] + m), float(hi[1] - p[1] + m)
 
-        sw = span / 800.0
         unit, scale = SVG_UNITS[self.units]
+        mm = _MM_PER_UNIT.get(self.units)  # millimetres per model unit (None: unitless)
+        if mm is None:  # no physical size: lines and dashes relative to the drawing
+            sw, dash = span / 800.0, 6 * span / 800.0
+        else:  # printed/cut at true scale: 0.25 mm lines, dashes of span/130 within 1..10 mm
+            sw = SVG_STROKE_MM / mm
+            dash = min(max(span / 130.0, 1.0 / mm), 10.0 / mm)
         out = [
             '<?xml version="1.0" encoding="UTF-8" standalone="no"?>',
             f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" '
@@ -714,7 +727,7 @@ class FlatPattern:
         out.append("</g>")
         out.append(
             f'<g id="BEND" inkscape:groupmode="layer" inkscape:label="BEND" fill="none" stroke="red" '
-            f'stroke-width="{sw:.6g}" stroke-dasharray="{6 * sw:.6g},{3 * sw:.6g}">'
+            f'stroke-width="{sw:.6g}" stroke-dasharray="{dash:.6g},{dash / 2:.6g}">'
         )
         for p, q in self.bend_lines:
             (x1, y1), (x2, y2) = tr(p), tr(q)

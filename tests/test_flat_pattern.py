@@ -225,3 +225,26 @@ def test_svg_size_is_true_scale_in_a_valid_svg_unit(units: str) -> None:
 def test_svg_one_metre_is_1000mm_and_one_foot_12in() -> None:
     assert _svg_size(_unit_square("m").svg_text(margin=0.0))[:4] == (1000.0, "mm", 1000.0, "mm")
     assert _svg_size(_unit_square("ft").svg_text(margin=0.0))[:4] == (12.0, "in", 12.0, "in")
+
+
+@pytest.mark.parametrize("units, mm_per_unit, scale", [("mm", 1.0, 3000.0), ("mm", 1.0, 20.0), ("m", 1000.0, 3.0),
+                                                       ("in", 25.4, 100.0), ("ft", 304.8, 10.0)])
+def test_svg_strokes_have_a_physical_width_at_true_scale(units: str, mm_per_unit: float, scale: float,
+                                                          tmp_path) -> None:
+    """Printed or cut at true scale, outline/bend/mark strokes are 0.25 mm wide and bend dashes
+    1..10 mm long, whatever the part's size (the width was 1/800 of the part: 3.75 mm lines on a
+    3 m panel, 7.6 mm on the 6 m demo plate)."""
+    pat = unroll(CurvePairRuledSurface(quarter(scale / 3, 0.0), quarter(2 * scale / 3, scale / 2)), rulings=5,
+                 units=units)
+    root = ET.parse(pat.export_svg(tmp_path / "p.svg")).getroot()
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    view_w = float(root.get("viewBox").split()[2])
+    width = float(root.get("width").rstrip("minc"))
+    unit = root.get("width").lstrip("0123456789.e+-")
+    mm_per_user = width * {"mm": 1.0, "cm": 10.0, "in": 25.4}[unit] / view_w  # true scale: = mm_per_unit
+    assert mm_per_user == pytest.approx(mm_per_unit, rel=1e-7)
+    groups = {g.get("id"): g for g in root.findall("s:g", ns)}
+    for layer in ("OUTLINE", "BEND", "MARKS"):
+        assert float(groups[layer].get("stroke-width")) * mm_per_user == pytest.approx(0.25, rel=1e-3), layer
+    dash = [float(x) * mm_per_user for x in groups["BEND"].get("stroke-dasharray").split(",")]
+    assert 1.0 * (1 - 1e-5) <= dash[0] <= 10.0 * (1 + 1e-5) and dash[1] == pytest.approx(dash[0] / 2, rel=1e-5), dash
