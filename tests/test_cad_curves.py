@@ -345,3 +345,17 @@ def test_cadquery_plugin_refuses_curves_of_more_than_three_dimensions():
         cq.Workplane("XY").ghtCurve(four)
     with pytest.raises(GHTError, match=r"2-D or 3-D; got 4 coordinates"):
         cq.Workplane("XY").ghtBezier([(0, 0, 0, 0), (1, 1, 1, 1), (2, 0, 0, 0)])
+
+
+def test_write_step_refuses_what_is_not_a_shape(tmp_path):
+    # a string, None or a null TopoDS_Shape reached BRepCheck_Analyzer and raised pybind11's
+    # "incompatible constructor arguments" TypeError (or crashed the analyzer on a null shape)
+    from OCP.TopoDS import TopoDS_Shape
+
+    target = tmp_path / "x.step"
+    for bad, what in (("not a shape", "str"), (None, "NoneType"), (TopoDS_Shape(), "null")):
+        with pytest.raises(GHTError, match=rf"shape #0 .*{what}"):
+            write_step(bad, target)
+        with pytest.raises(GHTError, match=rf"shape #1 .*{what}"):
+            write_step([ght_edge(GHTCurve([(0, 0), (1, 1), (2, 0)])), bad], target, check=False)
+    assert not target.exists()

@@ -171,8 +171,8 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
             coordinates as they are (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``).
 
     Raises:
-        GHTError: an invalid shape (when ``check``), an unknown unit or a failed write; the
-            target is untouched.
+        GHTError: something that is not a shape, a null shape, an invalid shape (when ``check``),
+            an unknown unit or a failed write; the target is untouched.
     """
     if units not in STEP_UNITS:
         raise GHTError(f"units={units!r} is not a STEP length unit; allowed: {', '.join(STEP_UNITS)}")
@@ -181,6 +181,14 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
     if not items:
         raise GHTError("nothing to export: the list of shapes is empty")
     raw = [unwrap(s) for s in items]
+    for i, s in enumerate(raw):
+        if not isinstance(s, TopoDS_Shape):
+            raise GHTError(
+                f"shape #{i} is a {type(items[i]).__name__}, not a shape; write_step takes build123d, "
+                f"cadquery or OCP shapes; not exported to {path}"
+            )
+        if s.IsNull():
+            raise GHTError(f"shape #{i} is a null (empty) shape; not exported to {path}")
     if check:
         for i, s in enumerate(raw):
             if not BRepCheck_Analyzer(s).IsValid():
