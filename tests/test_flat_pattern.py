@@ -248,3 +248,26 @@ def test_svg_strokes_have_a_physical_width_at_true_scale(units: str, mm_per_unit
         assert float(groups[layer].get("stroke-width")) * mm_per_user == pytest.approx(0.25, rel=1e-3), layer
     dash = [float(x) * mm_per_user for x in groups["BEND"].get("stroke-dasharray").split(",")]
     assert 1.0 * (1 - 1e-5) <= dash[0] <= 10.0 * (1 + 1e-5) and dash[1] == pytest.approx(dash[0] / 2, rel=1e-5), dash
+
+
+def test_edge_marks_of_a_narrow_panel_stay_inside_it() -> None:
+    """A 1-unit-wide strip joined to a 15.7-unit-wide one: the edge-mark label of each panel lies
+    inside that panel and its ticks and text are scaled to it (the marks were sized for the widest
+    panel: the narrow strip's "E1" sat 0.94 units inward, outside its 1-unit width)."""
+    from ght_cad.flat_pattern import _inside
+
+    s1 = CurvePairRuledSurface(quarter(10.0, 0.0), quarter(10.0, 10.0))  # ends at the ruling (0, 10, z)
+    b = GHTCurve([(0, 10, 0), (-0.5, 10, 0), (-1.0, 9.95, 0)])
+    t = GHTCurve([(0, 10, 10), (-0.5, 10, 10), (-1.0, 9.95, 10)])
+    pat = unroll_composite([s1, CurvePairRuledSurface(b, t)], rulings=3)
+    for panel in pat.panels:
+        loops = panel.loop_polylines()
+        lo, hi = panel.bbox()
+        small = float(np.min(hi - lo))
+        marks = [(x, y, h) for x, y, s, h in panel.texts if s == "E1"]
+        assert len(marks) == 1, panel.texts
+        x, y, h = marks[0]
+        assert _inside(np.array([[x, y]]), loops)[0], (panel.label, x, y, lo, hi)
+        assert h <= 0.25 * small, (panel.label, h, small)
+        for m in panel.marks:
+            assert np.linalg.norm(m[1] - m[0]) <= 0.25 * small + 1e-12
