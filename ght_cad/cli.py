@@ -230,7 +230,11 @@ def cmd_curve(args: argparse.Namespace) -> int:
     _check_suffix("--curvature-plot", args.curvature_plot, _PNG)
     curve = GHTCurve(_parse_points(args.points), args.mu, args.nu, args.gamma)
     t = np.linspace(0.0, 1.0, 513)
-    kappa = curve.curvature(t)
+    pts = curve.control_points
+    point = float(np.max(np.ptp(pts, axis=0))) <= 1e-12 * float(np.max(np.abs(pts)))  # all points coincide
+    with np.errstate(all="ignore"):
+        kappa = np.asarray(curve.curvature(t), dtype=float)
+    finite = np.zeros(0) if point else kappa[np.isfinite(kappa)]
     result: dict[str, Any] = {
         "command": "curve",
         "degree": curve.degree,
@@ -239,13 +243,16 @@ def cmd_curve(args: argparse.Namespace) -> int:
         "nu": curve.nu,
         "gamma": curve.gamma,
         "arc_length": curve.arc_length(),
-        "curvature_max": float(np.nanmax(kappa)),
+        "curvature_max": float(finite.max()) if finite.size else None,  # None: a point, no curvature
         "start_tangent": curve.derivative(0.0, 1).tolist(),
         "end_tangent": curve.derivative(1.0, 1).tolist(),
         "outputs": {},
     }
     if args.step and curve.dim not in (2, 3):
         raise UsageError(f"--step needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
+    if args.step and point:
+        raise UsageError(f"--step: the control points all coincide ({_fmt_point(pts[0].tolist())}): the curve is a "
+                         "point, not an edge; allowed: control points that are not all equal")
 
     def write_step_edge(path: Path) -> None:
         from .bspline import curve_to_bspline
@@ -271,7 +278,8 @@ def cmd_curve(args: argparse.Namespace) -> int:
     def text(r: dict[str, Any]) -> str:
         s = (
             f"GHT-Bézier curve: degree {r['degree']}, dim {r['dim']}, mu={r['mu']:g}, nu={r['nu']:g}, "
-            f"gamma={r['gamma']:g}\n  arc length {r['arc_length']:.10g}, max curvature {r['curvature_max']:.6g}"
+            f"gamma={r['gamma']:g}\n  arc length {r['arc_length']:.10g}, max curvature "
+            + ("n/a (a point)" if r["curvature_max"] is None else f"{r['curvature_max']:.6g}")
         )
         out = _outputs_text(r)
         return s + ("\n" + out if out else "")

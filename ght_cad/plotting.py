@@ -250,8 +250,10 @@ def plot_curvature(curve: Any, path: str | os.PathLike, samples: int = 400) -> P
     kmax = 0.0
     ax2 = None
     for k, c in enumerate(curves):
-        kappa = np.asarray(c.curvature(t), dtype=float)
-        kmax = max(kmax, float(np.nanmax(kappa)))
+        with np.errstate(all="ignore"):
+            kappa = np.asarray(c.curvature(t), dtype=float)
+        if np.isfinite(kappa).any():  # all NaN: the control points coincide (a point)
+            kmax = max(kmax, float(np.nanmax(kappa)))
         ax.plot(t + k, kappa, lw=1.8, color="C0", label="curvature κ" if k == 0 else None)
         if getattr(c, "dim", 0) == 3:
             tau = np.asarray(c.torsion(t), dtype=float)

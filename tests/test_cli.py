@@ -453,3 +453,16 @@ def test_run_into_a_folder_where_an_output_name_is_a_folder_changes_nothing(cone
     assert sorted(p.name for p in out.iterdir()) == ["model.step", "report.md"]
     assert (out / "model.step").read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cone.toml", "out"]  # no staging folder left
+
+
+def test_curve_whose_control_points_coincide(tmp_path: Path, capsys) -> None:
+    """All control points equal: the properties are reported (arc length 0, curvature null) without
+    numpy warnings on stderr, and ``--step`` is refused with exit 2 (a zero-length STEP edge was
+    written)."""
+    rc, res, err = run_json(["curve", "--points", "2,3 2,3 2,3", "--plot", str(tmp_path / "c.png"),
+                             "--curvature-plot", str(tmp_path / "k.png")], capsys)
+    assert rc == EXIT_OK and abs(res["arc_length"]) < 1e-12 and res["curvature_max"] is None
+    assert "Warning" not in err, err
+    rc, res, err = run_json(["curve", "--points", "2,3 2,3 2,3", "--step", str(tmp_path / "c.step")], capsys)
+    assert rc == EXIT_USAGE and "coincide" in res["error"] and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "c.step").exists()
