@@ -700,7 +700,7 @@ def build_parser() -> argparse.ArgumentParser:
         "with the classical Bernstein basis dashed for comparison. 1200x800 px.",
         epilog=_EPILOG,
     )
-    sp.add_argument("--degree", type=int, default=3, help="degree m >= 2 (default 3)")
+    sp.add_argument("--degree", type=int, default=3, help="degree m, 2..200 (default 3)")
     sp.add_argument(
         "--params", action="append", metavar="MU,NU,GAMMA",
         help="shape parameters of one panel, each in [-1, 1] (repeatable; default four panels)",

@@ -1893,7 +1893,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             for p in params:
                 if p not in uniq:
                     uniq.append(p)
-            P.plot_basis(stage.path(FIGURE_NAMES["basis"]), max(deg, 2), uniq)
+            # the basis figure stops at MAX_PLOT_DEGREE (a plot of more functions is unreadable)
+            P.plot_basis(stage.path(FIGURE_NAMES["basis"]), min(max(deg, 2), P.MAX_PLOT_DEGREE), uniq)
         if "curve" in want_figs and curves:
             P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
         if "curvature" in want_figs and curves:

@@ -33,6 +33,7 @@ from .io import atomic_path
 __all__ = [
     "SIZES",
     "DPI",
+    "MAX_PLOT_DEGREE",
     "plot_basis",
     "plot_curve",
     "plot_curvature",
@@ -40,6 +41,10 @@ __all__ = [
     "plot_flat_pattern",
     "plot_convergence",
 ]
+
+#: Largest degree :func:`plot_basis` draws (m + 1 lines per panel; beyond this the plot is unreadable
+#: and matplotlib takes minutes).
+MAX_PLOT_DEGREE = 200
 
 #: Dots per inch used for every figure (pixel size = inches x DPI, exactly).
 DPI = 100
@@ -109,7 +114,7 @@ def plot_basis(
 
     Args:
         path: PNG file to write (1200 x 800 pixels).
-        degree: basis degree m >= 2.
+        degree: basis degree m, 2 <= m <= :data:`MAX_PLOT_DEGREE`.
         params: 1..12 shape-parameter triples ``(mu, nu, gamma)``, each in [-1, 1].
         derivative: derivative order r in 0..3.
         samples: number of parameter values along [0, 1].
@@ -118,11 +123,14 @@ def plot_basis(
         The written path.
 
     Raises:
-        GHTError: degree < 2, a parameter outside [-1, 1], bad derivative order or bad params.
+        GHTError: degree < 2 or > MAX_PLOT_DEGREE, a parameter outside [-1, 1], bad derivative order or bad params.
     """
     from .basis import basis
 
     m = check_degree(degree)
+    if m > MAX_PLOT_DEGREE:
+        raise GHTError(f"degree={degree} is too large to plot (one line per basis function); "
+                       f"allowed for the plot: 2..{MAX_PLOT_DEGREE}")
     triples = _check_params(params)
     t = np.linspace(0.0, 1.0, int(samples))
     ref = basis(t, m, 0.0, 0.0, 1.0, derivative)

@@ -119,3 +119,15 @@ def test_joined_curves_in_one_figure(tmp_path: Path) -> None:
     with pytest.raises(GHTError, match="no curve"):
         plot_curve([], tmp_path / "x.png")
     assert not (tmp_path / "x.png").exists()
+
+
+def test_plot_basis_refuses_a_degree_too_large_to_draw(tmp_path) -> None:
+    """degree 100000 drew 800,000 matplotlib lines (the command ran for minutes); above
+    MAX_PLOT_DEGREE the plot is refused naming the value and the allowed range, nothing written."""
+    from ght_cad.errors import GHTError
+    from ght_cad.plotting import MAX_PLOT_DEGREE, plot_basis
+
+    assert MAX_PLOT_DEGREE >= 20
+    with pytest.raises(GHTError, match=rf"degree=100000 .*2\.\.{MAX_PLOT_DEGREE}"):
+        plot_basis(tmp_path / "b.png", 100000)
+    assert not list(tmp_path.iterdir())
