@@ -459,25 +459,10 @@ def _write_pattern(args: argparse.Namespace, pattern: Any, title: str) -> dict[s
     The files are staged beside their targets and moved into place only when every one was
     written, so a failure leaves neither a partial file nor a partial set.
     """
-    from .design import _FileStage, plot_pattern
+    from .design import plot_pattern
 
-    wanted = [(kind, Path(p)) for kind, p in (("dxf", args.dxf), ("svg", args.svg), ("png", args.png)) if p]
-    if not wanted:
-        return {}
-    stage = _FileStage([t for _, t in wanted])
-    try:
-        for kind, target in wanted:
-            tmp = stage.path(target)
-            if kind == "dxf":
-                pattern.export_dxf(tmp)
-            elif kind == "svg":
-                pattern.export_svg(tmp)
-            else:
-                plot_pattern(pattern, tmp, title=title)
-        stage.commit()
-    finally:
-        stage.cleanup()
-    return {kind: str(target) for kind, target in wanted}
+    return _write_staged([("dxf", args.dxf, pattern.export_dxf), ("svg", args.svg, pattern.export_svg),
+                          ("png", args.png, lambda path: plot_pattern(pattern, path, title=title))])
 
 
 def _unroll_step(args: argparse.Namespace) -> int:
