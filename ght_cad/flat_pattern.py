@@ -89,6 +89,24 @@ def romberg_length(points: np.ndarray) -> float:
     return (16 * r2 - r1) / 15
 
 
+def _dxf_ascii(text: str) -> str:
+    """Text for an ASCII DXF R12 file: every non-ASCII character as the DXF escape ``\\U+XXXX``
+    (outside the BMP: ``?``; control characters, which would break the group-code/value lines, as
+    spaces)."""
+    out = []
+    for ch in text:
+        code = ord(ch)
+        if code < 32:
+            out.append(" ")
+        elif code < 128:
+            out.append(ch)
+        elif code <= 0xFFFF:
+            out.append(f"\\U+{code:04X}")
+        else:  # outside the BMP (emoji ...): \U+ has four hex digits
+            out.append("?")
+    return "".join(out)
+
+
 def _shoelace(loop: np.ndarray) -> float:
     x, y = loop[:, 0], loop[:, 1]
     return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
@@ -683,7 +701,7 @@ class FlatPattern:
                 put(11, float(q[0])), put(21, float(q[1])), put(31, 0.0)
         for x, y, text, h in self.labels:
             put(0, "TEXT"), put(8, "LABELS"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
-            put(40, float(h)), put(1, text), put(72, 1), put(73, 2)
+            put(40, float(h)), put(1, _dxf_ascii(text)), put(72, 1), put(73, 2)
             put(11, float(x)), put(21, float(y)), put(31, 0.0)
         put(0, "ENDSEC"), put(0, "EOF")
         return "\n".join(out) + "\n"

@@ -271,3 +271,17 @@ def test_edge_marks_of_a_narrow_panel_stay_inside_it() -> None:
         assert h <= 0.25 * small, (panel.label, h, small)
         for m in panel.marks:
             assert np.linalg.norm(m[1] - m[0]) <= 0.25 * small + 1e-12
+
+
+def test_dxf_r12_labels_keep_non_ascii_text(tmp_path) -> None:
+    """R12 (no ezdxf) with a label "Düse ø20": the file is pure ASCII with DXF \\U+XXXX escapes and
+    reads back as the same text (it was written as UTF-8 and read as cp1252: "DÃ¼se Ã¸20")."""
+    pat = unroll(CurvePairRuledSurface(quarter(1.0, 0.0), quarter(2.0, 1.5)), rulings=2, units="mm")
+    x, y, _, h = pat.panels[0].texts[0]
+    pat.panels[0].texts[0] = (x, y, "Düse ø20", h)
+    text = pat.dxf_r12_text()
+    text.encode("ascii")  # raises if not pure ASCII
+    path = tmp_path / "u.dxf"
+    path.write_text(text, encoding="ascii")
+    doc = ezdxf.readfile(path)
+    assert "Düse ø20" in [ezdxf.decode_dxf_unicode(t.dxf.text) for t in doc.modelspace().query("TEXT")]
