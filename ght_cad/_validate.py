@@ -19,6 +19,13 @@ __all__ = [
 ]
 
 
+def _exact(v: float) -> str:
+    """Shortest text that reads back as ``v`` (``repr``), without a trailing ``.0``: 3 -> '3',
+    -1.0000001 -> '-1.0000001' (``:g`` would print '-1', hiding why it is outside [-1, 1])."""
+    r = repr(float(v))
+    return r[:-2] if r.endswith(".0") else r
+
+
 def check_shape_parameter(name: str, value: Any) -> float:
     """Return ``value`` as float after checking it is finite and in [-1, 1].
 
@@ -35,7 +42,7 @@ def check_shape_parameter(name: str, value: Any) -> float:
         raise ShapeParameterError(f"{name}={v} is not finite; allowed range is [-1, 1]")
     if v < -1.0 or v > 1.0:
         raise ShapeParameterError(
-            f"{name}={v:g} is outside the allowed range [-1, 1] "
+            f"{name}={_exact(v)} is outside the allowed range [-1, 1] "
             "(outside it the GHT basis loses non-negativity)"
         )
     return v
@@ -105,7 +112,10 @@ def check_points(
 
 def as_parameter_array(t: Any, name: str = "t") -> tuple[np.ndarray, bool]:
     """Return (1-D float array, was_scalar) for a curve parameter argument; rejects NaN/inf."""
-    arr = np.asarray(t, dtype=float)
+    try:
+        arr = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise GHTError(f"{name}={t!r} is not allowed; use real numbers in [0, 1] (a scalar or a 1-D array)") from None
     scalar = arr.ndim == 0
     arr = np.atleast_1d(arr)
     if arr.ndim != 1:
@@ -119,7 +129,7 @@ def check_unit_interval(name: str, arr: np.ndarray, slack: float = 1e-12) -> Non
     """Raise if any entry of ``arr`` is outside [0, 1] (parameter domain)."""
     if arr.size and (arr.min() < -slack or arr.max() > 1.0 + slack):
         bad = arr[(arr < -slack) | (arr > 1 + slack)][0]
-        raise GHTError(f"{name}={bad:g} is outside the parameter domain [0, 1]")
+        raise GHTError(f"{name}={_exact(float(bad))} is outside the parameter domain [0, 1]")
 
 
 def nonzero_norm(name: str, vec: np.ndarray, tol: float = 1e-14) -> float:

@@ -73,3 +73,20 @@ def test_basis_outside_the_parameter_domain() -> None:
         basis(np.array([0.0, 1.5]), 3)
     with pytest.raises(GHTError, match=r"t=-0\.25 is outside the parameter domain"):
         basis(-0.25, 4, 0.2, 0.1, 0.0)
+
+
+def test_messages_show_the_exact_bad_value_and_complex_parameters_are_named() -> None:
+    """gamma=-1.0000001 printed as 'gamma=-1 is outside [-1, 1]' (':g' rounding); complex t gave a raw
+    TypeError."""
+    import pytest as _pytest
+
+    from ght_cad import GHTCurve
+    from ght_cad.errors import GHTError
+
+    with _pytest.raises(GHTError, match=r"gamma=-1\.0000001 is outside the allowed range \[-1, 1\]"):
+        GHTCurve([[0, 0], [1, 1], [2, 0]], gamma=-1.0000001)
+    c = GHTCurve([[0, 0], [1, 1], [2, 0]])
+    with _pytest.raises(GHTError, match=r"t=1\.0000001 is outside the parameter domain \[0, 1\]"):
+        c.evaluate(1.0000001)
+    with _pytest.raises(GHTError, match=r"t=\(0\.5\+1j\) is not allowed; use real numbers in \[0, 1\]"):
+        c.evaluate(0.5 + 1j)
