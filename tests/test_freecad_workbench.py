@@ -61,8 +61,11 @@ def test_features_inside_freecadcmd(tmp_path: Path) -> None:
     assert not auditor.has_errors, [str(e) for e in auditor.errors]
     msp = dxf.modelspace()
     assert len(msp.query('LINE[layer=="BEND"]')) == 6
-    assert len(msp.query('*[layer=="OUTLINE"]')) >= 4
-    assert {"OUTLINE", "BEND"} <= {layer.dxf.name for layer in dxf.layers}
+    # the core's file: the rectangle as one closed polyline, bend lines dashed, a label
+    outline = msp.query('POLYLINE[layer=="OUTLINE"]')
+    assert len(msp.query('*[layer=="OUTLINE"]')) == len(outline) == 1 and outline[0].is_closed
+    assert {"OUTLINE", "BEND", "LABELS", "MARKS"} <= {layer.dxf.name for layer in dxf.layers}
+    assert dxf.layers.get("BEND").dxf.linetype == "DASHED" and len(msp.query('TEXT[layer=="LABELS"]')) == 1
     from ght_cad.cad.occ import is_valid, read_step
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps

@@ -1,9 +1,10 @@
 """Export commands: STEP of selected features (named products via FreeCAD's XCAF exporter), DXF/SVG of flat patterns (atomic writes).
 
-FreeCAD's Python has no ezdxf, so DXF is written by :func:`write_dxf_r12`, a minimal AutoCAD R12
-ASCII writer (LINE and POLYLINE entities on layers OUTLINE and BEND), which every CAM/laser
-program reads. SVG is plain ``<path>`` markup in millimetres. Curved edges are discretized with
-chordal deviation ``deflection``.
+DXF is the core's file (``FlatPattern.export_dxf``, the same as ``ght-cad unroll --dxf``): in
+FreeCAD's Python, which has no ezdxf, an AutoCAD R12 ASCII file with closed outline polylines,
+DASHED bend lines, labels and edge marks, which every CAM/laser program reads. SVG is plain
+``<path>`` markup in millimetres; its curved edges are discretized with chordal deviation
+``deflection``.
 """
 
 from __future__ import annotations
@@ -24,7 +25,6 @@ __all__ = [
     "read_step",
     "stale_reason",
     "flat_pattern_polylines",
-    "write_dxf_r12",
     "write_svg",
     "export_flat_pattern_dxf",
     "export_flat_pattern_svg",
@@ -176,48 +176,6 @@ def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[lis
     return outline, bends
 
 
-def _dxf_pairs(pairs: list[tuple[int, Any]]) -> str:
-    out = []
-    for code, value in pairs:
-        if isinstance(value, float):
-            value = f"{value:.12g}"
-        out.append(f"{code:>3}\n{value}\n")
-    return "".join(out)
-
-
-def write_dxf_r12(
-    path: str | os.PathLike, layers: dict[str, list[list[tuple[float, float]]]], colors: dict[str, int] | None = None
-) -> str:
-    """Minimal AutoCAD R12 ASCII DXF: 2-point polylines become LINE, longer ones POLYLINE/VERTEX.
-
-    Args:
-        path: target file (written atomically).
-        layers: layer name -> list of polylines [(x, y), ...] in model units (mm).
-        colors: ACI colour per layer (default 7; BEND 1 = red).
-    """
-    colors = {"OUTLINE": 7, "BEND": 1, **(colors or {})}
-    pairs: list[tuple[int, Any]] = [(0, "SECTION"), (2, "HEADER"), (9, "$ACADVER"), (1, "AC1009"), (9, "$INSUNITS"), (70, 4), (0, "ENDSEC")]
-    pairs += [(0, "SECTION"), (2, "TABLES"), (0, "TABLE"), (2, "LAYER"), (70, len(layers))]
-    for name in layers:
-        pairs += [(0, "LAYER"), (2, name), (70, 0), (62, colors.get(name, 7)), (6, "CONTINUOUS")]
-    pairs += [(0, "ENDTAB"), (0, "ENDSEC"), (0, "SECTION"), (2, "ENTITIES")]
-    for name, polys in layers.items():
-        for pl in polys:
-            if len(pl) < 2:
-                continue
-            if len(pl) == 2:
-                (x0, y0), (x1, y1) = pl
-                pairs += [(0, "LINE"), (8, name), (10, x0), (20, y0), (30, 0.0), (11, x1), (21, y1), (31, 0.0)]
-            else:
-                pairs += [(0, "POLYLINE"), (8, name), (66, 1), (10, 0.0), (20, 0.0), (30, 0.0), (70, 0)]
-                for x, y in pl:
-                    pairs += [(0, "VERTEX"), (8, name), (10, x), (20, y), (30, 0.0)]
-                pairs += [(0, "SEQEND"), (8, name)]
-    pairs += [(0, "ENDSEC"), (0, "EOF")]
-    write_text_atomic(path, _dxf_pairs(pairs))
-    return str(path)
-
-
 def write_svg(path: str | os.PathLike, layers: dict[str, list[list[tuple[float, float]]]], margin: float = 5.0) -> str:
     """SVG in millimetres (y up in the model, flipped for SVG); one ``<g id=layer>`` per layer."""
     pts = [p for polys in layers.values() for pl in polys for p in pl]
@@ -246,9 +204,24 @@ def write_svg(path: str | os.PathLike, layers: dict[str, list[list[tuple[float, 
 
 
 def export_flat_pattern_dxf(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
-    """DXF (R12) of a flat pattern feature: layer OUTLINE (cut) and BEND (bend lines)."""
-    outline, bends = flat_pattern_polylines(obj, deflection)
-    return write_dxf_r12(path, {"OUTLINE": outline, "BEND": bends})
+    """DXF of a flat pattern feature, written by the core (:meth:`ght_cad.flat_pattern.FlatPattern.export_dxf`).
+
+    The same file as ``ght-cad unroll --dxf``: layers OUTLINE (every loop one closed polyline),
+    BEND (bend lines, linetype DASHED), LABELS and MARKS, ``$INSUNITS`` millimetres; R12 ASCII in
+    FreeCAD's Python (no ezdxf). The outline is the feature's flat face up to a translation (the
+    core pattern's own frame). ``deflection`` is kept for compatibility and not used (the core
+    samples the exact flat boundary).
+
+    Raises:
+        GHTError: the feature is stale (see :func:`stale_reason`) or has never been computed.
+    """
+    why = stale_reason(obj)
+    if why:
+        raise GHTError(f"{obj.Label}: {why}; allowed: a flat pattern that recomputes without error")
+    if not obj.Shape.Faces:
+        raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")
+    obj.Proxy.pattern(obj).export_dxf(path)
+    return str(path)
 
 
 def export_flat_pattern_svg(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
@@ -325,7 +298,7 @@ class CommandExportDXF(_CommandExportFlat):
     name = "GHT_ExportDXF"
     icon_name = "GHT_ExportDXF"
     menu_text = "Export flat pattern DXF"
-    tooltip = "Export the selected flat patterns to DXF (R12: layer OUTLINE = cut contour, BEND = bend lines)"
+    tooltip = "Export the selected flat patterns to DXF (R12: layer OUTLINE = closed cut contour, BEND = dashed bend lines, LABELS, MARKS)"
     ext = ".dxf"
 
 

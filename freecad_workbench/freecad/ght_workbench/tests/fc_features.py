@@ -379,8 +379,29 @@ class FlatPatternTest(unittest.TestCase):
         pairs = list(zip(codes[0::2], codes[1::2]))
         ents = [(pairs[i][1], pairs[i + 1][1]) for i in range(len(pairs) - 1) if pairs[i][0].strip() == "0" and pairs[i + 1][0].strip() == "8"]
         self.assertEqual(sum(1 for kind, layer in ents if kind == "LINE" and layer == "BEND"), 6)
-        self.assertGreaterEqual(sum(1 for kind, layer in ents if layer == "OUTLINE" and kind in ("LINE", "POLYLINE")), 4)
+        # the core's file (as `ght-cad unroll --dxf`): one closed outline polyline, DASHED bend layer, label
+        self.assertEqual(sum(1 for kind, layer in ents if layer == "OUTLINE" and kind == "POLYLINE"), 1)
+        self.assertEqual(sum(1 for kind, layer in ents if layer == "OUTLINE" and kind == "LINE"), 0)
+        pairs = [(c.strip(), v.strip()) for c, v in pairs]
+        layer_rows = [i for i in range(len(pairs) - 1) if pairs[i] == ("0", "LAYER") and pairs[i + 1][1] == "BEND"]
+        self.assertTrue(layer_rows and ("6", "DASHED") in pairs[layer_rows[0]:layer_rows[0] + 6], layer_rows)
+        self.assertIn(("0", "TEXT"), pairs)
         self.assertEqual(pairs[-1][1].strip(), "EOF")
+        # every outline vertex of the DXF lies on the feature's flat face boundary (same coordinates)
+        i0 = next(i for i in range(len(pairs) - 1) if pairs[i] == ("0", "POLYLINE"))
+        verts = []
+        for i in range(i0, len(pairs) - 4):
+            if pairs[i] == ("0", "SEQEND"):
+                break
+            if pairs[i] == ("0", "VERTEX"):
+                j = next(k for k in range(i, i + 6) if pairs[k][0] == "10")
+                verts.append(App.Vector(float(pairs[j][1]), float(pairs[j + 1][1]), 0.0))
+        self.assertGreater(len(verts), 20)
+        # up to a translation (the DXF keeps the core pattern's own frame)
+        bb = fp.Shape.Faces[0].BoundBox
+        shift = App.Vector(bb.XMin - min(v.x for v in verts), bb.YMin - min(v.y for v in verts), 0.0)
+        boundary = Part.Compound(fp.Shape.Faces[0].Edges)
+        self.assertLess(max(boundary.distToShape(Part.Vertex(v + shift))[0] for v in verts), 1e-6)
         import xml.etree.ElementTree as ET
 
         root = ET.parse(svg).getroot()
