@@ -138,3 +138,24 @@ def nonzero_norm(name: str, vec: np.ndarray, tol: float = 1e-14) -> float:
     if not n > tol:
         raise DegenerateGeometryError(f"{name} has zero length ({n:g}); it must be non-degenerate")
     return n
+
+
+def affine_parts(matrix: Any, offset: Any, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """Linear part ``A`` (dim, dim) and translation ``b`` (dim,) of ``x -> A x + b``.
+
+    Args:
+        matrix: (dim, dim) linear part, or a (dim+1, dim+1) homogeneous matrix.
+        offset: translation b (dim,), only with a (dim, dim) matrix (None: zero).
+
+    Raises:
+        GHTError: another matrix shape, or an offset given with a homogeneous matrix.
+    """
+    A = np.asarray(matrix, dtype=float)
+    d = dim
+    if A.shape == (d + 1, d + 1):
+        if offset is not None:
+            raise GHTError("offset must be omitted with a homogeneous matrix")
+        return A[:d, :d], A[:d, d]
+    if A.shape == (d, d):
+        return A, (np.zeros(d) if offset is None else np.asarray(offset, dtype=float).reshape(d))
+    raise GHTError(f"matrix has shape {A.shape}; expected ({d}, {d}) or ({d+1}, {d+1})")

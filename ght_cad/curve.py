@@ -13,7 +13,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_points, check_unit_interval
+from ._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
 from .basis import _check_order, bernstein, seed_basis
 from .errors import GHTError
 from .seeds import Seed, make_seed
@@ -362,16 +362,7 @@ class GHTCurve:
             matrix: (dim, dim) linear part, or a (dim+1, dim+1) homogeneous matrix.
             offset: translation b (dim,), only with a (dim, dim) matrix.
         """
-        A = np.asarray(matrix, dtype=float)
-        d = self.dim
-        if A.shape == (d + 1, d + 1):
-            if offset is not None:
-                raise GHTError("offset must be omitted with a homogeneous matrix")
-            A, b = A[:d, :d], A[:d, d]
-        elif A.shape == (d, d):
-            b = np.zeros(d) if offset is None else np.asarray(offset, dtype=float).reshape(d)
-        else:
-            raise GHTError(f"matrix has shape {A.shape}; expected ({d}, {d}) or ({d+1}, {d+1})")
+        A, b = affine_parts(matrix, offset, self.dim)
         return self.with_control_points(self._points @ A.T + b)
 
     def translated(self, offset: Iterable[float]) -> "GHTCurve":

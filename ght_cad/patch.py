@@ -21,7 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_unit_interval
+from ._validate import affine_parts, as_parameter_array, check_unit_interval
 from .basis import _check_order, seed_basis
 from .bspline import BSplineSurfaceData, fit_function
 from .curve import GHTCurve
@@ -180,16 +180,7 @@ class GHTSurface:
             matrix: (dim, dim) linear part, or a (dim+1, dim+1) homogeneous matrix.
             offset: translation b (dim,), only with a (dim, dim) matrix.
         """
-        d = self.dim
-        A = np.asarray(matrix, dtype=float)
-        if A.shape == (d + 1, d + 1):
-            if offset is not None:
-                raise GHTError("offset must be omitted with a homogeneous matrix")
-            A, b = A[:d, :d], A[:d, d]
-        elif A.shape == (d, d):
-            b = np.zeros(d) if offset is None else np.asarray(offset, dtype=float).reshape(d)
-        else:
-            raise GHTError(f"matrix has shape {A.shape}; expected ({d}, {d}) or ({d+1}, {d+1})")
+        A, b = affine_parts(matrix, offset, self.dim)
         return self.with_control_points(self._P @ A.T + b)
 
     def translated(self, offset: Any) -> "GHTSurface":
