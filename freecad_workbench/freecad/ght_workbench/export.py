@@ -154,6 +154,16 @@ def _edge_points(edge: "Part.Edge", deflection: float) -> list[tuple[float, floa
     return [(float(p.x), float(p.y)) for p in pts]
 
 
+def _current_flat_shape(obj: Any) -> "Part.Shape":
+    """The flat pattern feature's shape, refused if stale (:func:`stale_reason`) or never computed."""
+    why = stale_reason(obj)
+    if why:
+        raise GHTError(f"{obj.Label}: {why}; allowed: a flat pattern that recomputes without error")
+    if not obj.Shape.Faces:
+        raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")
+    return obj.Shape
+
+
 def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[list[tuple[float, float]]], list[list[tuple[float, float]]]]:
     """(outline polylines, bend-line polylines) of a flat pattern feature in its XY plane.
 
@@ -164,12 +174,7 @@ def flat_pattern_polylines(obj: Any, deflection: float = 1e-3) -> tuple[list[lis
         GHTError: the shape is stale (:func:`stale_reason`: its or an input's last recompute failed,
             or changes are pending) or it has no planar face (never computed).
     """
-    why = stale_reason(obj)
-    if why:
-        raise GHTError(f"{obj.Label}: {why}; allowed: a flat pattern that recomputes without error")
-    shape = obj.Shape
-    if not shape.Faces:
-        raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")
+    shape = _current_flat_shape(obj)
     outline = [_edge_points(e, deflection) for f in shape.Faces for w in f.Wires for e in w.OrderedEdges]
     face_edges = [e for f in shape.Faces for e in f.Edges]
     bends = [_edge_points(e, deflection) for e in shape.Edges if not any(e.isSame(fe) for fe in face_edges)]
@@ -215,11 +220,7 @@ def export_flat_pattern_dxf(obj: Any, path: str | os.PathLike, deflection: float
     Raises:
         GHTError: the feature is stale (see :func:`stale_reason`) or has never been computed.
     """
-    why = stale_reason(obj)
-    if why:
-        raise GHTError(f"{obj.Label}: {why}; allowed: a flat pattern that recomputes without error")
-    if not obj.Shape.Faces:
-        raise GHTError(f"{obj.Label}: the flat pattern has no planar face to export; recompute it first")
+    _current_flat_shape(obj)
     obj.Proxy.pattern(obj).export_dxf(path)
     return str(path)
 
