@@ -89,6 +89,19 @@ def restore_constraints(obj: Any) -> None:
             setattr(obj, pname, (float(getattr(obj, pname)), -1.0, 1.0, _STEP))
 
 
+def float_list(values: Any) -> list[float]:
+    """Flat list of floats for a ``App::PropertyFloatList`` (e.g. n planes -> 4n coordinates)."""
+    import numpy as np
+
+    return [float(x) for x in np.asarray(values, dtype=float).ravel()]
+
+
+def link_sub_list(links: Iterable[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
+    """``[(object, sub-element names)]`` for a ``LinkSubList``; an empty sub-list becomes ``""``
+    ("the whole object": FreeCAD drops a link whose sub-list is empty)."""
+    return [(o, list(subs) if subs else "") for o, subs in links]
+
+
 def set_read_only(obj: Any, names: Iterable[str]) -> None:
     """Editor mode 1 (read-only in the property editor) for output properties."""
     for n in names:

@@ -24,6 +24,8 @@ from ._base import (
     ViewProviderBase,
     add_shape_parameters,
     check_shape,
+    float_list,
+    link_sub_list,
     new_feature,
     register_command,
     set_read_only,
@@ -193,15 +195,15 @@ def make_developable(
         return len(v) > 0 and isinstance(v[0], tuple) and hasattr(v[0][0], "TypeId")
 
     if is_links(planes):
-        obj.Planes = [(o, list(s) if s else "") for o, s in planes]
+        obj.Planes = link_sub_list(planes)
         if weights is not None:
             obj.PlaneWeights = [float(w) for w in weights]
     else:
-        obj.PlaneCoordinates = [float(x) for x in np.asarray(planes, dtype=float).ravel()]
+        obj.PlaneCoordinates = float_list(planes)
     if is_links(boundary_planes):
-        obj.BoundaryPlanes = [(o, list(s) if s else "") for o, s in boundary_planes]
+        obj.BoundaryPlanes = link_sub_list(boundary_planes)
     else:
-        obj.BoundaryCoordinates = [float(x) for x in np.asarray(boundary_planes, dtype=float).ravel()]
+        obj.BoundaryCoordinates = float_list(boundary_planes)
     obj.Mu, obj.Nu, obj.Gamma = float(mu), float(nu), float(gamma)
     obj.Document.recompute()
     return obj

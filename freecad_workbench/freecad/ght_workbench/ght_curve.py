@@ -22,6 +22,7 @@ from ._base import (
     ViewProviderBase,
     add_shape_parameters,
     check_shape,
+    link_sub_list,
     new_feature,
     register_command,
     set_read_only,
@@ -164,8 +165,7 @@ def make_ght_curve(
         pts = np.asarray(control_points, dtype=float)
         obj.ControlPoints = [App.Vector(*(list(p) + [0.0] * (3 - len(p)))[:3]) for p in pts]
     if source is not None:
-        # an empty sub-list would drop the link: FreeCAD wants "" for "the whole object"
-        obj.Source = [(o, list(subs) if subs else "") for o, subs in source]
+        obj.Source = link_sub_list(source)
     obj.Mu, obj.Nu, obj.Gamma = float(mu), float(nu), float(gamma)
     obj.Document.recompute()
     return obj

@@ -37,6 +37,7 @@ from ._base import (
     ViewProviderBase,
     add_shape_parameters,
     check_shape,
+    float_list,
     new_feature,
     set_read_only,
     tolerance_property,
@@ -239,9 +240,9 @@ def make_joined_developable(
     obj.Continuity = str(continuity).upper().strip()
     obj.K, obj.Beta2, obj.Beta3 = float(k), float(beta2), float(beta3)
     free = DEFAULT_FREE_PLANES if free_planes is None else free_planes
-    obj.PlaneCoordinates = [float(x) for x in np.asarray(free, dtype=float).ravel()]
+    obj.PlaneCoordinates = float_list(free)
     if boundary_planes is not None:
-        obj.BoundaryCoordinates = [float(x) for x in np.asarray(boundary_planes, dtype=float).ravel()]
+        obj.BoundaryCoordinates = float_list(boundary_planes)
     obj.Fuse = bool(fuse)
     obj.Mu, obj.Nu, obj.Gamma = float(mu), float(nu), float(gamma)
     obj.Document.recompute()
