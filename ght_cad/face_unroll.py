@@ -129,6 +129,8 @@ class FaceData:
     surface: SurfaceAdapter
     bounds: Bounds
     wires: list[list[EdgeData]]
+    #: the face's orientation is reversed: its normal is ``-(S_u × S_v)`` (sheet side, ght_cad.sheet)
+    reversed: bool = False
 
 
 class FaceRuledSurface(RuledSurface):
@@ -583,6 +585,7 @@ def unroll_face_data(
     samples: int = 257,
     units: str = "mm",
     label: str = "P1",
+    sheet: Any = None,
 ) -> FlatPattern:
     """Unroll one face given by an adapter (see module doc for the maps used).
 
@@ -598,6 +601,10 @@ def unroll_face_data(
         samples: points per boundary edge in the outline polylines.
         units: length unit of the model.
         label: panel label.
+        sheet: a :class:`ght_cad.sheet.Sheet` with ``T > 0``: the face's neutral offset
+            ``S + σ K T n`` (n the face normal, orientation included) is unrolled instead
+            (:class:`ght_cad.sheet.FaceSheet`: cylinders/cones keep their closed forms with the
+            offset radius); ``panel.info["sheet"]`` holds edge lengths and forming data.
 
     Returns:
         FlatPattern with one panel: all wires of the face mapped to the plane, the outer one
@@ -623,6 +630,12 @@ def unroll_face_data(
     if not any(face.wires):
         raise DegenerateGeometryError(f"face {label!r} has no boundary wires; allowed: a face trimmed by boundary wires")
     info: dict[str, Any] = {"best_effort": bool(best_effort)}
+    fsheet = None
+    if sheet is not None and not sheet.is_zero:  # the neutral surface replaces the face's own
+        from .sheet import FaceSheet
+
+        fsheet = FaceSheet(face, sheet, label)
+        ev = fsheet.neutral
     ruled_dir: str | None
     if kind == "plane":
         dmap: Any = ClosedFormMap("plane")
@@ -637,7 +650,7 @@ def unroll_face_data(
         ruled_dir = "v"
         info["method"] = "cone (closed form)"
     else:
-        ruled_dir, straight = ruling_direction(ev, bounds)
+        ruled_dir, straight = ruling_direction(face.surface, bounds)
         info.update(straight)
         if ruled_dir is None:
             if not best_effort:
@@ -680,7 +693,11 @@ def unroll_face_data(
                 return dmap.map(u, v)
 
             name = e.name or f"edge{k}"
-            loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=e.xyz, length_3d=float(e.length_3d), samples=samples))
+            if fsheet is None:
+                loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=e.xyz, length_3d=float(e.length_3d), samples=samples))
+            else:  # the edge on the neutral surface, its length measured (Romberg)
+                loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=fsheet.edge_xyz(e.uv),
+                                         length_3d=0.0 if e.length_3d == 0 else None, samples=samples))
         if loop:
             loops.append(loop)
             loops_uv.append(loop_uv)
@@ -726,6 +743,9 @@ def unroll_face_data(
         development=dmap,
     )
     measure_panel(panel)
+    if fsheet is not None:
+        wires = [w for w in face.wires if w]  # the loops' order: outer (k_out) first
+        fsheet.finish(panel, dmap, rulings, [wires[k_out]] + wires[:k_out] + wires[k_out + 1:])
     # place: bounding box at the origin
     lo, _ = panel.bbox()
     panel.translate(-lo)

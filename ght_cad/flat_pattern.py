@@ -245,6 +245,8 @@ class FlatPanel:
     offset: np.ndarray = field(default_factory=lambda: np.zeros(2))
     marks: list[np.ndarray] = field(default_factory=list)
     texts: list[tuple[float, float, str, float]] = field(default_factory=list)
+    #: sheet forming labels (x, y, text, height, rotation in degrees): layer FORMING (ght_cad.sheet)
+    forming_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     report: DistortionReport | None = None
     area_flat: float = float("nan")
 
@@ -263,6 +265,7 @@ class FlatPanel:
             self.bend_lines = self.bend_lines + delta
         self.marks = [m + delta for m in self.marks]
         self.texts = [(float(x + delta[0]), float(y + delta[1]), s, h) for x, y, s, h in self.texts]
+        self.forming_texts = [(float(x + delta[0]), float(y + delta[1]), s, h, a) for x, y, s, h, a in self.forming_texts]
 
     def bbox(self) -> tuple[np.ndarray, np.ndarray]:
         pts = np.concatenate(self.loop_polylines(), axis=0)
@@ -595,6 +598,40 @@ class FlatPattern:
     def area(self) -> float:
         return float(sum(p.area_flat for p in self.panels))
 
+    @property
+    def forming_labels(self) -> list[tuple[float, float, str, float, float]]:
+        """(x, y, text, height, rotation deg) of the sheet forming labels (bend radius and angle)."""
+        return [t for p in self.panels for t in p.forming_texts]
+
+    @property
+    def sheet(self) -> dict[str, Any] | None:
+        """Sheet data of the first panel unrolled with a thickness (``panel.info["sheet"]``:
+        thickness, K, side, edge lengths inside/neutral/outside, forming rows), else None."""
+        for p in self.panels:
+            if p.info.get("sheet"):
+                return p.info["sheet"]
+        return None
+
+    def forming_table(self) -> str:
+        """Plain-text forming tables (one per panel unrolled with a thickness; :mod:`ght_cad.sheet`)."""
+        from .sheet import FormingRow, forming_table_text
+
+        out = []
+        for p in self.panels:
+            sh = p.info.get("sheet")
+            if sh:
+                rows = [FormingRow(**r) for r in sh["forming"]]
+                out.append(f"{p.label}: T={sh['thickness']:g} K={sh['k_factor']:g} side={sh['side']}\n"
+                           + forming_table_text(rows, self.units))
+        return "\n\n".join(out)
+
+    def plot_roll_chart(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
+        """Roll-bending chart PNG (:func:`ght_cad.sheet.plot_roll_chart`)."""
+        from .sheet import plot_roll_chart
+
+        plot_roll_chart(self, path, dpi=dpi, title=title)
+        return Path(path)
+
     # -- report --------------------------------------------------------------------------
     @property
     def report(self) -> DistortionReport:
@@ -625,7 +662,8 @@ class FlatPattern:
 
     # -- exports -------------------------------------------------------------------------
     def export_dxf(self, path: str | os.PathLike, *, spline: bool = False) -> Path:
-        """Write a DXF (R2010) with layers OUTLINE, BEND, LABELS, MARKS; $INSUNITS from units.
+        """Write a DXF (R2010) with layers OUTLINE, BEND, LABELS, MARKS (and FORMING for a sheet:
+        bend radius and angle of every bend line, rotated along it); $INSUNITS from units.
 
         OUTLINE: every loop as a closed LWPOLYLINE (``spline=True``: a closed fit-point SPLINE).
         BEND: bend lines as LINEs with linetype DASHED. LABELS: TEXT. MARKS: edge-mark ticks.
@@ -646,6 +684,8 @@ class FlatPattern:
         doc.layers.add("BEND", color=1, linetype="DASHED")
         doc.layers.add("LABELS", color=3)
         doc.layers.add("MARKS", color=5)
+        if self.forming_labels:
+            doc.layers.add("FORMING", color=6)
         msp = doc.modelspace()
         for lp in self.outlines:
             if spline:
@@ -660,6 +700,9 @@ class FlatPattern:
             msp.add_line(tuple(m[0]), tuple(m[1]), dxfattribs={"layer": "MARKS"})
         for x, y, s, h in self.labels:
             t = msp.add_text(s, height=h, dxfattribs={"layer": "LABELS"})
+            t.set_placement((x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        for x, y, s, h, a in self.forming_labels:
+            t = msp.add_text(s, height=h, rotation=a, dxfattribs={"layer": "FORMING"})
             t.set_placement((x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
         with atomic_path(path) as tmp:
             doc.saveas(tmp)
@@ -682,6 +725,8 @@ class FlatPattern:
         put(40, 0.75), put(49, 0.5), put(49, -0.25)
         put(0, "ENDTAB")
         layers = (("OUTLINE", 7, "CONTINUOUS"), ("BEND", 1, "DASHED"), ("LABELS", 3, "CONTINUOUS"), ("MARKS", 5, "CONTINUOUS"))
+        if self.forming_labels:
+            layers += (("FORMING", 6, "CONTINUOUS"),)
         put(0, "TABLE"), put(2, "LAYER"), put(70, len(layers))
         for name, color, lt in layers:
             put(0, "LAYER"), put(2, name), put(70, 0), put(62, color), put(6, lt)
@@ -702,6 +747,10 @@ class FlatPattern:
         for x, y, text, h in self.labels:
             put(0, "TEXT"), put(8, "LABELS"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
             put(40, float(h)), put(1, _dxf_ascii(text)), put(72, 1), put(73, 2)
+            put(11, float(x)), put(21, float(y)), put(31, 0.0)
+        for x, y, text, h, a in self.forming_labels:
+            put(0, "TEXT"), put(8, "FORMING"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
+            put(40, float(h)), put(1, _dxf_ascii(text)), put(50, float(a)), put(72, 1), put(73, 2)
             put(11, float(x)), put(21, float(y)), put(31, 0.0)
         put(0, "ENDSEC"), put(0, "EOF")
         return "\n".join(out) + "\n"
@@ -768,6 +817,15 @@ class FlatPattern:
                 f'dominant-baseline="middle">{escape(s)}</text>'
             )
         out.append("</g>")
+        if self.forming_labels:
+            out.append('<g id="FORMING" inkscape:groupmode="layer" inkscape:label="FORMING" fill="magenta" font-family="sans-serif">')
+            for x, y, s, h, a in self.forming_labels:
+                X, Y = tr(np.array([x, y]))
+                out.append(
+                    f'<text x="{X:.9g}" y="{Y:.9g}" font-size="{h:.6g}" text-anchor="middle" dominant-baseline="middle" '
+                    f'transform="rotate({-a:.6g} {X:.9g} {Y:.9g})">{escape(s)}</text>'
+                )
+            out.append("</g>")
         out.append("</svg>")
         return "\n".join(out) + "\n"
 

@@ -364,6 +364,7 @@ def unroll_ruled(
     units: str = "mm",
     label: str = "P1",
     breakpoints: Sequence[float] = (),
+    sheet: Any = None,
 ) -> FlatPattern:
     r"""Unroll a :class:`~ght_cad.ruled.RuledSurface` by quadrature along its rulings.
 
@@ -374,6 +375,9 @@ def unroll_ruled(
         surface: the ruled surface (u, v ∈ [0, 1]).
         best_effort, tol_deg, rulings, samples, units, label: as in :func:`unroll`.
         breakpoints: parameters where a, b are not smooth (B-spline knots).
+        sheet: a :class:`ght_cad.sheet.Sheet` with ``T > 0``: the pattern is the development of
+            the neutral offset ``S + σ K T n`` (:func:`ght_cad.sheet.unroll_ruled_sheet`); None
+            or ``T = 0``: the surface itself.
 
     Returns:
         Single-panel FlatPattern; ``pattern.map(u, v)`` is the development map.
@@ -381,7 +385,13 @@ def unroll_ruled(
     Raises:
         NotDevelopableError: ``θ_max > tol_deg`` and not best_effort (message: θ_max, θ_rms, DD).
         DegenerateGeometryError: a zero-length ruling or a directrix tangent to a ruling.
+        SheetError: a thickness beyond a bending radius of the surface.
     """
+    if sheet is not None and not sheet.is_zero:
+        from .sheet import unroll_ruled_sheet
+
+        return unroll_ruled_sheet(surface, sheet, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings,
+                                  samples=samples, units=units, label=label)
     dd = _check_developable(surface, tol_deg, best_effort, f"surface {label!r}")
     dev = RuledDevelopment(surface, breakpoints=breakpoints)
     edges = _ruled_edges(surface, dev, samples)
@@ -425,6 +435,11 @@ def unroll(
     samples: int = 257,
     units: str = "mm",
     label: str = "P1",
+    sheet: Any = None,
+    thickness: float | None = None,
+    k_factor: float | None = None,
+    din_k_factor: float | None = None,
+    side: str = "normal",
 ) -> FlatPattern:
     r"""Unroll a developable surface or face into a flat pattern (spec section 6).
 
@@ -445,17 +460,27 @@ def unroll(
         samples: points per boundary edge in the outline polylines.
         units: length unit of the coordinates ("mm", "cm", "m", "in", "ft"); DXF $INSUNITS.
         label: panel label.
+        sheet: a :class:`ght_cad.sheet.Sheet` (thickness, K-factor, side), or give
+        thickness, k_factor, din_k_factor, side: the sheet's values (:func:`ght_cad.sheet.make_sheet`;
+            K default 0.5, DIN k = 2K, side "normal" = material along the surface normal or
+            "reverse"). With ``T > 0`` the pattern is the development of the neutral surface
+            ``S + δ n``, ``δ = ±K T`` (spec 6.1), ``panel.info["sheet"]`` holds the inside, neutral
+            and outside lengths of every boundary edge and the forming data (bend radius and
+            angle per bend line); ``T = 0`` gives the surface's own pattern.
 
     Returns:
         FlatPattern with ``.errors``, ``.report``, ``.export_dxf``, ``.export_svg``, ``.plot_png``.
 
     Raises:
         NotDevelopableError: θ_max > tol_deg (message gives θ_max, θ_rms, DD) and not best_effort.
+        SheetError: a bad thickness/K-factor/side or a thickness beyond a bending radius.
         GHTError: unsupported input or bad arguments.
     """
+    sheet = _sheet_arg(sheet, thickness, k_factor, din_k_factor, side)
     if isinstance(surface_or_face, (list, tuple)):
         return unroll_composite(
-            surface_or_face, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units
+            surface_or_face, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units,
+            sheet=sheet,
         )
     _check_args(tol_deg, rulings, samples, units)
     if isinstance(surface_or_face, RuledSurface):
@@ -468,6 +493,7 @@ def unroll(
             units=units,
             label=label,
             breakpoints=getattr(surface_or_face, "breakpoints", ()),
+            sheet=sheet,
         )
     if hasattr(surface_or_face, "wrapped") or type(surface_or_face).__module__.startswith("OCP"):
         from .cad.unroll_faces import shape_faces, unroll_face
@@ -475,7 +501,8 @@ def unroll(
         faces = shape_faces(surface_or_face)
         if len(faces) > 1:  # a shell, solid or compound: one panel per face
             return unroll_composite(
-                faces, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units
+                faces, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units,
+                sheet=sheet,
             )
 
         return unroll_face(
@@ -486,6 +513,7 @@ def unroll(
             samples=samples,
             units=units,
             label=label,
+            sheet=sheet,
         )
     raise GHTError(
         f"cannot unroll a {type(surface_or_face).__name__}; allowed: a ght_cad RuledSurface, a "
@@ -494,6 +522,25 @@ def unroll(
 
 
 _UNITS = ("mm", "cm", "m", "in", "ft", "unitless")
+
+
+def _sheet_arg(sheet: Any, thickness: Any, k_factor: Any, din_k_factor: Any, side: str) -> Any:
+    """The Sheet of ``sheet=`` or of the loose values (:func:`ght_cad.sheet.make_sheet`); None
+    when neither is given. Giving both is refused."""
+    loose = thickness is not None or k_factor is not None or din_k_factor is not None or side != "normal"
+    if sheet is None and not loose:
+        return None
+    from .sheet import Sheet, SheetError, make_sheet
+
+    if sheet is not None:
+        if loose:
+            raise SheetError("give either sheet=Sheet(...) or thickness/k_factor/din_k_factor/side, not both")
+        if not isinstance(sheet, Sheet):
+            raise SheetError(f"sheet={sheet!r} is not allowed; give a ght_cad.sheet.Sheet (or thickness=..., k_factor=...)")
+        return sheet
+    if thickness is None:
+        raise SheetError(f"side={side!r} or a K-factor was given without a thickness; give thickness=T (a length >= 0) too")
+    return make_sheet(thickness, k_factor, din_k_factor=din_k_factor, side=side)
 
 
 def _check_args(tol_deg: float, rulings: int, samples: int, units: str) -> None:
@@ -517,6 +564,7 @@ def unroll_composite(
     units: str = "mm",
     labels: Sequence[str] | None = None,
     gap: float | None = None,
+    sheet: Any = None,
 ) -> FlatPattern:
     """Unroll several surfaces/faces into one pattern: one labelled panel per face.
 
@@ -530,6 +578,8 @@ def unroll_composite(
         labels: panel labels (default P1, P2, ...).
         gap: spacing between panels in model units.
         best_effort, tol_deg, rulings, samples, units: as in :func:`unroll`.
+        sheet: one :class:`ght_cad.sheet.Sheet` for every part, or a sequence of them (one per
+            part, None for none): each panel is its part's neutral surface.
 
     Returns:
         FlatPattern with one panel per part; ``.report`` aggregates all panels.
@@ -544,9 +594,13 @@ def unroll_composite(
         labels = [f"P{i + 1}" for i in range(len(parts))]
     if len(labels) != len(parts):
         raise GHTError(f"{len(labels)} labels given for {len(parts)} parts; give one label per part")
+    sheets = list(sheet) if isinstance(sheet, (list, tuple)) else [sheet] * len(parts)
+    if len(sheets) != len(parts):
+        raise GHTError(f"{len(sheets)} sheets given for {len(parts)} parts; give one sheet (or None) per part")
     panels: list[FlatPanel] = []
-    for part, lab in zip(parts, labels):
-        pat = unroll(part, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units, label=lab)
+    for part, lab, sh in zip(parts, labels, sheets):
+        pat = unroll(part, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units, label=lab,
+                     sheet=sh)
         panels.extend(pat.panels)
     from .flat_pattern import layout_panels, mark_shared_edges
 

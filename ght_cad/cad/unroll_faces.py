@@ -283,6 +283,7 @@ def unroll_face(
     samples: int = 257,
     units: str = "mm",
     label: str = "P1",
+    sheet: Any = None,
 ) -> FlatPattern:
     """Unroll one build123d/cadquery/OCP face by :func:`ght_cad.face_unroll.unroll_face_data`
     (closed forms for plane/cylinder/cone, quadrature along the rulings otherwise; see module doc).
@@ -293,6 +294,8 @@ def unroll_face(
             :func:`ght_cad.face_unroll.unroll_face_data` (flatten a non-developable face with a
             distortion report; largest θ_max in degrees; bend lines; points per edge; length
             unit; panel label).
+        sheet: a :class:`ght_cad.sheet.Sheet`: unroll the face's neutral surface (side relative
+            to the face's normal, orientation included).
 
     Returns:
         FlatPattern with one panel: all wires of the face (outer + holes) mapped to the plane.
@@ -312,6 +315,7 @@ def unroll_face(
         samples=samples,
         units=units,
         label=label,
+        sheet=sheet,
     )
 
 
@@ -331,7 +335,7 @@ def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, 
             exp.Next()
         if loop:
             wires.append(loop)
-    return FaceData(surface=ev, bounds=bounds, wires=wires)
+    return FaceData(surface=ev, bounds=bounds, wires=wires, reversed=f.Orientation() == TopAbs_REVERSED)
 
 
 def flat_faces(pattern: FlatPattern, *, spline: bool = True) -> list[Any]:
