@@ -1,0 +1,337 @@
+r"""Building a validated design: its GHT curves (joins applied and measured) and its surface.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import GHTError
+from .objectives import dual_curve_objectives
+from .schema import SHAPE_NAMES, Design, DesignError
+
+
+GHT_DEFINITION = (
+    "GHT seed (this project's definition, spec section 1): f0 = (1-w)(1-s)(1-mu s) + w(1-t)^2, "
+    "f2 = (1-w)(1-c)(1-nu c) + w t^2, f1 = 1 - f0 - f2, s = sin(pi t/2), c = cos(pi t/2), "
+    "w = (1+gamma)/2; degree m: b_i,m = B_i,m-2 f0 + B_i-1,m-2 f1 + B_i-2,m-2 f2"
+)
+
+
+def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """GHT curves of the design with its joins applied, and a measured report per join.
+
+    Joins are applied in file order: ``second`` gets its first ``r+1`` control points re-solved
+    (:func:`ght_cad.continuity.join`) so that the joint ``first(1) → second(0)`` has the requested
+    continuity; :func:`ght_cad.continuity.measure_continuity` then measures it independently.
+
+    Args:
+        design: a validated design.
+        shape: for a ``curves`` surface, strip shape parameters ``{"a.mu", ..., "b.gamma"}`` (any
+            subset) that replace the file's ``mu, nu, gamma`` of ``curve_a`` / ``curve_b``
+            *before* the joins, so that joined curves follow them (as after an optimization).
+
+    Returns:
+        ``({name: GHTCurve}, [join report dicts])``.
+    """
+    return _joined_curves(design, shape, measure=True)
+
+
+def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: bool) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """:func:`build_curves`; ``measure=False`` skips the join reports (optimizer candidates)."""
+    from ..curve import GHTCurve
+
+    side_of: dict[str, str] = {}
+    if shape and design.surface is not None and design.surface.type == "curves":
+        side_of = {str(design.surface.curve_a): "a", str(design.surface.curve_b): "b"}
+    curves: dict[str, Any] = {}
+    for c in design.curves:
+        sh = {"mu": c.mu, "nu": c.nu, "gamma": c.gamma}
+        if c.name in side_of:
+            sh.update({k: float(shape[f"{side_of[c.name]}.{k}"]) for k in SHAPE_NAMES  # type: ignore[index]
+                       if f"{side_of[c.name]}.{k}" in shape})  # type: ignore[operator]
+        curves[c.name] = GHTCurve(c.control_points, sh["mu"], sh["nu"], sh["gamma"])
+    reports = []
+    for i, j in enumerate(design.joins):
+        from ..continuity import join, measure_continuity
+
+        a, b = curves[j.first], curves[j.second]
+        if a.dim != b.dim:
+            raise DesignError(
+                f"{design.source}: key 'joins': curves {j.first!r} (dim {a.dim}) and {j.second!r} (dim {b.dim}) "
+                "have different dimensions; allowed: curves of the same dimension"
+            )
+        geometric = j.continuity.startswith("G")
+        kw = {"k": j.k, "beta2": j.beta2, "beta3": j.beta3} if geometric else {}
+        try:
+            curves[j.second] = join(a, j.continuity, b, **kw)
+        except DesignError:
+            raise
+        except GHTError as exc:
+            raise type(exc)(f"{design.source}: key 'joins[{i}]': {' '.join(str(exc).split())}") from None
+        if not measure:
+            continue
+        rep = measure_continuity(a, curves[j.second])
+        reports.append(
+            {
+                "first": j.first,
+                "second": j.second,
+                "requested": j.continuity,
+                "achieved_C": int(rep.c_order),
+                "achieved_G": int(rep.g_order),
+                "satisfied": bool(rep.satisfies(j.continuity)),
+                "c_residuals": [float(x) for x in rep.c_residuals],
+                "g_residuals": [float(x) for x in rep.g_residuals],
+                "tol": float(rep.tol),
+            }
+        )
+    return curves, reports
+
+
+@dataclass
+class BuiltSurface:
+    """A design's surface with the shape parameters it was built with."""
+
+    design: Design
+    surface: Any
+    curves: dict[str, Any]
+    shape: dict[str, float]
+
+
+def _initial_shape(design: Design, curves: dict[str, Any]) -> dict[str, float]:
+    spec = design.surface
+    assert spec is not None
+    if spec.type == "planes":
+        return {"mu": spec.mu, "nu": spec.nu, "gamma": spec.gamma}
+    if spec.type == "composite":
+        return {f"{g.name}.{k}": float(getattr(g, k)) for g in spec.segments or [] for k in SHAPE_NAMES}
+    out = {}
+    for side, cname in (("a", spec.curve_a), ("b", spec.curve_b)):
+        c = curves[cname]
+        out.update({f"{side}.mu": c.mu, f"{side}.nu": c.nu, f"{side}.gamma": c.gamma})
+    return out
+
+
+def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float]) -> Any:
+    spec = design.surface
+    assert spec is not None
+    if spec.type == "planes":
+        from ..developable import developable_from_planes
+
+        return developable_from_planes(
+            spec.planes, spec.boundary_planes, shape["mu"], shape["nu"], shape["gamma"], normalize=spec.normalize
+        )
+    if spec.type == "composite":
+        return _make_composite(design, shape)
+    from ..ruled import CurvePairRuledSurface
+
+    ca = curves[spec.curve_a].with_shape(shape["a.mu"], shape["a.nu"], shape["a.gamma"])
+    cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
+    return CurvePairRuledSurface(ca, cb)
+
+
+def _make_composite(design: Design, shape: dict[str, float]) -> Any:
+    r"""Strips of a ``composite`` surface: strip 0 from its planes, strip i joined to strip i-1.
+
+    Join (spec 5.6): the 4-D dual curves meet with ``V(0) = U(1)`` and G1 ``V' = k U'``,
+    G2 ``V'' = k² U'' + β2 U'``, G3 ``V''' = k³ U''' + 3kβ2 U'' + β3 U'``
+    (:func:`ght_cad.developable.join_developable`); all strips share the boundary planes, so
+    consecutive strips share their joint ruling segment.
+
+    Raises:
+        GHTError: a join that cannot be solved or a degenerate strip, naming the segment.
+    """
+    from ..developable import CompositeDevelopable, developable_from_planes, join_developable
+    from ..planes import normalize_planes
+
+    spec = design.surface
+    assert spec is not None and spec.segments
+    segs: list[Any] = []
+    for i, g in enumerate(spec.segments):
+        P = np.asarray(g.planes, dtype=float)
+        if spec.normalize:
+            P = normalize_planes(P)
+        sh = {k: shape[f"{g.name}.{k}"] for k in SHAPE_NAMES}
+        try:
+            if i == 0:
+                segs.append(developable_from_planes(P, spec.boundary_planes, sh["mu"], sh["nu"], sh["gamma"]))
+            else:
+                segs.append(join_developable(segs[-1], g.continuity or "G1", P, mu=sh["mu"], nu=sh["nu"],
+                                             gamma=sh["gamma"], k=g.k, beta2=g.beta2, beta3=g.beta3))
+        except GHTError as exc:
+            raise type(exc)(f"{design.source}: key 'surface.segments[{i}]' ({g.name}): {' '.join(str(exc).split())}") from None
+    try:
+        comp = CompositeDevelopable(segs)
+    except GHTError as exc:
+        raise type(exc)(f"{design.source}: key 'surface.segments': {' '.join(str(exc).split())}") from None
+    return comp
+
+
+def _is_composite(surface: Any) -> bool:
+    return hasattr(surface, "segments") and hasattr(surface, "joints")
+
+
+def _developability_dict(surface: Any) -> dict[str, float]:
+    """Developability degree of a surface; for a composite the worst strip per quantity
+    (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed)."""
+    if not _is_composite(surface):
+        return surface.developability().as_dict()
+    ds = [d.as_dict() for d in surface.developability()]
+    return {
+        "theta_max": max(d["theta_max"] for d in ds),
+        "theta_rms": float(math.sqrt(sum(d["theta_rms"] ** 2 for d in ds) / len(ds))),
+        "dd": min(d["dd"] for d in ds),
+        "R": float(sum(d["R"] for d in ds)),
+        "residual_max": max(d["residual_max"] for d in ds),
+    }
+
+
+class _CompositeView:
+    """A composite surface seen as one ruled strip for plots: ``grid`` and ``theta`` by strip."""
+
+    def __init__(self, composite: Any) -> None:
+        self.segments = list(composite.segments)
+
+    def _split(self, n: int) -> list[int]:
+        k = len(self.segments)
+        return [max(2, n // k + (1 if i < n % k else 0)) for i in range(k)]
+
+    def grid(self, nu: int, nv: int) -> np.ndarray:
+        return np.concatenate([s.grid(m, nv) for s, m in zip(self.segments, self._split(int(nu)))], axis=0)
+
+    def theta(self, u: Any) -> np.ndarray:
+        n = int(np.size(u))
+        return np.concatenate([np.asarray(s.theta(np.linspace(0.0, 1.0, m)), dtype=float)
+                               for s, m in zip(self.segments, self._split(n))])
+
+
+def surface_view(built: "BuiltSurface") -> Any:
+    """What :func:`ght_cad.plotting.plot_surface` draws: the surface, or all strips of a composite."""
+    return _CompositeView(built.surface) if _is_composite(built.surface) else built.surface
+
+
+def build_surface(design: Design, shape: dict[str, float] | None = None,
+                  curves: dict[str, Any] | None = None) -> BuiltSurface:
+    """Build the design's surface with its own (or the given) shape parameters.
+
+    Raises:
+        DesignError: the design has no [surface] table.
+        GHTError: degenerate geometry (parallel planes, edge of regression inside the strip, ...).
+    """
+    if design.surface is None:
+        raise DesignError(f"{design.source}: key 'surface': missing; this command needs a [surface] table")
+    if curves is None:
+        curves, _ = build_curves(design)
+    sh = dict(_initial_shape(design, curves))
+    if shape:
+        sh.update(shape)
+    try:
+        surf = _make_surface(design, curves, sh)
+    except DesignError:
+        raise
+    except GHTError as exc:
+        msg = " ".join(str(exc).split())
+        if msg.startswith(f"{design.source}: key 'surface"):  # already names the file and key (a strip)
+            raise
+        raise type(exc)(f"{design.source}: key 'surface': {msg}") from None
+    return BuiltSurface(design, surf, curves, sh)
+
+
+def ruled_area(surface: Any, nodes: int = 64) -> float:
+    r"""Area ``∫_0^1 ∫_0^1 |X_u × X_v| dv du`` of a ruled surface (Gauss–Legendre, both directions)."""
+    from ..curve import gauss_legendre
+
+    t, w = gauss_legendre(nodes)
+    v, wv = gauss_legendre(16)
+    U = np.repeat(t, v.size)
+    V = np.tile(v, t.size)
+    xu, xv = surface.partials(U, V)
+    dens = np.linalg.norm(np.cross(xu, xv), axis=1)
+    return float(np.sum(dens * np.repeat(w, v.size) * np.tile(wv, t.size)))
+
+
+def surface_summary(built: BuiltSurface) -> dict[str, Any]:
+    """Developability degree (θ_max, θ_rms, DD, R), area and shape parameters of a built surface.
+
+    A composite surface also gets ``surface.strips`` (per strip: name, shape parameters, area,
+    ruling lengths, developability) and ``surface.joints`` (per joint: requested continuity, the
+    order measured by :func:`ght_cad.developable.measure_developable_joint`, its residuals, the
+    angle between the end tangent planes and the ruling distance); ``developability`` is then the
+    worst strip's (see ``_developability_dict``).
+    """
+    s = built.surface
+    if _is_composite(s):
+        return _composite_summary(built)
+    dev = s.developability()
+    out: dict[str, Any] = {
+        "surface": {
+            "type": built.design.surface.type if built.design.surface else None,
+            "shape_parameters": dict(built.shape),
+            "area_3d": ruled_area(s),
+            "ruling_length_min": float(np.min(s.ruling_lengths(np.linspace(0, 1, 257)))),
+            "ruling_length_max": float(np.max(s.ruling_lengths(np.linspace(0, 1, 257)))),
+        },
+        "developability": dev.as_dict(),
+    }
+    spec = built.design.surface
+    if spec is not None and spec.type == "planes":
+        out["surface"]["control_planes"] = np.asarray(s.planes).tolist()
+        out["surface"]["boundary_planes"] = np.asarray(s.boundary_planes).tolist()
+        out["surface"]["normalized"] = bool(spec.normalize)
+        out["surface"]["edge_of_regression"] = "outside the strip (checked on construction)"
+    return out
+
+
+def _composite_summary(built: BuiltSurface) -> dict[str, Any]:
+    from ..unroll import ruled_area as exact_area
+
+    comp = built.surface
+    spec = built.design.surface
+    assert spec is not None and spec.segments
+    u = np.linspace(0, 1, 257)
+    strips = []
+    for g, seg, dev in zip(spec.segments, comp.segments, comp.developability()):
+        L = seg.ruling_lengths(u)
+        strips.append({
+            "name": g.name,
+            "shape_parameters": {k: float(built.shape.get(f"{g.name}.{k}", getattr(g, k))) for k in SHAPE_NAMES},
+            "control_planes": np.asarray(seg.planes).tolist(),
+            "dual_curve_fairness": dual_curve_objectives(seg.dual_curve),
+            "area_3d": exact_area(seg),
+            "ruling_length_min": float(np.min(L)),
+            "ruling_length_max": float(np.max(L)),
+            "developability": dev.as_dict(),
+        })
+    joints = []
+    for i, (g, rep) in enumerate(zip(spec.segments[1:], comp.joints())):
+        joints.append({
+            "first": spec.segments[i].name,
+            "second": g.name,
+            "requested": g.continuity,
+            "k": g.k,
+            "beta2": g.beta2,
+            "beta3": g.beta3,
+            "achieved_G": int(rep.order),
+            "satisfied": bool(rep.satisfies(g.continuity or "G1")),
+            "residuals": [float(r) for r in rep.residuals],
+            "plane_angle_deg": float(rep.plane_angle),
+            "ruling_distance": float(rep.ruling_distance),
+            "tol": float(rep.tol),
+        })
+    return {
+        "surface": {
+            "type": "composite",
+            "shape_parameters": dict(built.shape),
+            "area_3d": float(sum(x["area_3d"] for x in strips)),
+            "ruling_length_min": min(x["ruling_length_min"] for x in strips),
+            "ruling_length_max": max(x["ruling_length_max"] for x in strips),
+            "boundary_planes": np.asarray(comp.segments[0].boundary_planes).tolist(),
+            "normalized": bool(spec.normalize),
+            "strips": strips,
+            "joints": joints,
+        },
+        "developability": _developability_dict(comp),
+    }

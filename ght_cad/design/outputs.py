@@ -1,0 +1,316 @@
+r"""Outputs of a built design: B-rep (face or shell), STEP, flat pattern (DXF, SVG, PNG) and
+:func:`export_files` (all or nothing, by suffix).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any, Iterable, Sequence
+
+import numpy as np
+
+from ..errors import GHTError
+from .build import BuiltSurface, _is_composite, build_curves, build_surface, surface_summary, surface_view
+from .schema import Design, DesignError
+
+
+def _ruled_face(surface: Any, tol: float) -> Any:
+    """B-spline face of degree (p, 1) through the paired boundary curves ``a(u)``, ``b(u)``.
+
+    ``a`` and ``b`` are fitted together as one 6-D function (one knot vector, pole i of each at
+    the same parameter), so the face is ``(1-v) A(u) + v B(u)`` with ``|A - a|, |B - b| <= tol``.
+    """
+    from ..bspline import BSplineSurfaceData, fit_function
+    from ..cad.occ import make_face
+
+    fit = fit_function(lambda t: np.hstack([surface.a(t), surface.b(t)]), tol=tol, degree=5)
+    poles = np.stack([fit.poles[:, :3], fit.poles[:, 3:]], axis=1)
+    data = BSplineSurfaceData(poles, fit.knots, np.array([0.0, 0.0, 1.0, 1.0]), fit.degree, 1,
+                              max_deviation=fit.max_deviation)
+    return make_face(data)
+
+
+def brep_face(built: BuiltSurface, tol: float | None = None) -> Any:
+    """A build123d face of the built surface (``surface.to_face()`` when it has one)."""
+    s = built.surface
+    if tol is None:
+        g = s.grid(17, 3).reshape(-1, 3)
+        tol = 1e-7 * float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
+    if hasattr(s, "to_face"):
+        try:
+            return s.to_face(tol=tol)
+        except ImportError:
+            pass
+    return _ruled_face(s, tol)
+
+
+def brep_shape(built: BuiltSurface, tol: float | None = None) -> Any:
+    """The B-rep of the built surface: one face (:func:`brep_face`), or for a composite one shell
+    of one B-spline face per strip sewn along the joint rulings
+    (:func:`ght_cad.cad.developable_faces.composite_shell`)."""
+    if _is_composite(built.surface):
+        from ..cad.developable_faces import composite_shell
+
+        return composite_shell(built.surface, tol=tol)
+    return brep_face(built, tol)
+
+
+def shared_edge_count(shape: Any) -> int:
+    """Number of edges of a B-rep shared by two or more of its faces (``TopExp`` edge→face map)."""
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    from ..cad.occ import unwrap
+
+    m = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(unwrap(shape), TopAbs_EDGE, TopAbs_FACE, m)
+    return sum(1 for i in range(1, m.Extent() + 1) if m.FindFromIndex(i).Size() >= 2)
+
+
+def curve_edges(curves: dict[str, Any]) -> list[Any]:
+    """Certified B-spline edges (``curve_to_bspline``) of the 2-D/3-D curves."""
+    from ..bspline import curve_to_bspline
+    from ..cad.occ import make_edge
+
+    return [make_edge(curve_to_bspline(c)) for c in curves.values() if c.dim in (2, 3)]
+
+
+def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bool = True) -> Path:
+    """Write the surface face (and the design's curves as edges) to one STEP file, atomically."""
+    from ..cad.occ import write_step
+
+    shapes = [brep_shape(built)]
+    if with_curves:
+        shapes += curve_edges(built.curves)
+    write_step(shapes, path, units=built.design.units)
+    return Path(path)
+
+
+def unroll_surface(built: BuiltSurface) -> Any:
+    """Flat pattern of the built surface (:func:`ght_cad.unroll`).
+
+    A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
+    distortion is then in the pattern's errors.
+    """
+    from ..unroll import unroll
+
+    d = built.design
+    if _is_composite(built.surface):
+        from ..unroll import unroll_composite
+
+        return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                                units=d.units, labels=[g.name for g in d.surface.segments or []])
+    best_effort = d.surface is not None and d.surface.type == "curves"
+    return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                  units=d.units, label=d.name[:24])
+
+
+def pattern_report(pattern: Any) -> dict[str, Any]:
+    """The ``flat_pattern`` entry of a report: area, errors, distortion report, outline and bend-line
+    counts, bounding box, per-panel areas and the edge-mark labels (``E<n>``, panel labels excluded)."""
+    import re
+
+    panel_labels = {pn.label for pn in pattern.panels}
+    return {
+        "area": float(pattern.area),
+        "errors": pattern_errors(pattern),
+        "report": pattern.report.as_dict(),
+        "outline_points": int(sum(len(o) for o in pattern.outlines)),
+        "bend_lines": int(len(pattern.bend_lines)),
+        "bbox": [np.min(np.concatenate(pattern.outlines), axis=0).tolist(),
+                 np.max(np.concatenate(pattern.outlines), axis=0).tolist()],
+        "panels": [{"label": pn.label, "area_flat": float(pn.area_flat), "area_3d": float(pn.area_3d),
+                    "max_error": float(pn.report.max_relative_error) if pn.report is not None else None}
+                   for pn in pattern.panels],
+        "edge_marks": sorted({t[2] for t in pattern.labels
+                              if t[2] not in panel_labels and re.fullmatch(r"E\d+", t[2])}, key=lambda m: int(m[1:])),
+    }
+
+
+def pattern_errors(pattern: Any) -> dict[str, float]:
+    """Max relative length/area errors of a flat pattern (``FlatPattern.errors``) as floats."""
+    return {k: float(v) for k, v in pattern.errors.items()}
+
+
+def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None) -> Path:
+    """Fixed-size PNG (900 x 700) of a flat pattern: outlines and bend lines."""
+    from ..plotting import plot_flat_pattern
+
+    e = pattern.errors
+    t = (title + ": " if title else "") + f"flat pattern, max rel. error {e['max']:.1e}"
+    return plot_flat_pattern(pattern.outlines, path, rulings=list(pattern.bend_lines), title=t,
+                             labels=list(pattern.labels), marks=list(pattern.marks))
+
+
+def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str, str]:
+    """Build the design with its given shape parameters and write each file by its suffix.
+
+    ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: name, units,
+    surface summary, curves and (with a surface) the ``flat_pattern`` entry of :func:`pattern_report`;
+    ``.png``: rendered surface (or the curves when the design has no surface).
+
+    All or nothing: every file is first written into a temporary folder beside its target
+    (which also proves the target's folder is writable) and the files are moved into place only
+    when every one was written; a failure leaves every target as it was (existing files
+    untouched, no new file).
+
+    Args:
+        design: a validated design (:func:`load_design`).
+        files: output paths; the suffix selects the content.
+
+    Raises:
+        DesignError: a suffix that is not allowed, a surface output without [surface], or a
+            target whose folder cannot be written (the message names the target).
+
+    Returns:
+        ``{kind: path}`` for each written file (``kind`` = suffix without dot, ``_<n>`` appended
+        for repeats).
+    """
+    files = [Path(f) for f in files]
+    allowed = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
+    for f in files:
+        if f.suffix.lower() not in allowed:
+            raise DesignError(f"{f}: unknown output suffix {f.suffix!r}; allowed: {', '.join(allowed)}")
+    curves, _ = build_curves(design)
+    built = build_surface(design, curves=curves) if design.surface is not None else None
+    if built is None:
+        for f in files:
+            if f.suffix.lower() in (".dxf", ".svg"):
+                raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
+    stage = _FileStage(files)
+    try:
+        out: dict[str, str] = {}
+        pattern = None
+        for f in files:
+            pattern = _export_one(design, curves, built, f, stage.path(f), pattern)
+            suf = f.suffix.lower().lstrip(".")
+            out[suf + (f"_{len(out)}" if suf in out else "")] = str(f)
+        stage.commit()
+    finally:
+        stage.cleanup()
+    return out
+
+
+def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | None, target: Path,
+                tmp: Path, pattern: Any) -> Any:
+    """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
+    import json
+
+    from ..io import write_text_atomic
+
+    suf = target.suffix.lower()
+    if suf in (".step", ".stp"):
+        if built is not None:
+            export_step(built, tmp)
+        else:
+            from ..cad.occ import write_step
+
+            write_step(curve_edges(curves), tmp, units=design.units)
+    elif suf in (".dxf", ".svg"):
+        pattern = pattern or unroll_surface(built)
+        (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp)
+    elif suf == ".json":
+        summ = {"name": design.name, "units": design.units}
+        summ.update(surface_summary(built) if built is not None else {})
+        summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
+        if built is not None:
+            pattern = pattern or unroll_surface(built)
+            summ["flat_pattern"] = pattern_report(pattern)
+        write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
+    else:
+        from ..plotting import plot_curve, plot_surface
+
+        if built is not None:
+            plot_surface(surface_view(built), tmp, title=design.name)
+        else:
+            plot_curve(list(curves.values()), tmp)
+    return pattern
+
+
+class _FileStage:
+    """One temporary folder beside each target's folder; :meth:`commit` moves all files into place.
+
+    Creating the temporary folders up front checks that every target folder is writable before
+    anything is computed or written. Folders created for missing parents are removed again on
+    failure.
+    """
+
+    def __init__(self, targets: Sequence[Path]) -> None:
+        self.dirs: dict[Path, Path] = {}
+        self.made: list[Path] = []
+        self.map: dict[Path, Path] = {}
+        try:
+            for t in targets:
+                parent = t.parent.absolute()
+                if t.exists() and t.is_dir():
+                    raise DesignError(f"cannot write {t}: it is a folder; allowed: a file path")
+                if parent not in self.dirs:
+                    self._mkdirs(parent, t)
+                    try:
+                        self.dirs[parent] = Path(tempfile.mkdtemp(prefix=".ght-cad-export.", dir=parent))
+                    except OSError as exc:
+                        raise DesignError(
+                            f"cannot write {t}: folder {parent} is not writable ({exc.strerror or exc})"
+                        ) from None
+                # a numbered name keeps repeated or equal base names apart; the suffix is kept for writers
+                self.map[t] = self.dirs[parent] / f"{len(self.map)}{t.suffix}"
+        except BaseException:
+            self.cleanup()
+            raise
+
+    def _mkdirs(self, parent: Path, target: Path) -> None:
+        missing = []
+        p = parent
+        while not p.exists() and p != p.parent:
+            missing.append(p)
+            p = p.parent
+        for d in reversed(missing):
+            try:
+                d.mkdir()
+            except OSError as exc:
+                raise DesignError(f"cannot write {target}: cannot create folder {d} ({exc.strerror or exc})") from None
+            self.made.append(d)
+
+    def path(self, target: Path) -> Path:
+        return self.map[target]
+
+    def commit(self) -> None:
+        """Move every staged file onto its target (same file system: ``os.replace`` each)."""
+        for t, tmp in self.map.items():
+            if not tmp.is_file():
+                raise GHTError(f"writing {t} produced no file")
+        for t, tmp in self.map.items():
+            os.replace(tmp, t)
+        self.made = []  # the folders now hold results
+
+    def cleanup(self) -> None:
+        for d in self.dirs.values():
+            shutil.rmtree(d, ignore_errors=True)
+        for d in reversed(self.made):
+            try:
+                d.rmdir()
+            except OSError:
+                pass
+        self.made = []
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {str(k): _jsonable(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_jsonable(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return _jsonable(o.tolist())
+    if isinstance(o, (np.floating, float)):
+        x = float(o)
+        return x if math.isfinite(x) else None
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.bool_,)):
+        return bool(o)
+    return o

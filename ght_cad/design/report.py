@@ -1,0 +1,104 @@
+r"""Markdown report of :func:`ght_cad.design.run_design` (``report.md``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def _f(x: Any, fmt: str = ".6g") -> str:
+    return "n/a" if x is None else format(x, fmt)
+
+
+def report_markdown(r: dict[str, Any]) -> str:
+    """Markdown report of :func:`run_design` (tables of the measured numbers, figure links)."""
+    L = [f"# {r['name']}: ght_cad report", ""]
+    L.append(f"Design: `{r['source']}` · units: {r['units']} · ght_cad {r['versions']['ght_cad']} · "
+             f"computed in {r['elapsed_s']:.1f} s")
+    L.append("")
+    L.append(f"GHT definition: {r['ght_definition']}.")
+    L.append("")
+    if r.get("curves"):
+        L += ["## Curves", "", "| name | degree | dim | μ | ν | γ | arc length | max curvature |", "|---|---|---|---|---|---|---|---|"]
+        for c in r["curves"]:
+            L.append(f"| {c['name']} | {c['degree']} | {c['dim']} | {c['mu']:.4g} | {c['nu']:.4g} | {c['gamma']:.4g} | "
+                     f"{c['arc_length']:.6g} | {_f(c['curvature_max'], '.4g')} |")
+        L.append("")
+    if r.get("joins"):
+        L += ["### Joins (measured independently of the construction)", "",
+              "| first → second | requested | achieved C | achieved G | satisfied |", "|---|---|---|---|---|"]
+        for j in r["joins"]:
+            L.append(f"| {j['first']} → {j['second']} | {j['requested']} | C{j['achieved_C']} | G{j['achieved_G']} | "
+                     f"{'yes' if j['satisfied'] else 'NO'} |")
+        L.append("")
+    if r.get("surface"):
+        s = r["surface"]
+        L += ["## Surface", "", f"Type: `{s['type']}` · shape parameters: "
+              + ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
+              + f" · area {s['area_3d']:.9g} {r['units']}² · ruling length {s['ruling_length_min']:.6g}–"
+              f"{s['ruling_length_max']:.6g} {r['units']}", ""]
+        L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
+        for label, key in (("initial", "developability_initial"), ("final", "developability")):
+            d = r.get(key)
+            if d:
+                L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
+        L.append("")
+        if r.get("initial_surface_error"):
+            L += [f"The file's shape parameters give no surface ({r['initial_surface_error']}); the values above "
+                  "are those of the optimized parameters.", ""]
+        if s.get("strips"):
+            L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
+            for x in s["strips"]:
+                sp, d = x["shape_parameters"], x["developability"]
+                L.append(f"| {x['name']} | {sp['mu']:.4g} | {sp['nu']:.4g} | {sp['gamma']:.4g} | {x['area_3d']:.9g} | "
+                         f"{d['theta_max']:.3e} | {d['dd']:.12f} |")
+            L.append("")
+        if s.get("joints"):
+            L += ["### Joints between strips (measured independently of the construction)", "",
+                  "| first → second | requested | achieved | satisfied | plane angle [deg] | residuals |",
+                  "|---|---|---|---|---|---|"]
+            for j in s["joints"]:
+                L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
+                         f"{'yes' if j['satisfied'] else 'NO'} | {j['plane_angle_deg']:.2e} | "
+                         + ", ".join(f"{x:.1e}" for x in j["residuals"]) + " |")
+            L.append("")
+    if r.get("optimization"):
+        o = r["optimization"]
+        L += ["## Shape-parameter optimization", "",
+              f"{o['method']} on {o['objective']}: {_f(o['initial_value'], '.8g')} → {o['best_value']:.8g} in "
+              f"{o['iterations']} iterations ({o['nfev']} evaluations, {o['time_s']:.2f} s); best "
+              + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
+        if o.get("strips"):
+            L += [f"Per strip ({o['objective']} of its dual curve as built):", "",
+                  "| strip | before | after | μ, ν, γ before | μ, ν, γ after |", "|---|---|---|---|---|"]
+            for x in o["strips"]:
+                L.append(f"| {x['name']} | {_f(x['initial_value'], '.8g')} | {x['best_value']:.8g} | "
+                         + ", ".join(f"{v:.4g}" for v in x["initial_parameters"].values()) + " | "
+                         + ", ".join(f"{v:.4g}" for v in x["best_parameters"].values()) + " |")
+            L.append("")
+        if o.get("joints"):
+            L += ["Joints after optimization:", "", "| first → second | requested | measured | satisfied |",
+                  "|---|---|---|---|"]
+            for j in o["joints"]:
+                L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
+                         f"{'yes' if j['satisfied'] else 'NO'} |")
+            L.append("")
+    if r.get("brep"):
+        b = r["brep"]
+        L += ["## B-rep", "", f"{b['faces']} face(s){' in one shell' if b.get('shape') == 'shell' else ''} "
+              f"(valid: {b['valid']}), area {b['area']:.9g} {r['units']}², "
+              f"{b['curve_edges']} curve edge(s).", ""]
+    if r.get("flat_pattern"):
+        p = r["flat_pattern"]
+        L += ["## Flat pattern (spec section 6)", "", f"Area {p['area']:.9g} {r['units']}², {p['bend_lines']} bend lines, "
+              f"{len(p.get('panels') or [1])} panel(s)" + (f", edge marks {', '.join(p['edge_marks'])}" if p.get("edge_marks") else "")
+              + ".", "",
+              "| quantity | max | rms |", "|---|---|---|"]
+        for k, v in p["report"].items():
+            L.append(f"| {k} | {v['max']:.3e} | {v['rms']:.3e} |")
+        L.append("")
+    L += ["## Files", ""]
+    for f in r.get("files", []):
+        L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))
+    L.append("")
+    return "\n".join(L)

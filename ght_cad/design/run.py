@@ -1,0 +1,301 @@
+r"""The pipeline behind ``ght-cad run``/``demo``: :func:`run_design`.
+
+curves → surface → optimization → measures → B-rep + STEP → flat pattern → figures → report,
+computed into a temporary folder beside the output folder and moved in only when every step
+succeeded, so a failure leaves the output folder untouched.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import GHTError
+from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, surface_summary,
+                    surface_view)
+from .optimize import optimize_design
+from .outputs import _jsonable, brep_shape, curve_edges, pattern_report, plot_pattern, shared_edge_count, unroll_surface
+from .report import report_markdown
+from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
+
+
+class _Stage:
+    """A temporary folder beside ``out_dir``; :meth:`commit` moves its files into ``out_dir``."""
+
+    def __init__(self, out_dir: Path) -> None:
+        self.out = out_dir
+        parent = out_dir.parent
+        # folders created for out_dir's parent: removed again by cleanup() after a failed run
+        self.made_parents = [d for d in (parent, *parent.parents) if not d.exists()][::-1]
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".ght-cad-tmp", dir=parent))
+        except OSError as exc:  # e.g. a part of the path is a regular file, or a read-only folder
+            self._remove_made_parents()
+            raise GHTError(
+                f"cannot create the output folder {out_dir}: {exc.strerror or exc}"
+                f"{f' ({exc.filename})' if exc.filename else ''}; allowed: a folder or a new path "
+                "whose parent folders can be created"
+            ) from None
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self.tmp, 0o777 & ~umask)  # mkdtemp makes 0700; the result is an ordinary folder
+
+    def path(self, name: str) -> Path:
+        return self.tmp / name
+
+    def commit(self) -> list[str]:
+        names = sorted(p.name for p in self.tmp.iterdir() if p.is_file() and not p.name.endswith(".part"))
+        if not self.out.exists():
+            os.replace(self.tmp, self.out)  # one atomic rename: the folder appears complete
+            return names
+        if not self.out.is_dir():
+            raise GHTError(f"{self.out} exists and is not a folder; allowed: a folder or a new path")
+        for n in names:  # checked before the first move: a failure must not leave a mixed folder
+            if (self.out / n).is_dir():
+                raise GHTError(f"cannot write {self.out / n}: it is a folder; allowed: a file path "
+                               "(remove or rename the folder)")
+        for n in names:
+            os.replace(self.tmp / n, self.out / n)
+        shutil.rmtree(self.tmp, ignore_errors=True)
+        return names
+
+    def cleanup(self) -> None:
+        """Remove the temporary folder and the parent folders created for it (after a failure)."""
+        shutil.rmtree(self.tmp, ignore_errors=True)
+        self._remove_made_parents()
+
+    def _remove_made_parents(self) -> None:
+        for d in reversed(self.made_parents):
+            try:
+                d.rmdir()  # only if still empty
+            except OSError:
+                pass
+
+
+def _versions() -> dict[str, str]:
+    import platform
+
+    from .. import __version__
+
+    out = {"ght_cad": __version__, "python": platform.python_version(), "numpy": np.__version__}
+    try:
+        import scipy
+
+        out["scipy"] = scipy.__version__
+    except ImportError:  # pragma: no cover
+        pass
+    return out
+
+
+def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
+    """Per curve: degree, dimension, shape parameters, control points, arc length, max curvature."""
+    return [
+        {
+            "name": k,
+            "degree": c.degree,
+            "dim": c.dim,
+            "mu": c.mu,
+            "nu": c.nu,
+            "gamma": c.gamma,
+            "control_points": c.control_points.tolist(),
+            "arc_length": c.arc_length(),
+            "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
+        }
+        for k, c in curves.items()
+    ]
+
+
+def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True) -> dict[str, Any]:
+    """Run the whole pipeline of a design and write its outputs into ``out_dir``.
+
+    Steps: GHT curves (+ joins, measured) → surface (developable from control planes, or a ruled
+    strip between two curves) → shape-parameter optimization (if ``[optimize]``) → developability
+    degree → B-rep face → STEP (face + curve edges) → flat pattern (DXF, SVG) → PNG figures
+    (basis, curve, curvature, surface, flat_pattern, convergence) → ``report.json`` and
+    ``report.md``. File names: ``model.step``, ``flat_pattern.dxf``, ``flat_pattern.svg``,
+    ``report.json``, ``report.md``, ``<figure>.png``.
+
+    Everything is computed into a temporary folder beside ``out_dir``; only when every step has
+    succeeded are the files moved in (a new ``out_dir`` appears by one rename). On any error the
+    temporary folder is removed and ``out_dir`` is untouched.
+
+    Args:
+        design: a validated :class:`Design`.
+        out_dir: output folder.
+        progress: progress bar on stderr when it is a terminal.
+
+    Returns:
+        The report dictionary (the content of ``report.json``).
+
+    Raises:
+        GHTError: degenerate geometry, non-developable surface, ...; nothing is written.
+    """
+    import sys
+
+    from ..progress import progress_enabled
+
+    t_start = time.perf_counter()
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
+    want_files = set(design.outputs.files)
+    want_figs = set(design.outputs.figures)
+    steps = ["curves", "surface", "optimize", "measure", "B-rep + STEP", "flat pattern", "figures", "report"]
+    show = bool(progress) and progress_enabled()
+    report: dict[str, Any] = {
+        "name": design.name,
+        "source": design.source,
+        "units": design.units,
+        "ght_definition": GHT_DEFINITION,
+        "design": design.to_dict(),
+    }
+
+    def step(name: str) -> None:
+        if show:
+            i = steps.index(name) + 1
+            sys.stderr.write(f"[{i}/{len(steps)}] {design.name}: {name} ({time.perf_counter() - t_start:.1f} s)\n")
+            sys.stderr.flush()
+
+    stage = _Stage(out)
+    try:
+        # 1. curves
+        step("curves")
+        curves, joins = build_curves(design)
+        report["curves"] = _curves_report(curves)
+        report["joins"] = joins
+
+        built = None
+        opt = None
+        if design.surface is not None:
+            # 2. surface
+            step("surface")
+            try:
+                built = build_surface(design, curves=curves)
+                report["developability_initial"] = _developability_dict(built.surface)
+            except GHTError as exc:
+                if design.optimize is None:
+                    raise
+                # the file's values are one rejected candidate; the optimization may find admissible ones
+                report["developability_initial"] = None
+                report["initial_surface_error"] = " ".join(str(exc).split())
+            # 3. optimization
+            if design.optimize is not None:
+                step("optimize")
+                opt = optimize_design(design, progress=progress, curves=curves)
+                if design.surface.type == "curves":
+                    # the strip's boundary curves (and the curves joined to them) take the optimized
+                    # shape parameters: STEP curve edges, figures and the report show those
+                    curves, joins = build_curves(design, opt.shape)
+                    report["curves"] = _curves_report(curves)
+                    report["joins"] = joins
+                built = build_surface(design, opt.shape, curves=curves)
+                report["optimization"] = opt.summary()
+            # 4. measures
+            step("measure")
+            report.update(surface_summary(built))
+            # 5. B-rep
+            step("B-rep + STEP")
+            face = brep_shape(built)
+            from ..cad.occ import is_valid
+
+            valid = is_valid(face)
+            nfaces = len(face.faces()) if hasattr(face, "faces") else 1
+            report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": nfaces}
+            if _is_composite(built.surface):
+                from ..cad.developable_faces import joint_normal_deviation
+
+                report["brep"]["shape"] = "shell"
+                report["brep"]["shared_edges"] = shared_edge_count(face)
+                report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
+            if not valid:
+                raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
+            edges = curve_edges(curves)
+            report["brep"]["curve_edges"] = len(edges)
+            if "step" in want_files:
+                from ..cad.occ import write_step
+
+                write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
+            # 6. flat pattern
+            step("flat pattern")
+            pattern = unroll_surface(built)
+            report["flat_pattern"] = pattern_report(pattern)
+            if "dxf" in want_files:
+                pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
+            if "svg" in want_files:
+                pattern.export_svg(stage.path(FILE_NAMES["svg"]))
+        else:
+            pattern = None
+            if "step" in want_files and curves:
+                from ..cad.occ import write_step
+
+                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]), units=design.units)
+
+        # 7. figures
+        step("figures")
+        from .. import plotting as P
+
+        if "basis" in want_figs:
+            if built is not None and design.surface is not None and design.surface.type == "composite":
+                deg = max(sg.dual_curve.degree for sg in built.surface.segments)
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0)] + [(g.mu, g.nu, g.gamma) for g in design.surface.segments or []]
+                params += [tuple(built.shape[f"{g.name}.{k}"] for k in SHAPE_NAMES) for g in design.surface.segments or []]
+            elif built is not None and design.surface is not None and design.surface.type == "planes":
+                deg = built.surface.dual_curve.degree
+                sh = built.shape
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (design.surface.mu, design.surface.nu, design.surface.gamma),
+                          (sh["mu"], sh["nu"], sh["gamma"])]
+            elif curves:
+                c0 = next(iter(curves.values()))
+                deg = c0.degree
+                params = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (c0.mu, c0.nu, c0.gamma)]
+            else:  # pragma: no cover - validation guarantees curves or a surface
+                deg, params = 3, [(0.0, 0.0, 0.0)]
+            uniq = []
+            for p in params:
+                if p not in uniq:
+                    uniq.append(p)
+            # the basis figure stops at MAX_PLOT_DEGREE (a plot of more functions is unreadable)
+            P.plot_basis(stage.path(FIGURE_NAMES["basis"]), min(max(deg, 2), P.MAX_PLOT_DEGREE), uniq)
+        if "curve" in want_figs and curves:
+            P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
+        if "curvature" in want_figs and curves:
+            P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
+        if "surface" in want_figs and built is not None:
+            P.plot_surface(surface_view(built), stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
+        if "flat_pattern" in want_figs and pattern is not None:
+            plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
+        if "convergence" in want_figs and opt is not None:
+            P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
+                               stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")
+
+        # 8. report
+        step("report")
+        files = sorted(p.name for p in stage.tmp.iterdir() if p.is_file())
+        if "json" in want_files:
+            files.append(FILE_NAMES["json"])
+        if "md" in want_files:
+            files.append(FILE_NAMES["md"])
+        report["files"] = sorted(files)
+        report["out_dir"] = str(out)
+        report["versions"] = _versions()
+        report["elapsed_s"] = time.perf_counter() - t_start
+        report = _jsonable(report)
+        from ..io import write_text_atomic
+        import json
+
+        if "json" in want_files:
+            write_text_atomic(stage.path(FILE_NAMES["json"]), json.dumps(report, indent=2) + "\n")
+        if "md" in want_files:
+            write_text_atomic(stage.path(FILE_NAMES["md"]), report_markdown(report))
+        stage.commit()
+    except BaseException:
+        stage.cleanup()
+        raise
+    return report

@@ -1,0 +1,647 @@
+r"""Design-file schema: the dataclasses of a design and their validation (:func:`parse_design`).
+
+Every check names the file, the key and the allowed values and raises :class:`DesignError`
+(a :class:`~ght_cad.errors.GHTError`, so ``ght-cad`` exits with code 2). The schema is documented
+in ``docs/design-files.md``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+from ..errors import GHTError
+
+
+#: file outputs a design may request
+FILE_OUTPUTS = ("step", "dxf", "svg", "json", "md")
+
+
+#: figures a design may request (PNG)
+FIGURE_OUTPUTS = ("basis", "curve", "curvature", "surface", "flat_pattern", "convergence")
+
+
+#: optimizers
+METHODS = ("pso", "gwo", "igwo")
+
+
+#: objectives: fairness of the dual curve (planes) or developability R (curve-pair strips)
+PLANE_OBJECTIVES = ("AL", "En", "CVEn", "weighted")
+
+
+STRIP_OBJECTIVES = ("R",)
+
+
+SURFACE_TYPES = ("planes", "curves", "composite")
+
+
+#: joins between the strips of a composite surface (spec 5.6)
+STRIP_JOINS = ("G1", "G2", "G3")
+
+
+CONTINUITIES = ("C0", "C1", "C2", "C3", "G0", "G1", "G2", "G3")
+
+
+UNITS = ("mm", "cm", "m", "in", "ft")
+
+
+SHAPE_NAMES = ("mu", "nu", "gamma")
+
+
+# output file names inside the output folder
+FILE_NAMES = {
+    "step": "model.step",
+    "dxf": "flat_pattern.dxf",
+    "svg": "flat_pattern.svg",
+    "json": "report.json",
+    "md": "report.md",
+}
+
+
+FIGURE_NAMES = {k: f"{k}.png" for k in FIGURE_OUTPUTS}
+
+
+class DesignError(GHTError):
+    """An invalid design file: one line naming the file, the key and the allowed values."""
+
+
+@dataclass
+class CurveSpec:
+    """One GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i`` of a design."""
+
+    name: str
+    control_points: list[list[float]]
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+
+
+@dataclass
+class JoinSpec:
+    """Re-solve the first points of curve ``second`` so that it meets ``first`` (spec section 4)."""
+
+    first: str
+    second: str
+    continuity: str = "G1"
+    k: float = 1.0
+    beta2: float = 0.0
+    beta3: float = 0.0
+
+
+@dataclass
+class SegmentSpec:
+    """One strip of a ``composite`` surface: an enveloping developable of control planes.
+
+    Strip 0 is built from its planes (spec 5.2); strip i > 0 is joined to strip i-1 with
+    ``continuity`` (G1/G2/G3) by :func:`ght_cad.developable.join_developable`, which re-solves
+    its first ``r+1`` control planes (``r`` = the order) and keeps the others.
+    """
+
+    name: str
+    planes: list[list[float]]
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+    continuity: str | None = None
+    k: float = 1.0
+    beta2: float = 0.0
+    beta3: float = 0.0
+
+
+@dataclass
+class SurfaceSpec:
+    """The design's surface: ``type = "planes"`` (spec 5.2), ``"curves"`` (ruled strip) or
+    ``"composite"`` (several strips from control planes joined G1/G2/G3, spec 5.6)."""
+
+    type: str
+    planes: list[list[float]] | None = None
+    boundary_planes: list[list[float]] | None = None
+    mu: float = 0.0
+    nu: float = 0.0
+    gamma: float = 0.0
+    curve_a: str | None = None
+    curve_b: str | None = None
+    normalize: bool = True
+    segments: list[SegmentSpec] | None = None
+
+
+@dataclass
+class OptimizeSpec:
+    """Shape-parameter optimization (spec sections 7, 8)."""
+
+    method: str = "igwo"
+    objective: str = "CVEn"
+    weights: list[float] = field(default_factory=lambda: [1.0, 0.0, 0.0])
+    parameters: list[str] = field(default_factory=lambda: list(SHAPE_NAMES))
+    population: int = 20
+    iterations: int = 40
+    seed: int = 1
+
+
+@dataclass
+class UnrollSpec:
+    """Flat-pattern options (see :func:`ght_cad.unroll`)."""
+
+    rulings: int = 16
+    tol_deg: float = 0.01
+
+
+@dataclass
+class OutputSpec:
+    """Which files and figures to write."""
+
+    files: list[str] = field(default_factory=lambda: list(FILE_OUTPUTS))
+    figures: list[str] = field(default_factory=lambda: list(FIGURE_OUTPUTS))
+
+
+@dataclass
+class Design:
+    """A validated design (see ``docs/design-files.md``)."""
+
+    name: str
+    units: str = "mm"
+    curves: list[CurveSpec] = field(default_factory=list)
+    joins: list[JoinSpec] = field(default_factory=list)
+    surface: SurfaceSpec | None = None
+    optimize: OptimizeSpec | None = None
+    unroll: UnrollSpec = field(default_factory=UnrollSpec)
+    outputs: OutputSpec = field(default_factory=OutputSpec)
+    source: str = "<design>"
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (as it would be written in TOML)."""
+        from dataclasses import asdict
+
+        d = asdict(self)
+        d.pop("source")
+        return d
+
+
+def _tname(v: Any) -> str:
+    if isinstance(v, bool):
+        return "boolean"
+    if isinstance(v, int):
+        return "integer"
+    if isinstance(v, float):
+        return "float"
+    if isinstance(v, str):
+        return "string"
+    if isinstance(v, list):
+        return "array"
+    if isinstance(v, dict):
+        return "table"
+    return type(v).__name__
+
+
+def _short(v: Any) -> str:
+    s = repr(v)
+    return s if len(s) <= 60 else s[:57] + "..."
+
+
+class _Checker:
+    """Typed getters that raise :class:`DesignError` naming ``source``, the key and what is allowed."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, key: str, message: str) -> DesignError:
+        return DesignError(f"{self.source}: key '{key}': {message}")
+
+    def table(self, data: dict, key: str, path: str, *, required: bool = False) -> dict | None:
+        if key not in data:
+            if required:
+                raise self.fail(path, "missing; this table is required")
+            return None
+        v = data[key]
+        if not isinstance(v, dict):
+            raise self.fail(path, f"expected a table [{path}], got {_tname(v)} {_short(v)}")
+        return v
+
+    def keys(self, tbl: dict, path: str, allowed: Sequence[str]) -> None:
+        for k in tbl:
+            if k not in allowed:
+                where = f"{path}.{k}" if path else k
+                raise self.fail(where, f"unknown key; allowed keys{' in ' + path if path else ''}: {', '.join(allowed)}")
+
+    def required(self, tbl: dict, key: str, path: str, what: str) -> Any:
+        if key not in tbl:
+            raise self.fail(f"{path}.{key}" if path else key, f"missing; required: {what}")
+        return tbl[key]
+
+    def number(self, tbl: dict, key: str, path: str, default: float | None = None, *,
+               lo: float | None = None, hi: float | None = None, lo_open: bool = False,
+               required: bool = False, allowed: str | None = None) -> float:
+        full = f"{path}.{key}" if path else key
+        rng = allowed or _range_text(lo, hi, lo_open)
+        if key not in tbl:
+            if required or default is None:
+                raise self.fail(full, f"missing; required: a number {rng}")
+            return default
+        v = tbl[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise self.fail(full, f"expected a number {rng}, got {_tname(v)} {_short(v)}")
+        x = float(v)
+        if not math.isfinite(x):
+            raise self.fail(full, f"{x} is not finite; allowed: a number {rng}")
+        if (lo is not None and (x <= lo if lo_open else x < lo)) or (hi is not None and x > hi):
+            raise self.fail(full, f"{x:g} is out of range; allowed: {rng}")
+        return x
+
+    def integer(self, tbl: dict, key: str, path: str, default: int, *, lo: int, hi: int) -> int:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return default
+        v = tbl[key]
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise self.fail(full, f"expected an integer in [{lo}, {hi}], got {_tname(v)} {_short(v)}")
+        if not lo <= v <= hi:
+            raise self.fail(full, f"{v} is out of range; allowed: an integer in [{lo}, {hi}]")
+        return int(v)
+
+    def string(self, tbl: dict, key: str, path: str, default: str | None = None, *,
+               choices: Sequence[str] | None = None, required: bool = False) -> str:
+        full = f"{path}.{key}" if path else key
+        allowed = f"one of {', '.join(choices)}" if choices else "a non-empty string"
+        if key not in tbl:
+            if required or default is None:
+                raise self.fail(full, f"missing; required: {allowed}")
+            return default
+        v = tbl[key]
+        if not isinstance(v, str):
+            raise self.fail(full, f"expected a string ({allowed}), got {_tname(v)} {_short(v)}")
+        if choices is not None:
+            match = [c for c in choices if c.lower() == v.lower()]
+            if not match:
+                raise self.fail(full, f"{v!r} is not allowed; allowed: {', '.join(choices)}")
+            return match[0]
+        if not v.strip():
+            raise self.fail(full, "is empty; allowed: a non-empty string")
+        return v
+
+    def matrix(self, tbl: dict, key: str, path: str, *, cols: Sequence[int], min_rows: int,
+               max_rows: int | None = None, required: bool = True) -> list[list[float]] | None:
+        full = f"{path}.{key}" if path else key
+        colt = " or ".join(str(c) for c in cols)
+        what = f"an array of at least {min_rows} arrays of {colt} numbers" if max_rows != min_rows else \
+            f"an array of exactly {min_rows} arrays of {colt} numbers"
+        if key not in tbl:
+            if required:
+                raise self.fail(full, f"missing; required: {what}")
+            return None
+        v = tbl[key]
+        if not isinstance(v, list) or not all(isinstance(r, list) for r in v):
+            raise self.fail(full, f"expected {what}, got {_tname(v)} {_short(v)}")
+        if len(v) < min_rows or (max_rows is not None and len(v) > max_rows):
+            raise self.fail(full, f"has {len(v)} rows; allowed: {what}")
+        n = len(v[0])
+        out = []
+        for i, row in enumerate(v):
+            if len(row) != n or n not in cols:
+                raise self.fail(f"{full}[{i}]", f"has {len(row)} numbers; allowed: {colt} numbers, the same for every row")
+            vals = []
+            for j, x in enumerate(row):
+                if isinstance(x, bool) or not isinstance(x, (int, float)):
+                    raise self.fail(f"{full}[{i}][{j}]", f"expected a number, got {_tname(x)} {_short(x)}")
+                if not math.isfinite(float(x)):
+                    raise self.fail(f"{full}[{i}][{j}]", f"{x} is not finite; allowed: a finite number")
+                vals.append(float(x))
+            out.append(vals)
+        return out
+
+    def boolean(self, tbl: dict, key: str, path: str, default: bool) -> bool:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return default
+        v = tbl[key]
+        if not isinstance(v, bool):
+            raise self.fail(full, f"expected a boolean (true or false), got {_tname(v)} {_short(v)}")
+        return v
+
+    def string_list(self, tbl: dict, key: str, path: str, default: list[str], *, choices: Sequence[str]) -> list[str]:
+        full = f"{path}.{key}" if path else key
+        if key not in tbl:
+            return list(default)
+        v = tbl[key]
+        if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+            raise self.fail(full, f"expected an array of strings from: {', '.join(choices)}; got {_tname(v)} {_short(v)}")
+        out = []
+        for x in v:
+            match = [c for c in choices if c.lower() == x.lower()]
+            if not match:
+                raise self.fail(full, f"{x!r} is not allowed; allowed: {', '.join(choices)}")
+            if match[0] not in out:
+                out.append(match[0])
+        return out
+
+
+def _range_text(lo: float | None, hi: float | None, lo_open: bool = False) -> str:
+    if lo is not None and hi is not None:
+        return f"in [{lo:g}, {hi:g}]"
+    if lo is not None:
+        return f"{'>' if lo_open else '>='} {lo:g}"
+    if hi is not None:
+        return f"<= {hi:g}"
+    return ""
+
+
+_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "optimize", "unroll", "outputs")
+
+
+def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
+    """Validate a parsed design file (a dict from ``tomllib``) and return a :class:`Design`.
+
+    Every check names ``source``, the key and the allowed values.
+
+    Args:
+        data: the parsed TOML document.
+        source: file name used in error messages.
+
+    Returns:
+        The validated design.
+
+    Raises:
+        DesignError: missing key, wrong type, value out of range, unknown key or unknown output.
+    """
+    ck = _Checker(source)
+    if not isinstance(data, dict):
+        raise DesignError(f"{source}: the document must be a TOML table")
+    ck.keys(data, "", _TOP_KEYS)
+    default_name = Path(source).stem if not source.startswith("<") else "design"
+    name = ck.string(data, "name", "", default_name or "design")
+    units = ck.string(data, "units", "", "mm", choices=UNITS)
+
+    # curves
+    curves: list[CurveSpec] = []
+    raw_curves = data.get("curves", [])
+    if not isinstance(raw_curves, list) or not all(isinstance(c, dict) for c in raw_curves):
+        raise ck.fail("curves", f"expected an array of tables [[curves]], got {_tname(raw_curves)}")
+    seen: set[str] = set()
+    for i, c in enumerate(raw_curves):
+        path = f"curves[{i}]"
+        ck.keys(c, path, ("name", "control_points", "mu", "nu", "gamma"))
+        cname = ck.string(c, "name", path, f"curve{i + 1}")
+        if cname in seen:
+            raise ck.fail(f"{path}.name", f"{cname!r} is used twice; allowed: a name unique among [[curves]]")
+        seen.add(cname)
+        pts = ck.matrix(c, "control_points", path, cols=(2, 3), min_rows=3)
+        shape = {k: ck.number(c, k, path, 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
+        curves.append(CurveSpec(cname, pts, **shape))  # type: ignore[arg-type]
+
+    # joins
+    joins: list[JoinSpec] = []
+    raw_joins = data.get("joins", [])
+    if not isinstance(raw_joins, list) or not all(isinstance(j, dict) for j in raw_joins):
+        raise ck.fail("joins", f"expected an array of tables [[joins]], got {_tname(raw_joins)}")
+    for i, j in enumerate(raw_joins):
+        path = f"joins[{i}]"
+        ck.keys(j, path, ("first", "second", "continuity", "k", "beta2", "beta3"))
+        names = sorted(seen) or ["(no curves defined)"]
+        first = ck.string(j, "first", path, required=True, choices=names if seen else None)
+        second = ck.string(j, "second", path, required=True, choices=names if seen else None)
+        if not seen:
+            raise ck.fail(f"{path}.first", "refers to a curve but no [[curves]] are defined")
+        if first == second:
+            raise ck.fail(f"{path}.second", f"{second!r} equals first; allowed: another curve name from {', '.join(names)}")
+        cont = ck.string(j, "continuity", path, "G1", choices=CONTINUITIES)
+        k = ck.number(j, "k", path, 1.0, lo=0.0, lo_open=True)
+        b2 = ck.number(j, "beta2", path, 0.0)
+        b3 = ck.number(j, "beta3", path, 0.0)
+        joins.append(JoinSpec(first, second, cont, k, b2, b3))
+    seconds = [j.second for j in joins]
+    for s in seconds:
+        if seconds.count(s) > 1:
+            raise ck.fail("joins", f"curve {s!r} is the 'second' of two joins; allowed: each curve re-solved at most once")
+
+    # surface
+    surface = None
+    st = ck.table(data, "surface", "surface")
+    if st is not None:
+        stype = ck.string(st, "type", "surface", "planes", choices=SURFACE_TYPES)
+        if stype != "composite" and "segments" in st:
+            raise ck.fail("surface.segments", f"strips need type = \"composite\" (this surface has type = \"{stype}\"); "
+                          "allowed: [[surface.segments]] only with type = \"composite\"")
+        if stype == "planes":
+            ck.keys(st, "surface", ("type", "planes", "boundary_planes", "mu", "nu", "gamma", "normalize"))
+            planes = ck.matrix(st, "planes", "surface", cols=(4,), min_rows=3)
+            bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
+            for key, rows in (("planes", planes), ("boundary_planes", bplanes)):
+                for i, r in enumerate(rows or []):
+                    if math.hypot(*r[1:]) < 1e-12:
+                        raise ck.fail(f"surface.{key}[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
+            shape = {k: ck.number(st, k, "surface", 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
+            normalize = ck.boolean(st, "normalize", "surface", True)
+            surface = SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
+        elif stype == "composite":
+            surface = _parse_composite(ck, st)
+        else:
+            ck.keys(st, "surface", ("type", "curve_a", "curve_b"))
+            names = sorted(seen)
+            if not names:
+                raise ck.fail("surface.curve_a", "a 'curves' surface needs two 3-D [[curves]]; none are defined")
+            ca = ck.string(st, "curve_a", "surface", required=True, choices=names)
+            cb = ck.string(st, "curve_b", "surface", required=True, choices=names)
+            for key, cn in (("curve_a", ca), ("curve_b", cb)):
+                spec = next(c for c in curves if c.name == cn)
+                if len(spec.control_points[0]) != 3:
+                    raise ck.fail(f"surface.{key}", f"curve {cn!r} is 2-D; allowed: a 3-D curve")
+            if ca == cb:
+                raise ck.fail("surface.curve_b", f"{cb!r} equals curve_a; allowed: another 3-D curve")
+            surface = SurfaceSpec("curves", curve_a=ca, curve_b=cb)
+
+    # optimize
+    optimize = None
+    ot = ck.table(data, "optimize", "optimize")
+    if ot is not None:
+        if surface is None:
+            raise ck.fail("optimize", "needs a [surface] table to optimize")
+        ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
+        method = ck.string(ot, "method", "optimize", "igwo", choices=METHODS)
+        objs = _objectives_for(surface.type)
+        objective = ck.string(ot, "objective", "optimize", objs[0] if surface.type == "curves" else "CVEn", choices=objs)
+        weights = [1.0, 0.0, 0.0]
+        if "weights" in ot:
+            w = ot["weights"]
+            if (not isinstance(w, list) or len(w) != 3
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x >= 0
+                               for x in w)
+                    or not any(x > 0 for x in w)):
+                raise ck.fail("optimize.weights", f"{_short(w)} is not allowed; allowed: three numbers >= 0 (weights of AL, En, CVEn), not all 0")
+            weights = [float(x) for x in w]
+        pchoices = _shape_names(surface)
+        if surface.type == "composite":
+            params = _composite_parameters(ck, ot, surface)
+        else:
+            params = ck.string_list(ot, "parameters", "optimize", list(pchoices), choices=pchoices)
+        if not params:
+            raise ck.fail("optimize.parameters", f"is empty; allowed: a non-empty subset of {', '.join(pchoices)}")
+        pop = ck.integer(ot, "population", "optimize", 20, lo=4, hi=500)
+        its = ck.integer(ot, "iterations", "optimize", 40, lo=1, hi=5000)
+        seed = ck.integer(ot, "seed", "optimize", 1, lo=0, hi=2**32 - 1)
+        optimize = OptimizeSpec(method, objective, weights, params, pop, its, seed)
+
+    # unroll
+    unroll = UnrollSpec()
+    ut = ck.table(data, "unroll", "unroll")
+    if ut is not None:
+        ck.keys(ut, "unroll", ("rulings", "tol_deg"))
+        unroll = UnrollSpec(ck.integer(ut, "rulings", "unroll", 16, lo=0, hi=1000),
+                            ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True))
+
+    # outputs
+    outputs = OutputSpec()
+    ot2 = ck.table(data, "outputs", "outputs")
+    if ot2 is not None:
+        ck.keys(ot2, "outputs", ("files", "figures"))
+        outputs = OutputSpec(ck.string_list(ot2, "files", "outputs", list(FILE_OUTPUTS), choices=FILE_OUTPUTS),
+                             ck.string_list(ot2, "figures", "outputs", list(FIGURE_OUTPUTS), choices=FIGURE_OUTPUTS))
+    if surface is None:
+        for key, kinds in (("files", ("dxf", "svg")), ("figures", ("surface", "flat_pattern"))):
+            explicit = ot2 is not None and key in ot2
+            needs = [f for f in getattr(outputs, key) if f in kinds]
+            if explicit and needs:
+                allowed = [f for f in (FILE_OUTPUTS if key == "files" else FIGURE_OUTPUTS) if f not in kinds]
+                raise ck.fail(f"outputs.{key}", f"{', '.join(needs)} need a [surface] table; allowed without one: {', '.join(allowed)}")
+            setattr(outputs, key, [f for f in getattr(outputs, key) if f not in kinds])
+        if not curves:
+            raise ck.fail("surface", "missing; a design needs a [surface] table or at least one [[curves]] entry")
+    explicit_figs = ot2 is not None and "figures" in ot2
+    if optimize is None:
+        if explicit_figs and "convergence" in outputs.figures:
+            raise ck.fail("outputs.figures", "'convergence' needs an [optimize] table; allowed without one: "
+                          + ", ".join(f for f in FIGURE_OUTPUTS if f != "convergence"))
+        outputs.figures = [f for f in outputs.figures if f != "convergence"]
+    if not curves:
+        if explicit_figs and any(f in ("curve", "curvature") for f in outputs.figures):
+            raise ck.fail("outputs.figures", "'curve' and 'curvature' need at least one [[curves]] entry; allowed without: "
+                          + ", ".join(f for f in FIGURE_OUTPUTS if f not in ("curve", "curvature")))
+        outputs.figures = [f for f in outputs.figures if f not in ("curve", "curvature")]
+    if not outputs.files and not outputs.figures:
+        raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
+    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source)
+
+
+def _objectives_for(surface_type: str) -> tuple[str, ...]:
+    """Objectives allowed for a surface type: dual-curve fairness for planes and composites, R for
+    curve-pair strips."""
+    return STRIP_OBJECTIVES if surface_type == "curves" else PLANE_OBJECTIVES
+
+
+def _composite_parameters(ck: _Checker, ot: dict, surface: SurfaceSpec) -> list[str]:
+    """``optimize.parameters`` of a composite: ``"<segment name>.mu|nu|gamma"`` (default: all).
+
+    Raises:
+        DesignError: not an array of strings, an unknown segment or shape name, or an empty list.
+    """
+    segs = [g.name for g in surface.segments or []]
+    key = "optimize.parameters"
+    form = f"'<segment>.mu', '<segment>.nu' or '<segment>.gamma' with <segment> one of {', '.join(segs)}"
+    if "parameters" not in ot:
+        return list(_shape_names(surface))
+    v = ot["parameters"]
+    if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+        raise ck.fail(key, f"expected an array of strings {form}; got {_tname(v)} {_short(v)}")
+    out: list[str] = []
+    for x in v:
+        seg, dot, name = x.rpartition(".")
+        if not dot or seg not in segs:
+            what = f"unknown segment {seg!r} in {x!r}" if dot else f"{x!r} names no segment"
+            raise ck.fail(key, f"{what}; allowed: {form}")
+        match = [k for k in SHAPE_NAMES if k == name.lower()]
+        if not match:
+            raise ck.fail(key, f"unknown shape parameter {name!r} in {x!r}; allowed: {form}")
+        full = f"{seg}.{match[0]}"
+        if full not in out:
+            out.append(full)
+    if not out:
+        raise ck.fail(key, f"is empty; allowed: a non-empty array of {form}")
+    return out
+
+
+_SEGMENT_KEYS = ("name", "planes", "mu", "nu", "gamma", "continuity", "k", "beta2", "beta3")
+
+
+def _parse_composite(ck: _Checker, st: dict) -> SurfaceSpec:
+    """``[surface] type = "composite"``: shared boundary planes and ``[[surface.segments]]``."""
+    ck.keys(st, "surface", ("type", "boundary_planes", "normalize", "segments"))
+    bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
+    for i, r in enumerate(bplanes or []):
+        if math.hypot(*r[1:]) < 1e-12:
+            raise ck.fail(f"surface.boundary_planes[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane "
+                          "u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
+    normalize = ck.boolean(st, "normalize", "surface", True)
+    raw = ck.required(st, "segments", "surface", "an array of at least 2 tables [[surface.segments]]")
+    if not isinstance(raw, list) or not all(isinstance(x, dict) for x in raw):
+        raise ck.fail("surface.segments", f"expected an array of tables [[surface.segments]], got {_tname(raw)} {_short(raw)}")
+    if len(raw) < 2:
+        raise ck.fail("surface.segments", f"has {len(raw)} strip(s); allowed: at least 2 (one strip: use type = \"planes\")")
+    segs: list[SegmentSpec] = []
+    names: set[str] = set()
+    prev: dict[str, float] = {k: 0.0 for k in SHAPE_NAMES}
+    for i, t in enumerate(raw):
+        path = f"surface.segments[{i}]"
+        ck.keys(t, path, _SEGMENT_KEYS)
+        name = ck.string(t, "name", path, f"strip{i + 1}")
+        if name in names:
+            raise ck.fail(f"{path}.name", f"{name!r} is used twice; allowed: a name unique among the strips")
+        names.add(name)
+        if i == 0:
+            for key in ("continuity", "k", "beta2", "beta3"):
+                if key in t:
+                    raise ck.fail(f"{path}.{key}", "the first strip has no joint before it; allowed: "
+                                  "continuity, k, beta2, beta3 on segments[1] and later")
+            cont, k, b2, b3 = None, 1.0, 0.0, 0.0
+        else:
+            cont = ck.string(t, "continuity", path, "G1", choices=STRIP_JOINS)
+            k = ck.number(t, "k", path, 1.0, lo=0.0, lo_open=True)
+            b2 = ck.number(t, "beta2", path, 0.0)
+            b3 = ck.number(t, "beta3", path, 0.0)
+        order = int(cont[1]) if cont else 0
+        planes = ck.matrix(t, "planes", path, cols=(4,), min_rows=max(3, order + 1))
+        for j, r in enumerate(planes or []):
+            if math.hypot(*r[1:]) < 1e-12:
+                raise ck.fail(f"{path}.planes[{j}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane with a non-zero normal")
+        # shape parameters default to the previous strip's (as join_developable does)
+        shape = {key: ck.number(t, key, path, prev[key], lo=-1.0, hi=1.0) for key in SHAPE_NAMES}
+        prev = shape
+        segs.append(SegmentSpec(name, planes, shape["mu"], shape["nu"], shape["gamma"], cont, k, b2, b3))  # type: ignore[arg-type]
+    return SurfaceSpec("composite", boundary_planes=bplanes, normalize=normalize, segments=segs)
+
+
+def parse_design_text(text: str, source: str = "<design>") -> Design:
+    """Parse TOML text and validate it (see :func:`parse_design`)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib  # type: ignore[no-redef]
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise DesignError(f"{source}: not valid TOML: {' '.join(str(exc).split())}") from None
+    return parse_design(data, source)
+
+
+def load_design(path: str | os.PathLike) -> Design:
+    """Read and validate a design file.
+
+    Raises:
+        DesignError: unreadable file, invalid TOML or an invalid design (one-line message).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DesignError(f"{p}: no such design file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DesignError(f"{p}: cannot read the design file: {exc}") from None
+    return parse_design_text(text, str(p))
+
+
+def _shape_names(spec: SurfaceSpec) -> tuple[str, ...]:
+    if spec.type == "planes":
+        return SHAPE_NAMES
+    if spec.type == "composite":
+        return tuple(f"{g.name}.{k}" for g in spec.segments or [] for k in SHAPE_NAMES)
+    return tuple(f"{s}.{k}" for s in ("a", "b") for k in SHAPE_NAMES)

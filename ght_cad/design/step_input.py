@@ -1,0 +1,216 @@
+r"""STEP input: unroll the developable faces of a STEP file made by any CAD tool
+(``ght-cad unroll FILE.step``), one panel per face.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import GHTError
+from .schema import DesignError
+
+
+#: millimetres per unit (OCCT's STEP reader converts lengths to its system unit, mm by default)
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
+
+
+_STEP_UNIT_NAMES = {
+    "millimetre": "mm", "millimeter": "mm", "mm": "mm",
+    "centimetre": "cm", "centimeter": "cm", "cm": "cm",
+    "metre": "m", "meter": "m", "m": "m",
+    "inch": "in", "in": "in",
+    "foot": "ft", "feet": "ft", "ft": "ft",
+}
+
+
+STEP_SUFFIXES = (".step", ".stp")
+
+
+@dataclass
+class StepUnroll:
+    """Result of :func:`unroll_step`: the pattern and a per-face report.
+
+    Attributes:
+        pattern: one panel per selected face, labelled ``F<n>`` (``n`` = 1-based face number).
+        units: length unit of the pattern (and of the face geometry as read).
+        file_units: the length unit the STEP file declares (OCCT name), or None.
+        face_count: number of faces in the file.
+        faces: per selected face: number, surface type, unroll method, 3-D and flat area,
+            developability (θ_max, θ_rms, DD, R) when measured, max relative errors.
+    """
+
+    pattern: Any
+    units: str
+    file_units: str | None
+    face_count: int
+    faces: list[dict[str, Any]]
+
+
+def _step_unit(name: str | None) -> str | None:
+    if not name:
+        return None
+    return _STEP_UNIT_NAMES.get(name.strip().lower())
+
+
+def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
+    """Read a STEP file with lengths in ``units`` (default: the file's own length unit, else mm).
+
+    OCCT converts STEP lengths to its system length unit (``SetSystemLengthUnit``, in mm), so
+    asking for ``MM_PER_UNIT[u]`` gives the coordinates in unit ``u``.
+    """
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+    from OCP.TColStd import TColStd_SequenceOfAsciiString
+
+    from ..cad.occ import quiet_occt
+
+    with quiet_occt():
+        reader = STEPControl_Reader()
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise DesignError(f"{path}: not a readable STEP file (OCCT STEPControl_Reader failed)")
+        lengths, angles, solids = (TColStd_SequenceOfAsciiString() for _ in range(3))
+        file_unit: str | None = None
+        try:
+            reader.FileUnits(lengths, angles, solids)
+            if lengths.Length() >= 1:
+                file_unit = lengths.Value(1).ToCString()
+        except Exception:  # pragma: no cover - FileUnits is advisory
+            file_unit = None
+        unit = units or _step_unit(file_unit) or "mm"
+        reader.SetSystemLengthUnit(MM_PER_UNIT[unit])
+        reader.TransferRoots()
+        shape = reader.OneShape()
+    if shape is None or shape.IsNull():
+        raise DesignError(f"{path}: the STEP file holds no shape")
+    return shape, unit, file_unit
+
+
+def unroll_step(
+    path: str | os.PathLike,
+    *,
+    faces: Sequence[int] | None = None,
+    best_effort: bool = False,
+    units: str | None = None,
+    tol_deg: float = 0.01,
+    rulings: int = 16,
+) -> StepUnroll:
+    r"""Unroll the developable faces of a STEP file: one labelled panel per face (spec section 6).
+
+    Each face goes through :func:`ght_cad.unroll` (closed forms for planes, cylinders
+    ``(u, v) ↦ (R u, v)`` and cones ``ρ (cos(s u), sin(s u))``; quadrature along the rulings
+    ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥`` for other ruled faces). Panels are labelled
+    ``F<n>`` with the 1-based face number ``n`` (file order, ``TopExp_Explorer``); edges shared
+    by two selected faces get matching edge marks (:func:`ght_cad.flat_pattern.mark_shared_edges`).
+
+    Args:
+        path: ``.step``/``.stp`` file.
+        faces: 1-based face numbers to unroll (default: every face).
+        best_effort: flatten faces that are not developable within ``tol_deg`` anyway (their
+            distortion is in the report) instead of refusing them.
+        units: length unit of the pattern, one of mm, cm, m, in, ft; default: the file's
+            declared length unit, else mm. Coordinates are converted by OCCT's reader.
+        tol_deg: largest accepted ``θ_max`` in degrees.
+        rulings: bend lines per face.
+
+    Returns:
+        :class:`StepUnroll`.
+
+    Raises:
+        DesignError: missing/unreadable file, no faces, a face number out of range, a unit that
+            is not allowed.
+        NotDevelopableError: a face is not developable within ``tol_deg`` (and not
+            ``best_effort``); the one-line message names the file, the face number and the
+            measured ``θ_max`` and ``DD``.
+    """
+    from ..errors import NotDevelopableError
+    from ..flat_pattern import FlatPattern, layout_panels, mark_shared_edges
+    from ..unroll import unroll
+
+    p = Path(path)
+    if p.suffix.lower() not in STEP_SUFFIXES:
+        raise DesignError(f"{p}: unknown suffix {p.suffix!r}; allowed STEP suffixes: {', '.join(STEP_SUFFIXES)}")
+    if not p.is_file():
+        raise DesignError(f"{p}: no such STEP file")
+    if units is not None and units not in MM_PER_UNIT:
+        raise DesignError(f"{p}: units={units!r} is not allowed; allowed: {', '.join(MM_PER_UNIT)}")
+    if not (isinstance(tol_deg, (int, float)) and math.isfinite(tol_deg) and 0 < tol_deg <= 90):
+        raise DesignError(f"{p}: tol_deg={tol_deg!r} is out of range; allowed: a number in (0, 90]")
+    if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or not 0 <= rulings <= 1000:
+        raise DesignError(f"{p}: rulings={rulings!r} is out of range; allowed: an integer in [0, 1000]")
+    shape, unit, file_unit = _read_step_in(p, units)
+    from ..cad.unroll_faces import shape_faces
+
+    try:
+        all_faces = shape_faces(shape)
+    except GHTError:
+        raise DesignError(f"{p}: the STEP file holds no faces to unroll") from None
+    n = len(all_faces)
+    chosen = list(range(1, n + 1)) if not faces else list(faces)
+    for k in chosen:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= n:
+            raise DesignError(f"{p}: face {k!r} does not exist; allowed: face numbers 1..{n}")
+    if len(set(chosen)) != len(chosen):
+        raise DesignError(f"{p}: face numbers {chosen} repeat a face; allowed: each face once")
+    panels = []
+    report: list[dict[str, Any]] = []
+    for k in chosen:
+        face = all_faces[k - 1]
+        kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
+        try:
+            pat = unroll(face, best_effort=best_effort, **kw)
+        except NotDevelopableError as exc:
+            info_be: dict[str, Any] = {}
+            be_error = ""
+            try:  # measure how far off it is (for a non-ruled face: the ruled surface between its boundary isolines)
+                info_be = unroll(face, best_effort=True, **kw).panels[0].info or {}
+            except GHTError as be_exc:  # e.g. a full sphere: no two boundary curves to span rulings between
+                info_be = {}
+                be_error = " ".join(str(be_exc).split())
+            dev = info_be.get("developability")
+            straight = min(info_be.get("deviation_u", 0.0), info_be.get("deviation_v", 0.0))
+            how = (f"theta_max={dev['theta_max']:.6g} deg, developability degree DD={dev['dd']:.12f} (1 = developable)"
+                   if dev else " ".join(str(exc).split()))
+            if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
+                how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
+                       "relative to their lengths (allowed 1e-9), so it has no rulings to unroll along")
+            if be_error and "cannot be flattened" not in how and "cannot flatten" not in how:
+                how += f"; --best-effort cannot flatten it either: {be_error}"
+            allowed = ("allowed: developable faces" if be_error else
+                       "allowed: developable faces, or --best-effort to flatten it with a distortion report")
+            raise NotDevelopableError(
+                f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; {allowed}"
+            ) from None
+        except GHTError as exc:
+            raise type(exc)(f"{p}: face {k} of {n}: {' '.join(str(exc).split())}") from None
+        panel = pat.panels[0]
+        info = panel.info or {}
+        rep = panel.report.as_dict() if panel.report is not None else {}
+        report.append({
+            "face": k,
+            "label": panel.label,
+            "surface_type": _face_type_name(face),
+            "method": info.get("method"),
+            "best_effort": bool(best_effort),
+            "area_3d": float(panel.area_3d),
+            "area_flat": float(panel.area_flat),
+            "developability": info.get("developability"),
+            "errors": {q: v["max"] for q, v in rep.items()},
+        })
+        panels.extend(pat.panels)
+    mark_shared_edges(panels)
+    layout_panels(panels)
+    return StepUnroll(FlatPattern(panels, units=unit), unit, file_unit, n, report)
+
+
+def _face_type_name(face: Any) -> str:
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+
+    t = BRepAdaptor_Surface(face).GetType()
+    name = getattr(t, "name", str(t))
+    return name.replace("GeomAbs_", "").lower()
