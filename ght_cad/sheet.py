@@ -455,7 +455,8 @@ def _midline_speed(surface: RuledSurface, delta: float, u: np.ndarray) -> np.nda
 def _signed_turning(surface: RuledSurface, sheet: Sheet, sign: float, u: np.ndarray) -> np.ndarray:
     """``σ sgn(X_u·e) ω`` at mid-ruling relative to the sheet's normal (``sign`` × ruled normal)."""
     s, w = _across(surface, u, np.full_like(u, 0.5))
-    return sheet.sign * np.sign(s) * w  # ω and X_u·e both flip with the normal: sign cancels
+    # flipping n flips e = n × d and n', so ω = n'·e stays and X_u·e flips: hence the factor sign
+    return sheet.sign * sign * np.sign(s) * w
 
 
 def forming_rows(

@@ -41,6 +41,8 @@ def test_cylinder_face_offset_radius(side: str, sign: float) -> None:
     assert pat.area == pytest.approx(0.5 * math.pi * (r + sign * K * T) * h, rel=RTOL)
     (row,) = pat.sheet["forming"]
     assert row["radius_a"] == pytest.approx(r + sign * K * T, rel=RTOL)
+    # positive: the design face is the inside of the bend (material on the convex side)
+    assert row["angle_deg"] == pytest.approx(sign * 90.0, rel=RTOL)
     assert pat.errors["max"] < 1e-12
 
 
@@ -59,6 +61,7 @@ def test_cone_face_offset_sector() -> None:
     assert pat.area == pytest.approx(0.5 * ang * (rho[1] ** 2 - rho[0] ** 2), rel=RTOL)
     (row,) = pat.sheet["forming"]
     assert sorted([row["radius_a"], row["radius_b"]]) == pytest.approx([R2 / cos_a + K * T, R1 / cos_a + K * T], rel=RTOL)
+    assert row["angle_deg"] == pytest.approx(90.0 * cos_a, rel=RTOL)
 
 
 def test_faces_thickness_zero_bit_for_bit() -> None:

@@ -12,6 +12,13 @@ via the small adapter below (:func:`face_data`): FreeCAD's ``face.Surface`` eval
 holes are kept. Non-developable faces (sphere, torus, twisted loft) are refused with the
 isolines' deviation or θ_max / DD unless ``BestEffort``.
 
+Sheet metal (spec 6.1): with ``Thickness`` T > 0, ``KFactor`` K and ``Side`` (material along the
+face/surface normal or against it) the pattern is the development of the neutral surface
+``S ± K T n`` (:mod:`ght_cad.sheet`); with Thickness 0 and a face of a solid plate (a SheetMetal
+base bend, ``Part::Thickness``, ``makeThickness``) the thickness, inside face and side are read
+from the solid (:func:`plate_partner`). ``FormingTable`` lists each bend line's neutral bending
+radius and angle; the DXF export carries them on layer FORMING.
+
 Every boundary edge of the pattern is fitted as a planar B-spline edge (straight ones become
 line segments) and the interior rulings become bend-line edges. The shape is a compound of the
 planar face and the bend lines in the XY plane (move it with ``Placement``).
@@ -31,7 +38,18 @@ from ght_cad.face_unroll import EdgeData, FaceData, SurfaceAdapter, chain_loop, 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only
 from .convert import edge_from_data
 
-__all__ = ["FlatPatternFeature", "make_flat_pattern", "surface_of_source", "face_of_source", "face_data", "FreeCADSurface"]
+__all__ = [
+    "FlatPatternFeature",
+    "make_flat_pattern",
+    "surface_of_source",
+    "face_of_source",
+    "face_data",
+    "FreeCADSurface",
+    "plate_partner",
+]
+
+#: the Side property's values (ght_cad.sheet.SIDES): material along / against the face normal
+SIDES = ["normal", "reverse"]
 
 _KINDS = {
     "Plane": "plane",
@@ -192,7 +210,7 @@ def face_data(face: "Part.Face") -> FaceData:
         loops.append(
             [EdgeData(uv=e.uv, duv=e.duv, xyz=e.xyz, length_3d=e.length(), breaks=e.breaks(), name=f"edge{k}") for k, e in enumerate(edges)]
         )
-    return FaceData(surface=surf, bounds=(u0, u1, v0, v1), wires=loops)
+    return FaceData(surface=surf, bounds=(u0, u1, v0, v1), wires=loops, reversed=face.Orientation == "Reversed")
 
 
 def face_of_source(obj: Any) -> "Part.Face | None":
@@ -255,6 +273,48 @@ def _planar_edge(f: Callable[[np.ndarray], np.ndarray], tol: float) -> "Part.Edg
     return edge_from_data(data)
 
 
+def _grid_points(face: "Part.Face", n: int = 5) -> list[Any]:
+    """Points of ``face`` on an n x n grid of its parameter range (5 %..95 %)."""
+    u0, u1, v0, v1 = face.ParameterRange
+    return [face.valueAt(u0 + a * (u1 - u0), v0 + b * (v1 - v0)) for a in np.linspace(0.05, 0.95, n) for b in np.linspace(0.05, 0.95, n)]
+
+
+def plate_partner(shape: "Part.Shape", face: "Part.Face", rtol: float = 1e-6) -> tuple["Part.Face", float, str] | None:
+    r"""The plate a face belongs to (a SheetMetal-style or ``Part::Thickness`` solid).
+
+    Among the other faces of ``shape`` with at least a quarter of the face's area, the first whose
+    25 grid points lie at a constant distance (spread <= ``rtol`` x size) from the face's surface
+    (``Surface.parameter`` projection) is the opposite face. The inside face is the smaller of the
+    two (the concave side of a bend); the side is where the other face lies relative to the
+    inside face's normal (``normalAt``, orientation included).
+
+    Returns:
+        ``(inside face, thickness, side)`` or None (no solid, or no opposite face).
+    """
+    if not shape.Solids:
+        return None
+    size = max(shape.BoundBox.DiagonalLength, 1e-300)
+    for other in shape.Faces:
+        if other.isSame(face) or other.Area < 0.25 * face.Area:
+            continue
+        inner, outer = (face, other) if face.Area <= other.Area else (other, face)
+        dist, signs = [], []
+        for p in _grid_points(outer):
+            try:
+                u, v = inner.Surface.parameter(p)
+            except Exception:  # noqa: BLE001 - no projection onto this surface
+                break
+            q = inner.Surface.value(u, v)
+            dist.append((p - q).Length)
+            signs.append(inner.normalAt(u, v).dot(p - q))
+        if len(dist) < 25:
+            continue
+        T = float(np.mean(dist))
+        if T > 1e-9 * size and float(np.ptp(dist)) <= rtol * size:
+            return inner, T, ("normal" if float(np.median(signs)) > 0 else "reverse")
+    return None
+
+
 class FlatPatternFeature(FeatureProxy):
     """Proxy of a flat pattern (``Part::FeaturePython``)."""
 
@@ -270,8 +330,52 @@ class FlatPatternFeature(FeatureProxy):
         obj.addProperty("App::PropertyFloat", "MaxRelativeError", "Output", "Largest relative error of boundary lengths, ruling lengths and area (flat vs 3-D)")
         self.restored(obj)
 
+    @staticmethod
+    def _sheet_properties(obj: Any) -> None:
+        """Sheet properties (added to documents saved before they existed)."""
+        have = set(obj.PropertiesList)
+        if "Thickness" not in have:
+            obj.addProperty("App::PropertyLength", "Thickness", "Sheet", "Sheet thickness T (0: the surface itself, or read from the solid the face belongs to)")
+        if "KFactor" not in have:
+            obj.addProperty("App::PropertyFloat", "KFactor", "Sheet", "ANSI K-factor in [0, 1]: the neutral surface lies K*T from the inside face (DIN k = 2K)")
+            obj.KFactor = 0.5
+        if "Side" not in have:
+            obj.addProperty("App::PropertyEnumeration", "Side", "Sheet", "Where the material lies: 'normal' (along the face/surface normal) or 'reverse' (against it)")
+            obj.Side = SIDES
+            obj.Side = "normal"
+        if "ThicknessFromSolid" not in have:
+            obj.addProperty("App::PropertyBool", "ThicknessFromSolid", "Sheet", "With Thickness 0 and a face of a solid plate: use the solid's thickness, inside face and side")
+            obj.ThicknessFromSolid = True
+        if "ThicknessUsed" not in have:
+            obj.addProperty("App::PropertyFloat", "ThicknessUsed", "Output", "Sheet thickness the pattern was made with (0: none)")
+        if "FormingTable" not in have:
+            obj.addProperty("App::PropertyStringList", "FormingTable", "Output", "Bend lines: neutral bending radius at both ruling ends and angle turned")
+
     def restored(self, obj: Any) -> None:
-        set_read_only(obj, ("AreaFlat", "Area3D", "MaxRelativeError"))
+        self._sheet_properties(obj)
+        set_read_only(obj, ("AreaFlat", "Area3D", "MaxRelativeError", "ThicknessUsed", "FormingTable"))
+
+    def sheet(self, obj: Any, face: Any) -> tuple[Any, Any]:
+        """``(sheet or None, face to unroll)``: the Thickness/KFactor/Side properties, or with
+        Thickness 0 the plate the face belongs to (:func:`plate_partner`: its inside face,
+        thickness and side).
+
+        Raises:
+            SheetError: a bad K-factor or a thickness beyond a bending radius (naming the value).
+        """
+        from ght_cad.sheet import Sheet
+
+        T = float(obj.Thickness.Value) if hasattr(obj.Thickness, "Value") else float(obj.Thickness)
+        K = float(obj.KFactor)
+        if T > 0:
+            return Sheet(T, K, str(obj.Side)), face
+        if face is not None and bool(obj.ThicknessFromSolid):
+            found = plate_partner(obj.Source[0].Shape, face)
+            if found is not None:
+                inner, thickness, side = found
+                return Sheet(thickness, K, side), inner
+        Sheet(0.0, K, str(obj.Side))  # validates K and Side even without a thickness
+        return None, face
 
     def pattern(self, obj: Any) -> Any:
         """The core :class:`ght_cad.flat_pattern.FlatPattern` of the source."""
@@ -280,12 +384,14 @@ class FlatPatternFeature(FeatureProxy):
         if int(obj.BendLines) < 0:
             raise ValueError(f"{obj.Label}: BendLines={int(obj.BendLines)} is not allowed; allowed: 0 or more bend lines")
         opts = dict(rulings=int(obj.BendLines), best_effort=bool(obj.BestEffort), samples=65)
+        self._sheet_properties(obj)
         face = face_of_source(obj)
+        sheet, face = self.sheet(obj, face)
         if face is None:
-            return unroll(surface_of_source(obj), **opts)
+            return unroll(surface_of_source(obj), sheet=sheet, **opts)
         src, subs = obj.Source
         label = src.Label + "".join(f".{x}" for x in (subs or [])[:1] if x)
-        return unroll_face_data(face_data(face), label=label, **opts)
+        return unroll_face_data(face_data(face), label=label, sheet=sheet, **opts)
 
     def compute(self, obj: Any) -> None:
         pat = self.pattern(obj)
@@ -313,6 +419,9 @@ class FlatPatternFeature(FeatureProxy):
         obj.AreaFlat = float(pat.area)
         obj.Area3D = float(sum(p.area_3d for p in pat.panels))
         obj.MaxRelativeError = float(pat.errors["max"])
+        sh = pat.sheet
+        obj.ThicknessUsed = float(sh["thickness"]) if sh else 0.0
+        obj.FormingTable = pat.forming_table().splitlines() if sh else []
         obj.Shape = Part.makeCompound(faces + bends)
 
 
@@ -322,11 +431,25 @@ class ViewProviderFlatPattern(ViewProviderBase):
     line_color = (0.7, 0.1, 0.1)
 
 
-def make_flat_pattern(source: Any, sub: str = "", bend_lines: int = 8, *, doc: Any = None, name: str = "FlatPattern") -> Any:
-    """Create the flat pattern of a developable feature (or of its face ``sub``)."""
+def make_flat_pattern(
+    source: Any,
+    sub: str = "",
+    bend_lines: int = 8,
+    *,
+    doc: Any = None,
+    name: str = "FlatPattern",
+    thickness: float = 0.0,
+    k_factor: float = 0.5,
+    side: str = "normal",
+) -> Any:
+    """Create the flat pattern of a developable feature (or of its face ``sub``); with a
+    ``thickness`` (or a face of a solid plate) the pattern is the sheet's neutral surface."""
     obj = new_feature(doc or source.Document, name, FlatPatternFeature, ViewProviderFlatPattern)
     obj.Source = (source, [sub] if sub else [])
     obj.BendLines = int(bend_lines)
+    obj.Thickness = float(thickness)
+    obj.KFactor = float(k_factor)
+    obj.Side = side
     obj.Document.recompute()
     # lay the pattern beside its source (XY plane, to the +x side); later recomputes keep it
     src, flat = source.Shape.BoundBox, obj.Shape.BoundBox

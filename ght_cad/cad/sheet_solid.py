@@ -1,0 +1,368 @@
+r"""The sheet as a solid plate (spec 6.1) through OCCT, and plates read back from STEP.
+
+:func:`plate_solid` thickens the design face (the exact B-spline face of a developable, or any
+build123d/cadquery/OCP face) by the sheet thickness ``T`` on the material side with
+``BRepOffset_MakeOffset`` (skin mode, thickening: the outside face is the offset surface
+``S + σ T n``, the side faces are swept along the normals of the boundary edges). Faces are
+classified by the distance of their parameter-box centre point from the design surface: below
+``T/4`` the inside face, above ``3T/4`` the outside face, the rest the edge faces. For a developable surface the B-spline face is
+fitted with a tolerance of ``3e-7 T`` (a fit deviation ``d`` changes the volume by ``d / T``
+relative: a thin plate needs a fit far tighter than the surface's size).
+
+:func:`write_plate_step` writes the solid through XCAF (``STEPCAFControl_Writer``) with the faces
+named ``inside``, ``outside`` and ``edge1..edgeN`` (STEP ``ADVANCED_FACE`` names);
+:func:`read_step_face_names` reads the names back and :func:`plate_faces` finds the inside and
+outside faces of a plate solid read from STEP (by those names, else geometrically: the two largest
+faces at a constant distance from each other) and the thickness between them.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepOffset import BRepOffset_MakeOffset, BRepOffset_Skin
+from OCP.BRepTools import BRepTools
+from OCP.GeomAbs import GeomAbs_Arc
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.GProp import GProp_GProps
+from OCP.BRep import BRep_Tool
+from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
+
+from ..errors import GHTError
+from ..ruled import RuledSurface
+from ..sheet import Sheet, SheetError, make_sheet
+from .occ import is_valid, quiet_occt, unwrap
+
+__all__ = ["PlateSolid", "plate_solid", "write_plate_step", "read_step_face_names", "plate_faces", "PlateFaces"]
+
+
+@dataclass
+class PlateSolid:
+    """A thickened plate: the solid and its classified faces.
+
+    Attributes:
+        solid: the OCP ``TopoDS_Solid``.
+        inside: the design face (inside face of the sheet).
+        outside: the offset face ``S + σ T n``.
+        edges: the side faces.
+        sheet: the sheet.
+    """
+
+    solid: TopoDS_Shape
+    inside: TopoDS_Face
+    outside: TopoDS_Face
+    edges: list[TopoDS_Face]
+    sheet: Sheet
+
+    def named_faces(self) -> list[tuple[str, TopoDS_Face]]:
+        """``[("inside", f), ("outside", f), ("edge1", f), ...]``."""
+        return [("inside", self.inside), ("outside", self.outside)] + [(f"edge{i + 1}", f) for i, f in enumerate(self.edges)]
+
+    @property
+    def volume(self) -> float:
+        from .occ import volume
+
+        return volume(self.solid)
+
+
+def _faces(shape: TopoDS_Shape) -> list[TopoDS_Face]:
+    out = []
+    exp = TopExp_Explorer(shape, TopAbs_FACE)
+    while exp.More():
+        out.append(TopoDS.Face_s(exp.Current()))
+        exp.Next()
+    return out
+
+
+def _centre_area(face: TopoDS_Face) -> tuple[np.ndarray, float]:
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(face, props)
+    c = props.CentreOfMass()
+    return np.array([c.X(), c.Y(), c.Z()]), float(props.Mass())
+
+
+def _distance_to_surface(face: TopoDS_Face, point: np.ndarray) -> float:
+    from OCP.gp import gp_Pnt
+
+    proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*map(float, point)), BRep_Tool.Surface_s(face))
+    return float(proj.LowerDistance()) if proj.NbPoints() else math.inf
+
+
+def _face_sheet_check(face: TopoDS_Face, sheet: Sheet, label: str) -> None:
+    """The core's curvature check on a CAD face (:class:`ght_cad.sheet.FaceSheet`)."""
+    from ..sheet import FaceSheet
+    from .unroll_faces import _open_face, face_data
+
+    f, _, bounds, ev = _open_face(face)
+    FaceSheet(face_data(f, ev, bounds), sheet, label)
+
+
+def plate_solid(
+    surface_or_face: Any,
+    sheet: Sheet | None = None,
+    *,
+    thickness: float | None = None,
+    k_factor: float | None = None,
+    side: str = "normal",
+    label: str = "plate",
+) -> PlateSolid:
+    r"""The plate of thickness T on the design surface as a valid solid (module doc).
+
+    Args:
+        surface_or_face: a developable :class:`~ght_cad.ruled.RuledSurface` (made into its exact
+            B-spline face, fit tolerance ``3e-7 T``) or a build123d/cadquery/OCP face.
+        sheet: the sheet, or give ``thickness``, ``k_factor``, ``side``
+            (:func:`ght_cad.sheet.make_sheet`; K does not change the solid).
+        label: name for messages.
+
+    Returns:
+        :class:`PlateSolid` (``BRepCheck_Analyzer`` valid).
+
+    Raises:
+        SheetError: no thickness, T = 0, or a thickness beyond a bending radius (before OCCT runs).
+        GHTError: OCCT failed to make a valid solid.
+    """
+    if sheet is None:
+        sheet = make_sheet(thickness, k_factor, side=side)
+    if sheet is None or sheet.is_zero:
+        raise SheetError(f"thickness={None if sheet is None else sheet.thickness!r} is not allowed for a solid plate; give a thickness > 0")
+    if isinstance(surface_or_face, RuledSurface):
+        from ..sheet import check_offset
+        from .developable_faces import developable_face
+
+        check_offset(surface_or_face, sheet, f"surface {label!r}")
+        face = unwrap(developable_face(surface_or_face, tol=3e-7 * sheet.thickness))
+    else:
+        shape = unwrap(surface_or_face)
+        if not isinstance(shape, TopoDS_Shape) or shape.IsNull():
+            raise GHTError(f"cannot thicken a {type(surface_or_face).__name__}; give a RuledSurface or a face")
+        faces = _faces(shape)
+        if len(faces) != 1:
+            raise GHTError(f"the shape has {len(faces)} faces; a plate is made from exactly one face")
+        face = faces[0]
+        _face_sheet_check(face, sheet, label)
+    T = sheet.thickness
+    with quiet_occt():
+        mo = BRepOffset_MakeOffset()
+        # skin mode, no intersection/self-intersection, arc joins, thickening (a solid), keep edges
+        mo.Initialize(face, sheet.outside_offset, 1e-7, BRepOffset_Skin, False, False, GeomAbs_Arc, True, False)
+        mo.MakeOffsetShape()
+    if not mo.IsDone():
+        raise GHTError(f"OCCT could not thicken {label!r} by thickness={T!r} (BRepOffset error {mo.Error()})")
+    solid = mo.Shape()
+    if solid.ShapeType() != TopAbs_SOLID:
+        exp = TopExp_Explorer(solid, TopAbs_SOLID)
+        if not exp.More():
+            raise GHTError(f"thickening {label!r} by thickness={T!r} gave no solid")
+        solid = TopoDS.Solid_s(exp.Current())
+    if not is_valid(solid):
+        raise GHTError(f"thickening {label!r} by thickness={T!r} gave an invalid solid (BRepCheck_Analyzer)")
+    inside, outside, edges = None, None, []
+    for f in _faces(solid):
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(f)  # a point on the face (its centre of mass is not)
+        c = np.array(BRepAdaptor_Surface(f).Value(0.5 * (u0 + u1), 0.5 * (v0 + v1)).Coord())
+        d = _distance_to_surface(face, c)
+        if f.IsSame(face) or d < 0.25 * T:
+            inside = f if inside is None else inside
+        elif d > 0.75 * T and outside is None:
+            outside = f
+        else:
+            edges.append(f)
+    if inside is None or outside is None:
+        raise GHTError(f"the thickened plate {label!r} has no inside/outside face pair")
+    return PlateSolid(solid, inside, outside, edges, sheet)
+
+
+def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm") -> str:
+    """Write plate solid(s) to STEP with named faces, atomically.
+
+    The solids go through ``STEPControl_Writer``; each face's ``ADVANCED_FACE`` entity (found by
+    ``STEPConstruct::FindEntity`` in the writer's finder process) is named ``inside``,
+    ``outside`` or ``edge1..edgeN`` (:meth:`PlateSolid.named_faces`).
+
+    Args:
+        plate: one plate or several (written as a compound).
+        path: target file.
+        units: length unit of the coordinates (mm, cm, m, in, ft).
+
+    Raises:
+        GHTError: an invalid solid, an unknown unit or a failed write (the target is untouched).
+    """
+    from OCP.BRep import BRep_Builder
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.Interface import Interface_Static
+    from OCP.STEPConstruct import STEPConstruct
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TCollection import TCollection_HAsciiString
+    from OCP.TopoDS import TopoDS_Compound
+
+    from ..io import atomic_path
+    from .occ import STEP_UNITS
+
+    plates = plate if isinstance(plate, list) else [plate]
+    if units not in STEP_UNITS:
+        raise GHTError(f"units={units!r} is not a STEP length unit; allowed: {', '.join(STEP_UNITS)}")
+    for i, p in enumerate(plates):
+        if not is_valid(p.solid):
+            raise GHTError(f"plate #{i + 1} is not a valid solid (BRepCheck_Analyzer); not exported to {path}")
+    if len(plates) == 1:
+        shape = plates[0].solid
+    else:
+        shape = TopoDS_Compound()
+        bb = BRep_Builder()
+        bb.MakeCompound(shape)
+        for p in plates:
+            bb.Add(shape, p.solid)
+    step_unit, mm_per_unit = STEP_UNITS[units]
+    with quiet_occt():
+        STEPControl_Writer()  # registers the statics
+        previous = Interface_Static.CVal_s("write.step.unit")
+        Interface_Static.SetCVal_s("write.step.unit", step_unit)
+        try:
+            writer = STEPControl_Writer()
+            writer.Model().SetLocalLengthUnit(mm_per_unit)
+            writer.Transfer(shape, STEPControl_AsIs)
+            finder = writer.WS().TransferWriter().FinderProcess()
+            for p in plates:
+                for name, f in p.named_faces():
+                    item = STEPConstruct.FindEntity_s(finder, f)
+                    if item is None:
+                        raise GHTError(f"the STEP entity of face {name!r} was not found; not exported to {path}")
+                    item.SetName(TCollection_HAsciiString(name))
+            with atomic_path(path) as tmp:
+                if writer.Write(str(tmp)) != IFSelect_RetDone:
+                    raise GHTError(f"OCCT failed to write STEP file {path}")
+        finally:
+            Interface_Static.SetCVal_s("write.step.unit", previous)
+    return str(path)
+
+
+def read_step_face_names(path: str | os.PathLike) -> tuple[TopoDS_Shape, dict[int, str]]:
+    """Read a STEP file: the shape and ``{face index (0-based, TopExp order): name}`` of the faces
+    whose ``ADVANCED_FACE`` entity has a non-empty name (e.g. from :func:`write_plate_step`).
+
+    Raises:
+        GHTError: the file cannot be read.
+    """
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
+    with quiet_occt():
+        reader = STEPControl_Reader()
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise GHTError(f"could not read STEP file {path}")
+        reader.TransferRoots()
+        shape = reader.OneShape()
+    tr = reader.WS().TransferReader()
+    names: dict[int, str] = {}
+    for k, f in enumerate(_faces(shape)):
+        ent = tr.EntityFromShapeResult(f, 1)
+        if ent is None:
+            continue
+        nm = getattr(ent, "Name", None)
+        if nm is None:
+            continue
+        text = nm().ToCString() if nm() is not None else ""
+        if text:
+            names[k] = text
+    return shape, names
+
+
+@dataclass
+class PlateFaces:
+    """The inside and outside faces of a plate solid and the thickness between them.
+
+    Attributes:
+        inside, outside: the two faces (``TopoDS_Face``); inside = the concave (shorter) one.
+        inside_index, outside_index: their 0-based indices among the shape's faces.
+        thickness: mean distance of the outside face's points from the inside face's surface.
+        spread: max - min of that distance (0 for a true plate).
+        how: "names" (STEP face names) or "geometry".
+        side: the sheet side relative to the inside face's normal (orientation included).
+    """
+
+    inside: TopoDS_Face
+    outside: TopoDS_Face
+    inside_index: int
+    outside_index: int
+    thickness: float
+    spread: float
+    how: str
+    side: str
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def _offset_distance(inner: TopoDS_Face, outer: TopoDS_Face, n: int = 5) -> tuple[np.ndarray, float]:
+    """Distances of an n x n grid of points of ``outer`` (inside its UV box, 5 %..95 %) from
+    ``inner``'s surface, and the sign of the side relative to inner's face normal."""
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    ad = BRepAdaptor_Surface(outer)
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(outer)
+    surf = BRep_Tool.Surface_s(inner)
+    inner_ad = BRepAdaptor_Surface(inner)
+    rev = -1.0 if inner.Orientation() == 1 else 1.0  # TopAbs_REVERSED == 1
+    dist, signs = [], []
+    for a in np.linspace(0.05, 0.95, n):
+        for b in np.linspace(0.05, 0.95, n):
+            p = ad.Value(u0 + a * (u1 - u0), v0 + b * (v1 - v0))
+            proj = GeomAPI_ProjectPointOnSurf(p, surf)
+            if not proj.NbPoints():
+                continue
+            dist.append(proj.LowerDistance())
+            uu, vv = proj.LowerDistanceParameters()
+            q, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+            inner_ad.D1(uu, vv, q, du, dv)
+            nrm = du.Crossed(dv)
+            signs.append(rev * (gp_Vec(q, p).Dot(nrm)))
+    return np.asarray(dist), (1.0 if np.median(signs) > 0 else -1.0) if signs else 1.0
+
+
+def plate_faces(shape: Any, names: dict[int, str] | None = None, *, rtol: float = 1e-6) -> PlateFaces | None:
+    """Find the inside/outside faces of a plate solid (module doc), or None if it is no plate.
+
+    By names: faces named ``inside`` and ``outside``. Else geometrically: among pairs of the
+    largest faces (each at least a quarter of the largest's area), the pair whose points lie at a
+    constant distance (spread <= ``rtol`` × size, distance > 0) from the other's surface; the face
+    with the smaller area is the inside (the concave side of a bend).
+
+    Returns:
+        :class:`PlateFaces` with the thickness between them (mean of 25 sampled distances).
+    """
+    faces = _faces(unwrap(shape))
+    if len(faces) < 2:
+        return None
+    areas = [_centre_area(f)[1] for f in faces]
+    size = max(math.sqrt(a) for a in areas)
+    pairs: list[tuple[int, int, str]] = []
+    if names:
+        ins = [k for k, v in names.items() if v == "inside"]
+        outs = [k for k, v in names.items() if v == "outside"]
+        if len(ins) == 1 and len(outs) == 1:
+            pairs.append((ins[0], outs[0], "names"))
+    if not pairs:
+        big = sorted(range(len(faces)), key=lambda k: -areas[k])
+        big = [k for k in big if areas[k] >= 0.25 * areas[big[0]]][:6]
+        for i in range(len(big)):
+            for j in range(i + 1, len(big)):
+                a, b = big[i], big[j]
+                inner, outer = (a, b) if areas[a] <= areas[b] else (b, a)
+                pairs.append((inner, outer, "geometry"))
+    for inner, outer, how in pairs:
+        d, sign = _offset_distance(faces[inner], faces[outer])
+        if d.size == 0:
+            continue
+        T = float(np.mean(d))
+        spread = float(np.ptp(d))
+        if T > 1e-9 * size and (how == "names" or spread <= rtol * size):
+            return PlateFaces(faces[inner], faces[outer], inner, outer, T, spread, how,
+                              "normal" if sign > 0 else "reverse", {"areas": (areas[inner], areas[outer])})
+    return None
