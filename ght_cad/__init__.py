@@ -59,6 +59,7 @@ __all__ = [
     "curve_to_bspline",
     "fit_function",
     "GHTSurface",
+    "developable_loft",
 ]
 
 # Names provided by modules that import scipy or are heavier: loaded on first use so that
@@ -72,6 +73,7 @@ _LAZY: dict[str, str] = {
     "curve_to_bspline": "ght_cad.bspline",
     "fit_function": "ght_cad.bspline",
     "GHTSurface": "ght_cad.patch",
+    "developable_loft": "ght_cad.loft",
 }
 
 

@@ -38,7 +38,7 @@ from .bspline import BSplineSurfaceData, fit_function
 from .curve import GHTCurve
 from .errors import ConversionError, DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
 from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
-from .ruled import Developability, RuledSurface
+from .ruled import Developability, RuledSurface, regression_v
 
 __all__ = [
     "EnvelopeDevelopable",
@@ -777,14 +777,8 @@ def _check_strip_regular(surf: RuledSurface, samples: int = 513, what: str = "st
     a1 = surf.a(u, 1)
     g = surf.ruling(u)
     g1 = surf.ruling(u, 1)
-    c1 = np.cross(a1, g)
-    c2 = np.cross(g1, g)
-    den = np.sum(c2 * c2, axis=1)
-    scale = np.sum(g * g, axis=1) * np.sum(g1 * g1, axis=1)
-    ok = den > 1e-24 * np.maximum(scale, 1e-300)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        vs = np.where(ok, -np.sum(c1 * c2, axis=1) / np.where(ok, den, 1.0), np.inf)
-    inside = ok & (vs >= 0.0) & (vs <= 1.0)
+    vs = regression_v(a1, g, g1)
+    inside = np.isfinite(vs) & (vs >= 0.0) & (vs <= 1.0)
     if inside.any():
         i = int(np.argmax(inside))
         raise EdgeOfRegressionError(

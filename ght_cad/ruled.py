@@ -28,6 +28,7 @@ __all__ = [
     "CurvePairRuledSurface",
     "FunctionRuledSurface",
     "developability_from_jets",
+    "regression_v",
 ]
 
 
@@ -109,6 +110,19 @@ def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, n
         cr = np.linalg.norm(np.cross(na, nb), axis=-1)
         th = np.degrees(np.arctan2(cr, dot))
     return np.where(ok, th, np.nan), np.where(ok, dot, np.nan)
+
+
+def regression_v(a1: np.ndarray, g: np.ndarray, g1: np.ndarray) -> np.ndarray:
+    r"""Edge-of-regression parameter on the rulings of ``X = a + v g`` (spec 5.7):
+    ``v* = -((a' × g)·(g' × g)) / |g' × g|²``, where ``X_u = a' + v g'`` is parallel to ``g``;
+    ``inf`` where ``|g' × g|`` vanishes (cylinder-like: no singular point)."""
+    c1 = np.cross(a1, g)
+    c2 = np.cross(g1, g)
+    den = np.sum(c2 * c2, axis=1)
+    scale = np.sum(g * g, axis=1) * np.sum(g1 * g1, axis=1)
+    ok = den > 1e-24 * np.maximum(scale, 1e-300)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(ok, -np.sum(c1 * c2, axis=1) / np.where(ok, den, 1.0), np.inf)
 
 
 def developability_from_jets(

@@ -110,8 +110,15 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
     L1 = np.einsum("ij,ij->i", d, g1)
     d1 = (g1 - d * L1[:, None]) / L[:, None]
     c = np.cross(a1, d)
-    cn = np.linalg.norm(c, axis=1)
     scale = np.linalg.norm(a1, axis=1)
+    # a stationary directrix (the apex of a cone, e.g. a loft's fan with apex on rail a): the
+    # tangent plane along the ruling is spanned by d and b' (X_u × X_v = v b' × g there)
+    b1 = a1 + g1
+    apex = scale <= 1e-12 * np.linalg.norm(b1, axis=1)
+    if apex.any():
+        c = np.where(apex[:, None], np.cross(b1, d), c)
+        scale = np.where(apex, np.linalg.norm(b1, axis=1), scale)
+    cn = np.linalg.norm(c, axis=1)
     if not np.all(cn > 1e-12 * np.maximum(scale, 1e-300)):
         i = int(np.argmin(cn / np.maximum(scale, 1e-300)))
         raise DegenerateGeometryError(
@@ -251,7 +258,7 @@ def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> 
         f = (lambda t: np.linalg.norm(surface.a(t, 1), axis=1)) if which == "a" else (
             lambda t: np.linalg.norm(surface.b(t, 1), axis=1)
         )
-        return integrate(f, 0.0, 1.0, rtol=1e-14)
+        return sum(integrate(f, lo, hi, rtol=1e-14) for lo, hi in _smooth_pieces(surface))
 
     def edge(name: str, uv: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], length: float) -> BoundaryEdge:
         def flat(t: np.ndarray) -> np.ndarray:
@@ -275,8 +282,16 @@ def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> 
     ]
 
 
+def _smooth_pieces(surface: RuledSurface) -> list[tuple[float, float]]:
+    """Sub-intervals of [0, 1] between the surface's ``breakpoints`` (where a, b are not smooth)."""
+    bp = sorted(b for b in getattr(surface, "breakpoints", ()) if 0.0 < b < 1.0)
+    edges = [0.0, *bp, 1.0]
+    return [(lo, hi) for lo, hi in zip(edges[:-1], edges[1:]) if hi > lo]
+
+
 def ruled_area(surface: RuledSurface, rtol: float = 1e-14) -> float:
-    """3-D area ``∫_0^1 ∫_0^1 |(a' + v g') × g| dv du`` (Gauss–Legendre in v, adaptive in u)."""
+    """3-D area ``∫_0^1 ∫_0^1 |(a' + v g') × g| dv du`` (Gauss–Legendre in v, adaptive in u,
+    piecewise between the surface's ``breakpoints``)."""
     tv, wv = gauss_legendre(16)
 
     def f(u: np.ndarray) -> np.ndarray:
@@ -286,7 +301,7 @@ def ruled_area(surface: RuledSurface, rtol: float = 1e-14) -> float:
         xu = a1[:, None, :] + tv[None, :, None] * g1[:, None, :]
         return np.linalg.norm(np.cross(xu, g[:, None, :]), axis=2) @ wv
 
-    return integrate(f, 0.0, 1.0, rtol=rtol)
+    return sum(integrate(f, lo, hi, rtol=rtol) for lo, hi in _smooth_pieces(surface))
 
 
 def broadcast_uv(u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -340,7 +355,9 @@ def _metric_samples(surface: RuledSurface, dev: RuledDevelopment, n: int = 24) -
     U, Vv = np.meshgrid(u, v, indexing="ij")
     U, Vv = U.ravel(), Vv.ravel()
     xu, xv = surface.partials(U, Vv)
-    return metric_angles(xu, xv, dev.map, U, Vv, 1e-3, 1e-3)
+    # at a cone's apex on a boundary (X_u = 0) the angle is undefined: leave those points out
+    keep = np.linalg.norm(xu, axis=1) > 1e-9 * np.linalg.norm(xv, axis=1)
+    return metric_angles(xu[keep], xv[keep], dev.map, U[keep], Vv[keep], 1e-3, 1e-3)
 
 
 def _check_developable(surface: RuledSurface, tol_deg: float, best_effort: bool, what: str) -> Any:

@@ -1,0 +1,1421 @@
+r"""Exact developable loft between two rails (spec section 5.7).
+
+For rails ``a(t)``, ``b(s)``, t, s ∈ [0, 1], the segment ``a(t)–b(s)`` is a ruling of a
+developable through both rails iff the tangent plane is the same at its two ends:
+
+    F(t, s) = det(a'(t), b'(s), b(s) - a(t)) = 0.
+
+The loft is one branch of the zero set of F in the unit square, an increasing curve ``s = σ(t)``
+(rulings must not cross). It is traced by predictor–corrector continuation in the path parameter
+``λ = (t + s) / 2``: on the branch ``t + s = 2λ`` and ``F = 0`` give
+
+    dt/dλ = 2 F_s / (F_s - F_t),   ds/dλ = -2 F_t / (F_s - F_t),
+
+(both >= 0 on an increasing branch; ``F_t = det(a'', b', g)``, ``F_s = det(a', b'', g)``,
+``g = b - a``) and every point is corrected by Newton's method on ``G(t) = F(t, 2λ - t)`` to
+round-off, so θ of spec section 5 is round-off on every ruling. Where the branch meets a side of
+the square the loft is completed by fans, cones with apex at a rail end: the branch starting on
+``s = 0`` at ``t0 > 0`` adds the fan with apex ``b(0)`` over ``a([0, t0])``, starting on ``t = 0``
+at ``s0 > 0`` the fan with apex ``a(0)`` over ``b([0, s0])``, and likewise at the upper-right
+sides with apex ``a(1)`` or ``b(1)``. The whole loft is then the path from the corner (0, 0) to
+(1, 1) in the (t, s) square, parametrized by ``λ ∈ [0, 1]``: fans run along the sides, the main
+part along the branch. So both rails are covered over their whole length, the fans share the
+tangent plane of the main part along the common ruling (G1), and the loft is one ruled surface
+``X(λ, v) = (1-v) a(t(λ)) + v b(s(λ))`` that unrolls as one panel.
+
+Rails running opposite ways (the developable pairs a(t) with a decreasing s) are handled by
+tracing with rail b reversed (``orientation="auto"`` tries both).
+
+This module imports numpy and scipy only; matplotlib is imported inside :func:`plot_loft_sign`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from functools import cached_property
+from typing import Any, Callable, Mapping, Protocol, Sequence, runtime_checkable
+
+import numpy as np
+
+from ._validate import as_parameter_array
+from .curve import GHTCurve, gauss_legendre
+from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from .optimize.problems import Problem
+from .ruled import Developability, RuledSurface, regression_v
+
+__all__ = [
+    "Rail",
+    "CallableRail",
+    "as_rail",
+    "developable_loft",
+    "DevelopableLoft",
+    "LoftSegment",
+    "LoftReport",
+    "loft_function",
+    "plot_loft_sign",
+    "LoftProblem",
+    "LOFT_OBJECTIVES",
+]
+
+_EPS = np.finfo(float).eps
+#: relative size of a fan (in the rail parameter) below which the branch is taken to start or end
+#: at the corner (no fan)
+MIN_FAN = 1e-12
+
+
+# ----------------------------------------------------------------------------------------------
+# rails
+# ----------------------------------------------------------------------------------------------
+@runtime_checkable
+class Rail(Protocol):
+    """What a rail must provide: positions and derivatives on t ∈ [0, 1], each (n, 3).
+
+    GHTCurve objects qualify; CAD edges are wrapped in :class:`CallableRail` by the adapters.
+    """
+
+    def evaluate(self, t: Any) -> np.ndarray:  # pragma: no cover - protocol
+        """Points ``r(t)``, shape (n, 3)."""
+
+    def derivative(self, t: Any, order: int = 1) -> np.ndarray:  # pragma: no cover - protocol
+        """Derivative ``r^(order)(t)``, shape (n, 3)."""
+
+
+def _fd(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, h: float = 1e-3) -> np.ndarray:
+    r"""Derivative of ``fun`` by 4th-order differences inside [0, 1].
+
+    Central ``(-f(t+2h) + 8f(t+h) - 8f(t-h) + f(t-2h)) / 12h`` where the stencil fits in [0, 1],
+    else the one-sided ``±(-25 f(t) + 48 f(t±h) - 36 f(t±2h) + 16 f(t±3h) - 3 f(t±4h)) / 12h``.
+    """
+    out = np.empty((t.size, 3))
+    lo = t < 2 * h
+    hi = (t > 1 - 2 * h) & ~lo
+    mid = ~(lo | hi)
+    if mid.any():
+        x = t[mid]
+        out[mid] = (-fun(x + 2 * h) + 8 * fun(x + h) - 8 * fun(x - h) + fun(x - 2 * h)) / (12 * h)
+    for mask, sgn in ((lo, 1.0), (hi, -1.0)):
+        if mask.any():
+            x = t[mask]
+            hh = sgn * h
+            out[mask] = (-25 * fun(x) + 48 * fun(x + hh) - 36 * fun(x + 2 * hh) + 16 * fun(x + 3 * hh)
+                         - 3 * fun(x + 4 * hh)) / (12 * hh)
+    return out
+
+
+def _as_points(value: Any, n: int, what: str) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.size != 3 * n:
+        raise GHTError(f"{what} returned an array of shape {arr.shape}; expected ({n}, 3)")
+    return arr.reshape(n, 3)
+
+
+class CallableRail:
+    r"""A rail from plain callables ``position(t)``, ``first(t)`` (and optionally ``second(t)``).
+
+    Each callable takes a 1-D array of parameters in [0, 1] and returns an (n, 3) array. Higher
+    derivatives that are not given are computed by 4th-order finite differences of the highest
+    given one (step 1e-3 in t, error about 1e-12 of the curve size for a smooth edge), which is
+    what the CAD adapters use for edges whose kernel gives only two derivatives.
+
+    Args:
+        position: ``t -> r(t)``.
+        first: ``t -> r'(t)``.
+        second: ``t -> r''(t)`` or None.
+        name: label used in error messages.
+    """
+
+    def __init__(
+        self,
+        position: Callable[[np.ndarray], Any],
+        first: Callable[[np.ndarray], Any],
+        second: Callable[[np.ndarray], Any] | None = None,
+        *,
+        name: str = "rail",
+    ) -> None:
+        for nm, f in (("position", position), ("first", first), ("second", second)):
+            if f is not None and not callable(f):
+                raise GHTError(f"CallableRail {nm} must be callable, got {type(f).__name__}")
+        self._f = [position, first, second]
+        self.name = name
+
+    def _call(self, r: int, t: np.ndarray) -> np.ndarray:
+        return _as_points(self._f[r](t), t.size, f"{self.name} derivative {r}")
+
+    def _deriv(self, t: np.ndarray, r: int) -> np.ndarray:
+        if r < len(self._f) and self._f[r] is not None:
+            return self._call(r, t)
+        return _fd(lambda x: self._deriv(x, r - 1), t)
+
+    def evaluate(self, t: Any) -> np.ndarray:
+        """Points ``r(t)``, shape (n, 3)."""
+        return self.derivative(t, 0)
+
+    def derivative(self, t: Any, order: int = 1) -> np.ndarray:
+        """``r^(order)(t)`` for order 0..3 (given callables or finite differences of them)."""
+        if order not in (0, 1, 2, 3):
+            raise GHTError(f"order={order!r} is not allowed; rails give derivatives of order 0..3")
+        tt, _ = as_parameter_array(t, "t")
+        return self._deriv(tt, order)
+
+    def __repr__(self) -> str:
+        return f"CallableRail(name={self.name!r})"
+
+
+class _ObjectRail:
+    """Adapter for any object with ``evaluate(t)`` and ``derivative(t, order)`` (GHTCurve too).
+
+    Orders the object refuses are computed by finite differences of the highest it gives.
+    """
+
+    def __init__(self, obj: Any, name: str) -> None:
+        self.obj = obj
+        self.name = name
+        self._max_order = 3
+
+    def _call(self, t: np.ndarray, r: int) -> np.ndarray:
+        if r == 0:
+            return _as_points(self.obj.evaluate(t), t.size, f"{self.name}.evaluate")
+        return _as_points(self.obj.derivative(t, r), t.size, f"{self.name}.derivative(order={r})")
+
+    def derivative(self, t: Any, order: int = 1) -> np.ndarray:
+        tt, _ = as_parameter_array(t, "t")
+        if order <= self._max_order:
+            try:
+                return self._call(tt, order)
+            except (NotImplementedError, TypeError, ValueError) as exc:
+                if order <= 1 or isinstance(exc, GHTError) and "order" not in str(exc):
+                    raise
+                self._max_order = order - 1
+        return _fd(lambda x: self.derivative(x, order - 1), tt)
+
+    def evaluate(self, t: Any) -> np.ndarray:
+        return self.derivative(t, 0)
+
+    def __repr__(self) -> str:
+        return f"{self.name}={self.obj!r}"
+
+
+def as_rail(obj: Any, name: str = "rail") -> Any:
+    """A rail object (``evaluate`` and ``derivative(t, order)`` of orders 0..3) for ``obj``.
+
+    Args:
+        obj: a 3-D :class:`~ght_cad.curve.GHTCurve`, a :class:`CallableRail`, or any object with
+            ``evaluate(t) -> (n, 3)`` and ``derivative(t, order=1) -> (n, 3)`` on [0, 1]. CAD
+            edges (build123d/OCP, FreeCAD ``Part.Edge``) are wrapped by the adapters
+            (``ght_cad.cad``, ``freecad_workbench``) into a :class:`CallableRail`.
+        name: label used in error messages ("rail_a", "rail_b").
+
+    Raises:
+        GHTError: an object without those methods, or a GHTCurve that is not 3-D.
+    """
+    if isinstance(obj, (CallableRail, _ObjectRail)):
+        return obj
+    if isinstance(obj, GHTCurve):
+        if obj.dim != 3:
+            raise GHTError(f"{name} is a GHTCurve of dimension {obj.dim}; a rail must be a 3-D curve")
+        return _ObjectRail(obj, name)
+    if callable(getattr(obj, "evaluate", None)) and callable(getattr(obj, "derivative", None)):
+        return _ObjectRail(obj, name)
+    raise GHTError(
+        f"{name} is a {type(obj).__name__}; a rail is a 3-D GHTCurve, a CallableRail(position, first, "
+        "second=None) or an object with evaluate(t) and derivative(t, order) on [0, 1] (CAD edges: use "
+        "the build123d/FreeCAD loft adapters, which wrap them)"
+    )
+
+
+class _Reversed:
+    """``r~(s) = r(1 - s)``: derivatives of order k get the sign ``(-1)^k``."""
+
+    def __init__(self, rail: Any) -> None:
+        self.rail = rail
+        self.name = getattr(rail, "name", "rail") + " (reversed)"
+
+    def derivative(self, t: Any, order: int = 1) -> np.ndarray:
+        tt, _ = as_parameter_array(t, "t")
+        return (-1.0) ** order * self.rail.derivative(1.0 - tt, order)
+
+    def evaluate(self, t: Any) -> np.ndarray:
+        return self.derivative(t, 0)
+
+
+def _jet(rail: Any, t: np.ndarray, k: int) -> list[np.ndarray]:
+    return [rail.derivative(t, r) for r in range(k + 1)]
+
+
+def _det(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", x, np.cross(y, z))
+
+
+# ----------------------------------------------------------------------------------------------
+# the tangent-plane function F and its continuation
+# ----------------------------------------------------------------------------------------------
+class _Pair:
+    """Rails a, b (b possibly reversed) with F and its partial derivatives."""
+
+    def __init__(self, ra: Any, rb: Any, size: float) -> None:
+        self.ra, self.rb, self.size = ra, rb, size
+
+    def parts(self, t: np.ndarray, s: np.ndarray, k: int = 1) -> dict[str, Any]:
+        """F, F_t, F_s (and with k = 2 the second partials) at (t, s); scale = |a'||b'||g|."""
+        A = _jet(self.ra, t, k + 1)
+        B = _jet(self.rb, s, k + 1)
+        g = B[0] - A[0]
+        out: dict[str, Any] = {"A": A, "B": B, "g": g}
+        out["F"] = _det(A[1], B[1], g)
+        out["Ft"] = _det(A[2], B[1], g)
+        out["Fs"] = _det(A[1], B[2], g)
+        out["scale"] = np.linalg.norm(A[1], axis=1) * np.linalg.norm(B[1], axis=1) * np.linalg.norm(g, axis=1)
+        if k >= 2:
+            out["Ftt"] = _det(A[3], B[1], g) - _det(A[2], B[1], A[1])
+            out["Fts"] = _det(A[2], B[2], g)
+            out["Fss"] = _det(A[1], B[3], g) + _det(A[1], B[2], B[1])
+        return out
+
+    def F(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
+        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
+        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
+        return _det(A1, B1, B0 - A0)
+
+    def f(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """Scale-free ``F / (|a'| |b'| |g|)`` (the sine of the angle between the two end planes,
+        up to the sines of the ruling angles); 0 where a scale factor vanishes."""
+        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
+        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
+        g = B0 - A0
+        sc = np.linalg.norm(A1, axis=1) * np.linalg.norm(B1, axis=1) * np.linalg.norm(g, axis=1)
+        F = _det(A1, B1, g)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(sc > 0, F / np.where(sc > 0, sc, 1.0), 0.0)
+
+    # -- Newton on the branch at fixed λ --------------------------------------------------
+    def correct(self, lam: np.ndarray, t: np.ndarray, iters: int = 12) -> tuple[np.ndarray, np.ndarray, bool]:
+        """Solve ``G(t) = F(t, 2λ - t) = 0`` by Newton from ``t`` (vectorized); (t, s, converged)."""
+        lam = np.asarray(lam, float)
+        lo = np.maximum(0.0, 2 * lam - 1.0)
+        hi = np.minimum(1.0, 2 * lam)
+        t = np.clip(np.asarray(t, float).copy(), lo, hi)
+        done = False
+        for it in range(iters):
+            s = 2 * lam - t
+            p = self.parts(t, s, 1)
+            dG = p["Ft"] - p["Fs"]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                dt = np.where(dG != 0, p["F"] / dG, 0.0)
+            if not np.all(np.isfinite(dt)):
+                return t, 2 * lam - t, False
+            t = np.clip(t - dt, lo, hi)
+            small = np.abs(dt) <= 4 * _EPS * np.maximum(1.0, np.abs(t))
+            resid = np.abs(p["F"]) <= 8 * _EPS * np.maximum(p["scale"], 1e-300)
+            if np.all(small | resid):
+                if done:
+                    break
+                done = True  # one more iteration after convergence: polish to round-off
+        s = 2 * lam - t
+        F = self.F(t, s)
+        scale = self._scale(t, s)
+        ok = bool(np.all(np.abs(F) <= 1e-12 * np.maximum(scale, 1e-300)))
+        return t, s, ok
+
+    def _scale(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
+        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
+        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
+        return np.linalg.norm(A1, axis=1) * np.linalg.norm(B1, axis=1) * np.linalg.norm(B0 - A0, axis=1)
+
+    def tangent(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(dt/dλ, ds/dλ) = (2 F_s, -2 F_t) / (F_s - F_t)`` on the branch."""
+        p = self.parts(t, s, 1)
+        den = p["Fs"] - p["Ft"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 2 * p["Fs"] / den, -2 * p["Ft"] / den
+
+    def side_root(self, side: str, guess: float, iters: int = 30) -> float | None:
+        """Newton/bisection root of F on a side ('t=1' solves F(1, s) = 0 for s, 's=1' F(t, 1) = 0)."""
+        from scipy.optimize import brentq
+
+        def fun(x: float) -> float:
+            if side == "t=1":
+                return float(self.F(np.array([1.0]), np.array([x]))[0])
+            return float(self.F(np.array([x]), np.array([1.0]))[0])
+
+        x = min(max(guess, 0.0), 1.0)
+        h = 1e-6
+        for lo_, hi_ in ((x - h, x + h), (x - 1e-3, x + 1e-3), (x - 0.05, x + 0.05), (0.0, 1.0)):
+            lo_, hi_ = max(lo_, 0.0), min(hi_, 1.0)
+            flo, fhi = fun(lo_), fun(hi_)
+            if flo == 0.0:
+                return lo_
+            if fhi == 0.0:
+                return hi_
+            if flo * fhi < 0:
+                r = brentq(fun, lo_, hi_, xtol=1e-16, rtol=4 * _EPS, maxiter=200)
+                return self._polish_side(side, r)
+        return None
+
+    def _polish_side(self, side: str, x: float) -> float:
+        for _ in range(3):
+            if side == "t=1":
+                p = self.parts(np.array([1.0]), np.array([x]), 1)
+                d = p["Fs"][0]
+            else:
+                p = self.parts(np.array([x]), np.array([1.0]), 1)
+                d = p["Ft"][0]
+            if d == 0:
+                break
+            xn = min(max(x - p["F"][0] / d, 0.0), 1.0)
+            if abs(xn - x) > 1e-9:
+                break
+            x = xn
+        return x
+
+
+@dataclass(eq=False)
+class _Branch:
+    """A traced branch: nodes (λ, t, s, dt/dλ, ds/dλ), from a lower-left to an upper-right side."""
+
+    lam: np.ndarray
+    t: np.ndarray
+    s: np.ndarray
+    tp: np.ndarray
+    sp: np.ndarray
+    reversed_b: bool
+
+    @property
+    def start(self) -> tuple[float, float]:
+        return float(self.t[0]), float(self.s[0])
+
+    @property
+    def end(self) -> tuple[float, float]:
+        return float(self.t[-1]), float(self.s[-1])
+
+
+def _boundary_roots(pair: _Pair, samples: int) -> list[tuple[float, float]]:
+    """Zeros of F on the lower-left sides s = 0 (t ∈ [0, 1]) and t = 0 (s ∈ [0, 1]), corner first."""
+    from scipy.optimize import brentq
+
+    x = np.linspace(0.0, 1.0, samples)
+    z = np.zeros_like(x)
+    out: list[tuple[float, float]] = []
+    f00 = float(pair.f(np.array([0.0]), np.array([0.0]))[0])
+    if abs(f00) <= 1e-12:
+        out.append((0.0, 0.0))
+    for side in ("s=0", "t=0"):
+        vals = pair.f(x, z) if side == "s=0" else pair.f(z, x)
+
+        def fun(y: float, side: str = side) -> float:
+            yy = np.array([y])
+            zz = np.array([0.0])
+            return float((pair.F(yy, zz) if side == "s=0" else pair.F(zz, yy))[0])
+
+        for i in range(samples - 1):
+            if vals[i] == 0.0 and i > 0:
+                r = x[i]
+            elif vals[i] * vals[i + 1] < 0:
+                r = brentq(fun, x[i], x[i + 1], xtol=1e-16, rtol=4 * _EPS, maxiter=200)
+            else:
+                continue
+            if r <= MIN_FAN:
+                if not out or out[0] != (0.0, 0.0):
+                    out.insert(0, (0.0, 0.0))
+                continue
+            pt = (r, 0.0) if side == "s=0" else (0.0, r)
+            if all(abs(pt[0] - q[0]) + abs(pt[1] - q[1]) > 1e-10 for q in out):
+                out.append(pt)
+        if vals[-1] == 0.0:
+            pt = (1.0, 0.0) if side == "s=0" else (0.0, 1.0)
+            if pt not in out:
+                out.append(pt)
+    return out
+
+
+class _TraceFailure(Exception):
+    pass
+
+
+def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: float, tol: float) -> _Branch:
+    """Predictor–corrector continuation in λ = (t + s) / 2 from ``start`` to an upper-right side.
+
+    Predictor: Hermite extrapolation ``t + h t'`` (Euler) from the last node; corrector: Newton on
+    ``F(t, 2λ - t) = 0`` to round-off. Step control: the corrector displacement must stay below
+    ``tol`` (halve the step, or grow it by sqrt(tol / displacement) up to ``max_step``).
+
+    Raises:
+        _TraceFailure: the branch turns back (dt/dλ or ds/dλ < 0: crossing rulings), meets a
+            singular point of F, or leaves the square through a lower-left side.
+    """
+    t, s = start
+    lam = 0.5 * (t + s)
+    tp, sp = (float(v[0]) for v in pair.tangent(np.array([t]), np.array([s])))
+    mono = -1e-9
+
+    def check(tp: float, sp: float, t: float, s: float) -> None:
+        if not (np.isfinite(tp) and np.isfinite(sp)):
+            raise _TraceFailure(f"F is singular (grad F = 0 along the branch direction) at t={t:.6g}, s={s:.6g}")
+        if tp < mono or sp < mono:
+            raise _TraceFailure(
+                f"the branch turns back at t={t:.6g}, s={s:.6g} (dt/dλ={tp:.3g}, ds/dλ={sp:.3g}): "
+                "its rulings would cross"
+            )
+
+    check(tp, sp, t, s)
+    L, T, S, TP, SP = [lam], [t], [s], [tp], [sp]
+    h = min(max_step, 1e-2)
+    hmin = 1e-13
+    steps = 0
+    while True:
+        steps += 1
+        if steps > 200000:
+            raise _TraceFailure(f"tracing did not finish (step too small near t={t:.6g}, s={s:.6g})")
+        t_pred, s_pred = t + h * tp, s + h * sp
+        if t_pred >= 1.0 or s_pred >= 1.0:
+            # the branch leaves through an upper-right side: find where exactly
+            ht = (1.0 - t) / tp if tp > 0 else np.inf
+            hs = (1.0 - s) / sp if sp > 0 else np.inf
+            if ht <= hs:
+                sr = pair.side_root("t=1", s + ht * sp)
+                end = None if sr is None else (1.0, sr)
+            else:
+                tr = pair.side_root("s=1", t + hs * tp)
+                end = None if tr is None else (tr, 1.0)
+            if end is not None and end[0] >= t - 1e-12 and end[1] >= s - 1e-12:
+                te, se = end
+                lam_e = 0.5 * (te + se)
+                # the end must be reached by a short monotone step (else keep stepping)
+                if lam_e - lam <= 1.5 * h or h <= 1e-9:
+                    tpe, spe = (float(v[0]) for v in pair.tangent(np.array([te]), np.array([se])))
+                    if not (np.isfinite(tpe) and np.isfinite(spe)):
+                        tpe, spe = tp, sp
+                    if lam_e - lam > 1e-14:
+                        L.append(lam_e), T.append(te), S.append(se), TP.append(tpe), SP.append(spe)
+                    else:
+                        T[-1], S[-1] = te, se
+                    break
+            h *= 0.5
+            if h < hmin:
+                raise _TraceFailure(f"the branch cannot be followed to a side near t={t:.6g}, s={s:.6g}")
+            continue
+        lam_n = lam + h
+        tn, sn, ok = pair.correct(np.array([lam_n]), np.array([t_pred]))
+        tn, sn = float(tn[0]), float(sn[0])
+        disp = abs(tn - t_pred) + abs(sn - s_pred)
+        if not ok or disp > tol or tn < t - 1e-12 or sn < s - 1e-12:
+            h *= 0.5
+            if h < hmin:
+                raise _TraceFailure(
+                    f"Newton on F = 0 does not converge near t={t:.6g}, s={s:.6g}: the branch turns back, "
+                    "branches cross or F vanishes on a region there"
+                )
+            continue
+        tpn, spn = (float(v[0]) for v in pair.tangent(np.array([tn]), np.array([sn])))
+        check(tpn, spn, tn, sn)
+        lam, t, s, tp, sp = lam_n, tn, sn, tpn, spn
+        L.append(lam), T.append(t), S.append(s), TP.append(tp), SP.append(sp)
+        h = min(max_step, h * min(2.0, math.sqrt(tol / max(disp, 1e-3 * tol))))
+    return _Branch(np.array(L), np.array(T), np.array(S), np.array(TP), np.array(SP), reversed_b)
+
+
+# ----------------------------------------------------------------------------------------------
+# segments: fans and the main part as ruled surfaces
+# ----------------------------------------------------------------------------------------------
+_KINDS = ("fan_a", "fan_b", "main")
+
+
+class _Path:
+    """The path (t(λ), s(λ)) from (0, 0) to (1, 1) through fans and the branch, with derivatives."""
+
+    def __init__(self, pair: _Pair, branch: _Branch) -> None:
+        self.pair = pair
+        self.branch = branch
+        from scipy.interpolate import CubicHermiteSpline
+
+        lam, t = branch.lam, branch.t
+        if lam.size >= 2:
+            self._guess = CubicHermiteSpline(lam, t, branch.tp, extrapolate=True)
+        else:
+            self._guess = None
+        self.lam0, self.lam1 = float(lam[0]), float(lam[-1])
+        self._cache: dict[bytes, Any] = {}
+
+    def main(self, lam: np.ndarray, k: int) -> list[np.ndarray]:
+        """[t, t', t''], [s, s', s''] on the branch at ``lam`` (derivatives w.r.t. λ, up to k)."""
+        key = lam.tobytes() + bytes([k])
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit
+        g = np.clip(self._guess(lam), 0.0, 1.0) if self._guess is not None else np.full(lam.shape, self.branch.t[0])
+        t, s, ok = self.pair.correct(lam, g)
+        if not ok:
+            bad = int(np.argmax(np.abs(self.pair.f(t, s))))
+            raise NotDevelopableError(
+                f"Newton on F(t, s) = 0 failed at λ={lam[bad]:.9g} (t={t[bad]:.9g}, s={s[bad]:.9g}) of the traced branch"
+            )
+        p = self.pair.parts(t, s, 2 if k >= 2 else 1)
+        Ft, Fs = p["Ft"], p["Fs"]
+        den = Fs - Ft
+        tp = 2 * Fs / den
+        sp = 2.0 - tp
+        out_t, out_s = [t, tp], [s, sp]
+        if k >= 2:
+            dFt = p["Ftt"] * tp + p["Fts"] * sp
+            dFs = p["Fts"] * tp + p["Fss"] * sp
+            tpp = 2 * (Fs * dFt - Ft * dFs) / den**2
+            out_t.append(tpp)
+            out_s.append(-tpp)
+        res = (out_t, out_s, p)
+        if len(self._cache) > 8:
+            self._cache.clear()
+        self._cache[key] = res
+        return res
+
+
+class LoftSegment(RuledSurface):
+    r"""One piece of a developable loft: a fan (cone with apex at a rail end) or the main part.
+
+    ``X(u, v) = (1-v) a(t(λ)) + v b(s(λ))``, ``λ = λ0 + u (λ1 - λ0)``, u ∈ [0, 1], with the path
+    of the loft in the (t, s) square (module doc). ``kind`` is ``"fan_a"`` (apex on rail a: t
+    constant), ``"fan_b"`` (apex on rail b: s constant) or ``"main"`` (the traced branch
+    ``F(t, σ(t)) = 0``). ``a``, ``b`` are rail a and rail b in their given orientation.
+
+    Attributes:
+        kind, lam_range, t_range, s_range (parameters on the given rails), apex (3-D point or None).
+    """
+
+    def __init__(self, loft: "DevelopableLoft", kind: str, lam0: float, lam1: float, side: str | None = None) -> None:
+        self._loft = loft
+        self.kind = kind
+        self.side = side  # for fans: "s=0", "t=0", "t=1", "s=1"
+        self.lam_range = (float(lam0), float(lam1))
+
+    # path parameters (internal orientation: rail b possibly reversed)
+    def _ts(self, u: np.ndarray, k: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        lam0, lam1 = self.lam_range
+        dl = lam1 - lam0
+        lam = lam0 + u * dl
+        if self.kind == "main":
+            tt, ss, _ = self._loft._path.main(lam, k)
+        else:
+            z = np.zeros_like(lam)
+            one = np.ones_like(lam)
+            if self.side == "s=0":
+                tt, ss = [2 * lam, 2 * one], [z, z]
+            elif self.side == "t=0":
+                tt, ss = [z, z], [2 * lam, 2 * one]
+            elif self.side == "t=1":
+                tt, ss = [one, z], [2 * lam - 1.0, 2 * one]
+            else:  # s=1
+                tt, ss = [2 * lam - 1.0, 2 * one], [one, z]
+            tt = tt + [z] * k
+            ss = ss + [z] * k
+        tt = [np.clip(tt[0], 0.0, 1.0)] + [tt[r] * dl**r for r in range(1, k + 1)]
+        ss = [np.clip(ss[0], 0.0, 1.0)] + [ss[r] * dl**r for r in range(1, k + 1)]
+        return tt, ss
+
+    @staticmethod
+    def _compose(rail: Any, x: list[np.ndarray], r: int) -> np.ndarray:
+        """``d^r/du^r rail(x(u))`` for r = 0, 1, 2 (Faà di Bruno)."""
+        if r == 0:
+            return rail.derivative(x[0], 0)
+        if r == 1:
+            return rail.derivative(x[0], 1) * x[1][:, None]
+        if r == 2:
+            return rail.derivative(x[0], 2) * (x[1] ** 2)[:, None] + rail.derivative(x[0], 1) * x[2][:, None]
+        raise GHTError(f"derivative={r!r} is not allowed; loft segments give derivatives of order 0..2")
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        uu, _ = as_parameter_array(u, "u")
+        tt, _ = self._ts(uu, derivative)
+        return self._compose(self._loft._pair.ra, tt, derivative)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        uu, _ = as_parameter_array(u, "u")
+        _, ss = self._ts(uu, derivative)
+        return self._compose(self._loft._pair.rb, ss, derivative)
+
+    def parameters(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Rail parameters ``(t, s)`` of the rulings at ``u`` (s on rail b as given)."""
+        uu, _ = as_parameter_array(u, "u")
+        tt, ss = self._ts(uu, 0)
+        return tt[0], self._loft._given_s(ss[0])
+
+    @property
+    def t_range(self) -> tuple[float, float]:
+        t, _ = self.parameters(np.array([0.0, 1.0]))
+        return float(t[0]), float(t[1])
+
+    @property
+    def s_range(self) -> tuple[float, float]:
+        _, s = self.parameters(np.array([0.0, 1.0]))
+        return float(s[0]), float(s[1])
+
+    @property
+    def apex(self) -> np.ndarray | None:
+        """The cone apex (a rail end) of a fan; None for the main part."""
+        if self.kind == "fan_a":
+            return self.a(np.array([0.5]))[0]
+        if self.kind == "fan_b":
+            return self.b(np.array([0.5]))[0]
+        return None
+
+    def __repr__(self) -> str:
+        t0, t1 = self.t_range
+        s0, s1 = self.s_range
+        return f"LoftSegment({self.kind}, t=[{t0:.6g}, {t1:.6g}], s=[{s0:.6g}, {s1:.6g}])"
+
+
+# ----------------------------------------------------------------------------------------------
+# report
+# ----------------------------------------------------------------------------------------------
+@dataclass
+class LoftReport:
+    r"""What the loft construction found (spec section 5.7).
+
+    Attributes:
+        reversed_b: rail b was traced reversed (the rails run opposite ways).
+        branch_start, branch_end: (t, s) where the branch meets the lower-left / upper-right sides
+            (s on rail b as given).
+        nodes: number of traced branch nodes (predictor–corrector steps + 1).
+        segments: per segment: kind, t and s ranges, apex, area.
+        area: 3-D area of the loft; fan_area, fan_share = fan_area / area.
+        theta_max_deg: max θ over ``samples`` rulings per segment (round-off expected).
+        f_residual_max: max ``|F| / (|a'||b'||b - a|)`` at those rulings.
+        theta: (λ, t, s, θ in degrees) of the sampled rulings.
+        degenerate_rulings: rulings with ``|b - a|`` below 1e-9 of the size, or a rail tangent
+            parallel to the ruling (sine below 1e-9): dicts with t, s, kind, value.
+        regression: sampled rulings with the edge of regression between the rails,
+            ``v* = -((a' × g)·(g' × g)) / |g' × g|²`` in [0, 1]: dicts with t, s, v, point.
+        regression_clearance: min over the sampled rulings of the distance of ``v*`` from [0, 1]
+            (0 when the edge of regression meets the loft; inf for a cylinder-like loft).
+        candidates: every branch tried: start, end, orientation, fan_share or why it was refused.
+    """
+
+    reversed_b: bool
+    branch_start: tuple[float, float]
+    branch_end: tuple[float, float]
+    nodes: int
+    segments: list[dict[str, Any]]
+    area: float
+    fan_area: float
+    fan_share: float
+    theta_max_deg: float
+    f_residual_max: float
+    theta: np.ndarray = field(repr=False)
+    degenerate_rulings: list[dict[str, Any]] = field(default_factory=list)
+    regression: list[dict[str, Any]] = field(default_factory=list)
+    regression_clearance: float = math.inf
+    candidates: list[dict[str, Any]] = field(default_factory=list)
+
+    def as_dict(self) -> dict[str, Any]:
+        """Plain data (floats, lists, dicts) for JSON reports."""
+        d = asdict(self)
+        d["theta"] = np.asarray(self.theta).tolist()
+        return _plain(d)
+
+    def __str__(self) -> str:
+        kinds = ", ".join(f"{s['kind']} t=[{s['t'][0]:.4g},{s['t'][1]:.4g}] s=[{s['s'][0]:.4g},{s['s'][1]:.4g}]"
+                          for s in self.segments)
+        return (
+            f"developable loft: {len(self.segments)} segment(s) ({kinds}); fan share {self.fan_share:.4g}; "
+            f"θ_max={self.theta_max_deg:.3g}°; |F| residual {self.f_residual_max:.2g}; "
+            f"{len(self.degenerate_rulings)} degenerate ruling(s); edge of regression "
+            + ("between the rails" if self.regression else f"clear (margin {self.regression_clearance:.3g})")
+        )
+
+
+def _plain(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
+        return x.item()
+    return x
+
+
+# ----------------------------------------------------------------------------------------------
+# the loft
+# ----------------------------------------------------------------------------------------------
+class DevelopableLoft(RuledSurface):
+    r"""The exact developable loft between two rails (spec section 5.7), fans included.
+
+    As a whole it is one ruled surface ``X(λ, v) = (1-v) a(t(λ)) + v b(s(λ))``, λ ∈ [0, 1]
+    (``λ = (t + s)/2`` along the path from corner (0, 0) to (1, 1) of the (t, s) square, module
+    doc), smooth inside each segment and G1 across the joint rulings (listed in
+    ``breakpoints``), so :func:`ght_cad.unroll` gives one panel with bend lines along the
+    rulings. ``segments`` are the fans and the main part in order along the rails.
+
+    Do not construct directly: use :func:`developable_loft`.
+
+    Attributes:
+        rail_a, rail_b: the rails as given.
+        segments: :class:`LoftSegment` list (RuledSurface instances).
+        report: :class:`LoftReport`.
+        breakpoints: λ of the joint rulings (inside (0, 1)).
+    """
+
+    def __init__(self, rail_a: Any, rail_b: Any, pair: _Pair, branch: _Branch, *, samples: int = 257,
+                 candidates: Sequence[dict[str, Any]] = ()) -> None:
+        self.rail_a = rail_a
+        self.rail_b = rail_b
+        self._pair = pair
+        self._branch = branch
+        self.reversed_b = branch.reversed_b
+        self._path = _Path(pair, branch)
+        (t0, s0), (t1, s1) = branch.start, branch.end
+        segs: list[LoftSegment] = []
+        lam0, lam1 = self._path.lam0, self._path.lam1
+        if t0 > MIN_FAN:
+            segs.append(LoftSegment(self, "fan_b", 0.0, lam0, "s=0"))
+        elif s0 > MIN_FAN:
+            segs.append(LoftSegment(self, "fan_a", 0.0, lam0, "t=0"))
+        if lam1 - lam0 > MIN_FAN:
+            segs.append(LoftSegment(self, "main", lam0, lam1))
+        if t1 < 1.0 - MIN_FAN:
+            segs.append(LoftSegment(self, "fan_b", lam1, 1.0, "s=1"))
+        elif s1 < 1.0 - MIN_FAN:
+            segs.append(LoftSegment(self, "fan_a", lam1, 1.0, "t=1"))
+        self.segments: list[LoftSegment] = segs
+        self._edges = np.array([segs[0].lam_range[0]] + [sg.lam_range[1] for sg in segs])
+        self._edges[0], self._edges[-1] = 0.0, 1.0
+        self.breakpoints = tuple(float(x) for x in self._edges[1:-1])
+        self.report = self._make_report(samples, list(candidates))
+
+    # -- parametrization -----------------------------------------------------------------
+    def _given_s(self, s: np.ndarray) -> np.ndarray:
+        return 1.0 - s if self.reversed_b else s
+
+    def _dispatch(self, u: Any, fn: Callable[[LoftSegment, np.ndarray], np.ndarray]) -> np.ndarray:
+        uu, _ = as_parameter_array(u, "u")
+        idx = np.clip(np.searchsorted(self._edges, uu, side="right") - 1, 0, len(self.segments) - 1)
+        out = np.empty((uu.size, 3))
+        for i, sg in enumerate(self.segments):
+            m = idx == i
+            if m.any():
+                lo, hi = self._edges[i], self._edges[i + 1]
+                out[m] = fn(sg, (uu[m] - lo) / (hi - lo), hi - lo)
+        return out
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Rail a along the loft: ``a(t(λ))`` and its λ-derivatives."""
+        return self._dispatch(u, lambda sg, x, w: sg.a(x, derivative) / w**derivative)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """Rail b along the loft: ``b(s(λ))`` and its λ-derivatives."""
+        return self._dispatch(u, lambda sg, x, w: sg.b(x, derivative) / w**derivative)
+
+    def parameters(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Rail parameters ``(t, s)`` of the rulings at loft parameters ``u`` (= λ)."""
+        uu, _ = as_parameter_array(u, "u")
+        ts = self._dispatch(uu, lambda sg, x, w: np.column_stack([*sg.parameters(x), np.zeros(x.size)]))
+        return ts[:, 0], ts[:, 1]
+
+    def sigma(self, t: Any) -> np.ndarray:
+        r"""``s = σ(t)``: the parameter on rail b (as given) of the ruling from ``a(t)``.
+
+        On the main part ``F(t, σ(t)) = 0`` solved by Newton in s to round-off; where a(t) is
+        covered by a fan with apex on rail b it is that apex's parameter (0 or 1); at an end of
+        rail a that is a fan apex itself, the end of the branch.
+        """
+        tt, scalar = as_parameter_array(t, "t")
+        if np.any((tt < 0) | (tt > 1)) or not np.all(np.isfinite(tt)):
+            raise GHTError("t must be finite and in [0, 1]")
+        br = self._branch
+        (t0, s0), (t1, s1) = br.start, br.end
+        s = np.interp(tt, br.t, br.s)
+        s = np.where(tt <= t0, s0 if t0 <= MIN_FAN else 0.0, s)
+        s = np.where(tt >= t1, s1 if t1 >= 1 - MIN_FAN else 1.0, s)
+        inner = (tt > t0) & (tt < t1)
+        if inner.any():
+            ti, si = tt[inner], s[inner]
+            for _ in range(8):
+                p = self._pair.parts(ti, si, 1)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    ds = np.where(p["Fs"] != 0, p["F"] / p["Fs"], 0.0)
+                si = np.clip(si - ds, 0.0, 1.0)
+                if np.all(np.abs(ds) <= 4 * _EPS):
+                    break
+            s[inner] = si
+        out = self._given_s(s)
+        return out[0] if scalar else out
+
+    # -- measures ------------------------------------------------------------------------
+    def developability(self, nodes: int = 64, samples: int = 257) -> Developability:
+        """Developability degree of the whole loft, per segment combined (θ_max over all rulings;
+        integrals weighted by the segments' λ-lengths)."""
+        parts = [sg.developability(nodes, samples) for sg in self.segments]
+        w = np.diff(self._edges)
+        w = w / w.sum()
+        th = [p.theta_max for p in parts if math.isfinite(p.theta_max)]
+        return Developability(
+            theta_max=max(th) if th else math.nan,
+            theta_rms=float(math.sqrt(sum(wi * p.theta_rms**2 for wi, p in zip(w, parts) if math.isfinite(p.theta_rms)))),
+            dd=float(sum(wi * p.dd for wi, p in zip(w, parts) if math.isfinite(p.dd))),
+            R=float(sum(wi * p.R for wi, p in zip(w, parts) if math.isfinite(p.R))),
+            residual_max=max(p.residual_max for p in parts),
+        )
+
+    def area(self) -> float:
+        """3-D area, sum over the segments of ``∫∫ |(a' + v g') × g| dv du``."""
+        from .unroll import ruled_area
+
+        return float(sum(ruled_area(sg, rtol=1e-13) for sg in self.segments))
+
+    def ruling_field(self, u: Any) -> dict[str, np.ndarray]:
+        """Unit ruling direction ``d = g/|g|`` and its λ-derivative ``d' = (g' - d (d·g'))/|g|``."""
+        uu, _ = as_parameter_array(u, "u")
+        g = self.ruling(uu)
+        g1 = self.ruling(uu, 1)
+        L = np.linalg.norm(g, axis=1)
+        d = g / L[:, None]
+        d1 = (g1 - d * np.einsum("ij,ij->i", d, g1)[:, None]) / L[:, None]
+        return {"d": d, "d1": d1, "length": L}
+
+    def fairness(self, nodes: int = 32) -> float:
+        r"""Fairness of the ruling field ``∫_0^1 |d'(λ)|² dλ`` (Gauss–Legendre per segment)."""
+        x, w = gauss_legendre(nodes)
+        tot = 0.0
+        for i in range(len(self.segments)):
+            lo, hi = self._edges[i], self._edges[i + 1]
+            uu = lo + (hi - lo) * x
+            d1 = self.ruling_field(uu)["d1"]
+            tot += float(np.sum(w * (hi - lo) * np.sum(d1 * d1, axis=1)))
+        return tot
+
+    def regression_parameter(self, u: Any) -> np.ndarray:
+        r"""``v* = -((a' × g)·(g' × g)) / |g' × g|²``: where on the ruling ``X = a + v g`` the
+        surface is singular (the edge of regression); ±inf where ``g' × g = 0`` (cylinder-like)."""
+        uu, _ = as_parameter_array(u, "u")
+        return regression_v(self.a(uu, 1), self.ruling(uu), self.ruling(uu, 1))
+
+    def bspline_data(self, tol: float | None = None, degree: int = 5, theta_tol_deg: float = 1e-3) -> list[Any]:
+        r"""Plain-data B-spline surfaces, one per segment (poles, knots, degrees; degree 1 across
+        the rulings), from :func:`ght_cad.developable.developable_bspline`: the boundary curves are
+        fitted together (compatible poles) with ``max_u |f(u) - F(u)| <= max_deviation <= tol``,
+        so the faces' edges lie on the rails within ``max_deviation`` (the certified tolerance) and
+        joint rulings are exact end poles."""
+        from .developable import developable_bspline
+
+        return [developable_bspline(sg, tol=tol, degree=degree, theta_tol_deg=theta_tol_deg) for sg in self.segments]
+
+    def to_dict(self, tol: float | None = None, degree: int = 5) -> dict[str, Any]:
+        """Plain data: the report and per segment the B-spline data (poles, knots, degrees)."""
+        segs = []
+        for sg, data in zip(self.segments, self.bspline_data(tol=tol, degree=degree)):
+            segs.append({
+                "kind": sg.kind,
+                "t_range": list(sg.t_range),
+                "s_range": list(sg.s_range),
+                "poles": np.asarray(data.poles).tolist(),
+                "knots_u": np.asarray(data.knots_u).tolist(),
+                "knots_v": np.asarray(data.knots_v).tolist(),
+                "degree_u": int(data.degree_u),
+                "degree_v": int(data.degree_v),
+                "max_deviation": float(data.max_deviation),
+            })
+        return {"report": self.report.as_dict(), "segments": segs}
+
+    def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
+        """A build123d ``Shell`` of one B-spline face per segment sewn along the joint rulings
+        (:func:`ght_cad.cad.developable_faces.composite_shell`; needs build123d)."""
+        from .cad.developable_faces import composite_shell
+
+        return composite_shell(self.segments, tol=tol, **kwargs)
+
+    def joint_folds(self) -> list[dict[str, float]]:
+        r"""Joint rulings where the surface folds back (a fan lying over the main part).
+
+        At a joint ruling the segments share the tangent plane; the loft continues across it iff
+        the normals ``N = X_λ × g`` at mid-ruling (``X_λ = a' + g'/2``) on both sides point the same
+        way, ``N_left · N_right > 0``. Returns the folded joints (λ, t, s of the joint).
+        """
+        out = []
+        one, zero = np.array([1.0]), np.array([0.0])
+        for i in range(len(self.segments) - 1):
+            L, R = self.segments[i], self.segments[i + 1]
+            nl = np.cross(0.5 * (L.a(one, 1) + L.b(one, 1)), L.ruling(one))[0]
+            nr = np.cross(0.5 * (R.a(zero, 1) + R.b(zero, 1)), R.ruling(zero))[0]
+            if float(np.dot(nl, nr)) < 0:
+                t, s = L.parameters(one)
+                out.append({"lam": L.lam_range[1], "t": float(t[0]), "s": float(s[0])})
+        return out
+
+    def __repr__(self) -> str:
+        return f"DevelopableLoft({', '.join(sg.kind for sg in self.segments)}; fan share {self.report.fan_share:.3g})"
+
+    # -- report --------------------------------------------------------------------------
+    def _make_report(self, samples: int, candidates: list[dict[str, Any]]) -> LoftReport:
+        from .unroll import ruled_area
+        from .ruled import _theta
+
+        size = self._pair.size
+        seg_info = []
+        area = fan_area = 0.0
+        rows = []
+        degenerate: list[dict[str, Any]] = []
+        regression: list[dict[str, Any]] = []
+        clearance = math.inf
+        fres = 0.0
+        for i, sg in enumerate(self.segments):
+            ar = ruled_area(sg, rtol=1e-13)
+            area += ar
+            if sg.kind != "main":
+                fan_area += ar
+            apex = sg.apex
+            seg_info.append({
+                "kind": sg.kind,
+                "t": list(sg.t_range),
+                "s": list(sg.s_range),
+                "lam": list(sg.lam_range),
+                "apex": None if apex is None else apex.tolist(),
+                "area": ar,
+            })
+            u = np.linspace(0.0, 1.0, samples)
+            a0, a1 = sg.a(u), sg.a(u, 1)
+            b0, b1 = sg.b(u), sg.b(u, 1)
+            g = b0 - a0
+            th, _ = _theta(a1, b1, g)
+            lam = sg.lam_range[0] + u * (sg.lam_range[1] - sg.lam_range[0])
+            t, s = sg.parameters(u)
+            rows.append(np.column_stack([lam, t, s, th]))
+            if sg.kind == "main":
+                tt, ss, _ = self._path.main(lam, 0)
+                fres = max(fres, float(np.max(np.abs(self._pair.f(tt[0], ss[0])))))
+            L = np.linalg.norm(g, axis=1)
+            # degenerate rulings: zero length or a rail tangent along the ruling
+            sin_a = _sine(self._pair.ra.derivative(np.clip(t, 0, 1), 1), g)
+            sin_b = _sine(self._pair.rb.derivative(np.clip(self._given_s(s), 0, 1), 1), g)
+            for j in range(u.size):
+                if L[j] <= 1e-9 * size:
+                    degenerate.append({"t": float(t[j]), "s": float(s[j]), "kind": "zero length", "value": float(L[j])})
+                elif sin_a[j] <= 1e-9 or sin_b[j] <= 1e-9:
+                    which = "rail_a" if sin_a[j] <= sin_b[j] else "rail_b"
+                    degenerate.append({"t": float(t[j]), "s": float(s[j]), "kind": f"{which} tangent along the ruling",
+                                       "value": float(min(sin_a[j], sin_b[j]))})
+            vs = regression_v(a1, g, b1 - a1)
+            # a cone's apex on a rail (a stationary side: v* = 0 with a' = 0, v* = 1 with b' = 0) is
+            # the edge of regression of a fan (or of a planar triangle), not a defect between the rails
+            g1n = np.linalg.norm(b1 - a1, axis=1)
+            apex = ((np.linalg.norm(a1, axis=1) <= 1e-9 * g1n) & (np.abs(vs) <= 1e-6)) | (
+                (np.linalg.norm(b1, axis=1) <= 1e-9 * g1n) & (np.abs(vs - 1) <= 1e-6))
+            vs = np.where(apex, np.inf, vs)
+            fin = np.isfinite(vs)
+            if fin.any():
+                dist = np.where(vs < 0, -vs, np.where(vs > 1, vs - 1, 0.0))[fin]
+                clearance = min(clearance, float(dist.min()))
+                inside = np.flatnonzero(fin & (vs >= 0) & (vs <= 1))
+                for j in inside:
+                    regression.append({"t": float(t[j]), "s": float(s[j]), "v": float(vs[j]),
+                                       "point": (a0[j] + vs[j] * g[j]).tolist()})
+        theta = np.vstack(rows)
+        fin = np.isfinite(theta[:, 3])
+        theta_max = float(np.max(theta[fin, 3])) if fin.any() else math.nan
+        start = (float(self._branch.t[0]), float(self._given_s(np.array([self._branch.s[0]]))[0]))
+        end = (float(self._branch.t[-1]), float(self._given_s(np.array([self._branch.s[-1]]))[0]))
+        return LoftReport(
+            reversed_b=bool(self.reversed_b),
+            branch_start=start,
+            branch_end=end,
+            nodes=int(self._branch.lam.size),
+            segments=seg_info,
+            area=area,
+            fan_area=fan_area,
+            fan_share=fan_area / area if area > 0 else math.nan,
+            theta_max_deg=theta_max,
+            f_residual_max=fres,
+            theta=theta,
+            degenerate_rulings=degenerate,
+            regression=regression,
+            regression_clearance=clearance,
+            candidates=candidates,
+        )
+
+
+def _sine(x: np.ndarray, g: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        den = np.linalg.norm(x, axis=1) * np.linalg.norm(g, axis=1)
+        return np.where(den > 0, np.linalg.norm(np.cross(x, g), axis=1) / np.where(den > 0, den, 1.0), 1.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# entry point
+# ----------------------------------------------------------------------------------------------
+_ORIENTATIONS = ("auto", "same", "reversed")
+
+
+def _max_distance(P: np.ndarray, rail: Any, t: np.ndarray, Q: np.ndarray) -> float:
+    """max over the points P of their distance to the curve ``rail`` (samples Q at t): nearest
+    sample, then Newton on ``(r(s) - p) · r'(s) = 0``."""
+    s = t[np.argmin(np.linalg.norm(P[:, None, :] - Q[None, :, :], axis=2), axis=1)]
+    for _ in range(4):
+        r0, r1, r2 = rail.derivative(s, 0), rail.derivative(s, 1), rail.derivative(s, 2)
+        e = r0 - P
+        den = np.einsum("ij,ij->i", r1, r1) + np.einsum("ij,ij->i", e, r2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ds = np.where(den > 0, np.einsum("ij,ij->i", e, r1) / np.where(den > 0, den, 1.0), 0.0)
+        s = np.clip(s - ds, 0.0, 1.0)
+    return float(np.max(np.linalg.norm(rail.derivative(s, 0) - P, axis=1)))
+
+
+def _check_rails(ra: Any, rb: Any, samples: int = 129) -> float:
+    """Sample both rails: finite values, regular tangents, not coincident; returns the size."""
+    t = np.linspace(0.0, 1.0, samples)
+    pts = {}
+    for name, r in (("rail_a", ra), ("rail_b", rb)):
+        try:
+            P = r.derivative(t, 0)
+            D = r.derivative(t, 1)
+        except GHTError:
+            raise
+        except Exception as exc:  # a user callable failing: say which rail
+            raise GHTError(f"{name} could not be evaluated on t ∈ [0, 1]: {type(exc).__name__}: {exc}") from exc
+        for what, arr in (("position", P), ("derivative", D)):
+            bad = ~np.all(np.isfinite(arr), axis=1)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise GHTError(f"{name} {what} is not finite at t={t[i]:.6g}: {arr[i].tolist()}; rails must be finite")
+        ext = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+        speed = np.linalg.norm(D, axis=1)
+        if ext <= 0 or not np.any(speed > 0):
+            raise DegenerateGeometryError(f"{name} is a single point {P[0].tolist()}; a rail must be a curve of positive length")
+        pts[name] = (P, speed, ext)
+    Pa, sa, ea = pts["rail_a"]
+    Pb, sb, eb = pts["rail_b"]
+    allp = np.vstack([Pa, Pb])
+    size = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0)))
+    for name, sp in (("rail_a", sa), ("rail_b", sb)):
+        low = sp <= 1e-9 * size
+        if low.any():
+            i = int(np.argmax(low))
+            raise DegenerateGeometryError(
+                f"{name} has a zero tangent (|r'| = {sp[i]:.3g}) at t={t[i]:.6g}; a loft needs regular rails "
+                "(split the rail there or re-parametrize it)"
+            )
+    if _max_distance(Pa, rb, t, Pb) <= 1e-9 * size and _max_distance(Pb, ra, t, Pa) <= 1e-9 * size:
+        raise DegenerateGeometryError("rail_a and rail_b coincide (every point of one lies on the other); give two distinct rails")
+    return size
+
+
+def developable_loft(
+    rail_a: Any,
+    rail_b: Any,
+    *,
+    orientation: str = "auto",
+    branch: str | int = "auto",
+    max_step: float = 1.0 / 64,
+    step_tol: float = 2e-3,
+    samples: int = 257,
+    boundary_samples: int = 513,
+) -> DevelopableLoft:
+    r"""The exact developable loft between two rails (spec section 5.7).
+
+    Traces the branch of ``F(t, s) = det(a'(t), b'(s), b(s) - a(t)) = 0`` from a zero of F on a
+    lower-left side of the (t, s) square (s = 0 or t = 0) as an increasing ``s = σ(t)`` by
+    predictor–corrector continuation in ``λ = (t + s)/2`` with Newton correction to round-off, to
+    an upper-right side, and adds fans (cones with apex at a rail end) along the sides so both
+    rails are covered over [0, 1] (module doc).
+
+    Args:
+        rail_a, rail_b: GHTCurve objects, :class:`CallableRail` or objects with ``evaluate(t)``
+            and ``derivative(t, order)`` on [0, 1] (see :func:`as_rail`).
+        orientation: ``"same"`` (s increases with t), ``"reversed"`` (rail b is traced from its
+            end: s decreases with t) or ``"auto"``: both, keep the better branch.
+        branch: ``"auto"`` keeps, among the branches that join the lower-left to the upper-right
+            sides, the one without an edge of regression between the rails and with the smallest
+            fan share; an integer picks ``report.candidates[i]`` (in the order they were found).
+        max_step: largest continuation step in λ.
+        step_tol: largest corrector displacement (in t + s) of an accepted step.
+        samples: rulings per segment sampled for the report (θ, degenerate rulings, regression).
+        boundary_samples: samples per side when looking for the zeros of F on the lower-left sides.
+
+    Returns:
+        :class:`DevelopableLoft` with ``segments``, ``report``, ``sigma``, ``developability``.
+
+    Raises:
+        NotDevelopableError: no branch of F = 0 joins the rails over their whole length (the
+            message says where the branches go; :func:`plot_loft_sign` draws the sign of F).
+        DegenerateGeometryError: coincident rails, a rail that is a point or has a zero tangent,
+            coplanar rails (F ≡ 0).
+        GHTError: bad options or rails that cannot be evaluated.
+    """
+    if orientation not in _ORIENTATIONS:
+        raise GHTError(f"orientation={orientation!r} is not allowed; use one of {_ORIENTATIONS}")
+    if not (branch == "auto" or (isinstance(branch, (int, np.integer)) and not isinstance(branch, bool) and branch >= 0)):
+        raise GHTError(f"branch={branch!r} is not allowed; use 'auto' or a candidate index >= 0")
+    for nm, v, lo, hi in (("max_step", max_step, 1e-6, 0.5), ("step_tol", step_tol, 1e-8, 0.1)):
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and lo <= v <= hi):
+            raise GHTError(f"{nm}={v!r} is not allowed; it must be a number in [{lo:g}, {hi:g}]")
+    for nm, v, lo in (("samples", samples, 9), ("boundary_samples", boundary_samples, 17)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise GHTError(f"{nm}={v!r} is not allowed; it must be an integer >= {lo}")
+    ra = as_rail(rail_a, "rail_a")
+    rb = as_rail(rail_b, "rail_b")
+    size = _check_rails(ra, rb)
+    orients = {"auto": (False, True), "same": (False,), "reversed": (True,)}[orientation]
+    found: list[tuple[_Pair, _Branch]] = []
+    cands: list[dict[str, Any]] = []
+    zero_everywhere = True
+    for rev in orients:
+        pair = _Pair(ra, _Reversed(rb) if rev else rb, size)
+        grid = np.linspace(0.0, 1.0, 33)
+        T, S = np.meshgrid(grid, grid, indexing="ij")
+        fv = pair.f(T.ravel(), S.ravel())
+        if np.max(np.abs(fv)) > 1e-10:
+            zero_everywhere = False
+        for start in _boundary_roots(pair, boundary_samples):
+            given = (start[0], 1.0 - start[1] if rev else start[1])
+            entry: dict[str, Any] = {"orientation": "reversed" if rev else "same", "start": list(given)}
+            try:
+                br = _trace(pair, start, rev, max_step, step_tol)
+            except _TraceFailure as exc:
+                entry["refused"] = str(exc) if not rev else str(exc) + " (rail_b reversed: s there is 1 - s on rail_b)"
+                cands.append(entry)
+                continue
+            entry["end"] = [br.end[0], 1.0 - br.end[1] if rev else br.end[1]]
+            entry["index"] = len(found)
+            found.append((pair, br))
+            cands.append(entry)
+    if zero_everywhere:
+        raise DegenerateGeometryError(
+            "F(t, s) = det(a', b', b - a) vanishes on the whole square: the rails are coplanar (every ruled "
+            "surface between them is planar); use a planar face instead of a loft"
+        )
+    if not found:
+        raise NotDevelopableError(_no_branch_message(ra, rb, size, cands, orients))
+    lofts = []
+    for i, (pair, br) in enumerate(found):
+        if branch != "auto" and i != branch:
+            continue
+        try:
+            lf = DevelopableLoft(rail_a, rail_b, pair, br, samples=samples, candidates=cands)
+            lf._index = i
+            folds = lf.joint_folds()
+            if folds:
+                raise NotDevelopableError(
+                    "the fans fold back over the main part at the joint ruling(s) "
+                    + ", ".join(f"t={f['t']:.6g}, s={f['s']:.6g}" for f in folds)
+                )
+            lofts.append(lf)
+        except NotDevelopableError as exc:
+            for c in cands:
+                if c.get("index") == i:
+                    c["refused"] = str(exc)
+    if branch != "auto" and not lofts:
+        raise GHTError(f"branch={branch} is not a usable candidate; candidates: {cands}")
+    if not lofts:
+        raise NotDevelopableError(_no_branch_message(ra, rb, size, cands, orients))
+    for lf in lofts:
+        for c in cands:
+            if c.get("index") == lf._index:
+                c["fan_share"] = lf.report.fan_share
+                c["regression_inside"] = bool(lf.report.regression)
+    best = min(lofts, key=lambda lf: (bool(lf.report.regression), round(lf.report.fan_share, 9),
+                                      len(lf.segments)))
+    best.report.candidates = cands
+    return best
+
+
+def _no_branch_message(ra: Any, rb: Any, size: float, cands: list[dict[str, Any]], orients: tuple[bool, ...]) -> str:
+    what = "in either orientation of rail_b" if len(orients) == 2 else ("with rail_b reversed" if orients[0] else "with rail_b as given")
+    head = (
+        "no developable joins the rails over their whole length: no branch of F(t, s) = det(a'(t), b'(s), "
+        f"b(s) - a(t)) = 0 runs from a lower-left side (t = 0 or s = 0) to an upper-right side (t = 1 or s = 1) "
+        f"of the parameter square as an increasing curve, {what}"
+    )
+    if not cands:
+        pair = _Pair(ra, rb, size)
+        g = np.linspace(0.0, 1.0, 65)
+        T, S = np.meshgrid(g, g, indexing="ij")
+        f = pair.f(T.ravel(), S.ravel())
+        pos = float(np.mean(f > 0))
+        tail = (f"; F has no zero on the lower-left sides (F/(|a'||b'||b-a|) ranges over [{f.min():.3g}, {f.max():.3g}] "
+                f"on the square, positive on {100 * pos:.0f}% of it)")
+    else:
+        tail = "; branches found: " + "; ".join(
+            f"from (t, s) = ({c['start'][0]:.6g}, {c['start'][1]:.6g}) [{c['orientation']}]: {c.get('refused', 'refused')}"
+            for c in cands
+        )
+    return head + tail + ". ght_cad.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws the sign of F over the square."
+
+
+def loft_function(rail_a: Any, rail_b: Any, t: Any, s: Any, *, normalized: bool = True) -> np.ndarray:
+    r"""``F(t, s) = det(a'(t), b'(s), b(s) - a(t))`` (or ``F / (|a'||b'||b - a|)`` when normalized)
+    at broadcast parameter arrays."""
+    ra = as_rail(rail_a, "rail_a")
+    rb = as_rail(rail_b, "rail_b")
+    tt, ss = np.broadcast_arrays(np.asarray(t, float), np.asarray(s, float))
+    pair = _Pair(ra, rb, 1.0)
+    fn = pair.f if normalized else pair.F
+    return fn(tt.ravel(), ss.ravel()).reshape(tt.shape)
+
+
+def plot_loft_sign(rail_a: Any, rail_b: Any, path: Any, *, loft: DevelopableLoft | None = None, resolution: int = 241) -> Any:
+    r"""PNG of the sign of ``F(t, s) = det(a'(t), b'(s), b(s) - a(t))`` over the (t, s) square.
+
+    Blue where F < 0, red where F > 0: the zero set (the boundary between the colours) holds the
+    possible rulings; a developable loft over the whole rails is an increasing branch from the
+    lower-left to the upper-right sides. With ``loft`` its path (fans along the sides, the traced
+    branch) is drawn in black. 800 x 800 pixels, written atomically (:mod:`ght_cad.plotting`
+    conventions: Agg canvas, no pyplot).
+
+    Returns:
+        The written path.
+    """
+    from .plotting import DPI, _save
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.colors import ListedColormap
+    from matplotlib.figure import Figure
+
+    if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)) or resolution < 9:
+        raise GHTError(f"resolution={resolution!r} is not allowed; it must be an integer >= 9")
+    ra = as_rail(rail_a, "rail_a")
+    rb = as_rail(rail_b, "rail_b")
+    g = np.linspace(0.0, 1.0, resolution)
+    T, S = np.meshgrid(g, g, indexing="ij")
+    f = _Pair(ra, rb, 1.0).f(T.ravel(), S.ravel()).reshape(T.shape)
+    fig = Figure(figsize=(800 / DPI, 800 / DPI), dpi=DPI)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.pcolormesh(g, g, np.sign(f).T, cmap=ListedColormap(["#4a7bd0", "#f0f0f0", "#d05a4a"]), vmin=-1, vmax=1, shading="nearest")
+    ax.contour(g, g, f.T, levels=[0.0], colors="#303030", linewidths=0.6)
+    if loft is not None:
+        lam = np.linspace(0.0, 1.0, 801)
+        t, s = loft.parameters(lam)
+        ax.plot(t, s, color="black", lw=2.2, label="loft path (fans on the sides)")
+        ax.legend(loc="upper left")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("t (rail_a)")
+    ax.set_ylabel("s (rail_b)")
+    ax.set_title("sign of F(t, s) = det(a', b', b - a): red > 0, blue < 0")
+    return _save(fig, path)
+
+
+# ----------------------------------------------------------------------------------------------
+# objectives for optimizing GHT rails' shape parameters
+# ----------------------------------------------------------------------------------------------
+LOFT_OBJECTIVES = ("fan_share", "fairness", "regression")
+
+
+def _regression_penalty(loft: DevelopableLoft, margin: float, nodes: int = 32) -> float:
+    r"""``∫_0^1 max(0, 1 - c(λ)/margin)² dλ`` with ``c`` the distance of ``v*(λ)`` from [0, 1]
+    (fans' apexes excluded: a cone's apex on its rail is not an edge of regression between the
+    rails)."""
+    x, w = gauss_legendre(nodes)
+    tot = 0.0
+    for i, sg in enumerate(loft.segments):
+        lo, hi = loft._edges[i], loft._edges[i + 1]
+        if sg.kind != "main":
+            continue
+        vs = regression_v(sg.a(x, 1), sg.ruling(x), sg.ruling(x, 1))
+        c = np.where(vs < 0, -vs, np.where(vs > 1, vs - 1, 0.0))
+        c = np.where(np.isfinite(vs), c, np.inf)
+        tot += float(np.sum(w * (hi - lo) * np.maximum(0.0, 1.0 - c / margin) ** 2))
+    return tot
+
+
+class LoftProblem(Problem):
+    r"""Objectives of the developable loft over the shape parameters of two GHT rails.
+
+    Parameters ``a.mu, a.nu, a.gamma, b.mu, b.nu, b.gamma``; for each candidate the loft is built
+    (:func:`developable_loft`) and the objective is the weighted sum of
+
+    * ``fan_share``: fan area / loft area (0 = rulings end to end),
+    * ``fairness``: ``∫_0^1 |d'(λ)|² dλ``, d the unit ruling direction,
+    * ``regression``: ``∫ max(0, 1 - c/margin)² dλ``, c the distance of the edge of regression
+      parameter ``v*`` from [0, 1] on the main part (0 when it stays ``margin`` away),
+
+    ``+inf`` where no loft exists (infeasible candidate). Usable with
+    :func:`ght_cad.optimize.minimize` (``problem(X) -> (pop,)``); it has the attributes of
+    :class:`ght_cad.optimize.problems.Problem` (names, lb, ub, x0, build, report).
+
+    Args:
+        rail_a, rail_b: 3-D GHTCurve objects with the 'ght' seed.
+        objective: a name of :data:`LOFT_OBJECTIVES` or a mapping name -> weight.
+        free, bounds: as in :class:`ght_cad.optimize.problems.Problem`.
+        margin: regression margin (fraction of the ruling length).
+        loft_options: passed to :func:`developable_loft`.
+    """
+
+    label = "loft"
+
+    def __init__(
+        self,
+        rail_a: GHTCurve,
+        rail_b: GHTCurve,
+        objective: str | Mapping[str, float] = "fan_share",
+        free: Sequence[str] | None = None,
+        bounds: Mapping[str, tuple[float, float]] | None = None,
+        *,
+        margin: float = 0.25,
+        loft_options: Mapping[str, Any] | None = None,
+    ) -> None:
+        for nm, c in (("rail_a", rail_a), ("rail_b", rail_b)):
+            if not isinstance(c, GHTCurve) or c.dim != 3:
+                raise GHTError(f"{nm} must be a 3-D GHTCurve to optimize its shape parameters, got {c!r}")
+            if c.seed.name != "ght":
+                raise GHTError(f"{nm} uses seed {c.seed.name!r}; shape-parameter problems need the 'ght' seed")
+        if isinstance(objective, str):
+            objective = {objective: 1.0}
+        weights = dict(objective)
+        for k, v in weights.items():
+            if k not in LOFT_OBJECTIVES:
+                raise GHTError(f"loft objective {k!r} is unknown; allowed: {', '.join(LOFT_OBJECTIVES)}")
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise GHTError(f"weight {k}={v!r} is not allowed; weights are finite numbers >= 0")
+        if not any(v > 0 for v in weights.values()):
+            raise GHTError(f"objective={objective!r} has no positive weight")
+        if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin > 0):
+            raise GHTError(f"margin={margin!r} is not allowed; it must be a finite number > 0")
+        names = [f"{r}.{p}" for r in ("a", "b") for p in ("mu", "nu", "gamma")]
+        super().__init__(names, list(rail_a.shape_parameters) + list(rail_b.shape_parameters), free, bounds)
+        self.rail_a, self.rail_b = rail_a, rail_b
+        self.weights = weights
+        self.margin = float(margin)
+        self.loft_options = dict(loft_options or {"samples": 33})
+        self.label = "loft " + "+".join(weights)
+
+    def rails(self, x: Any) -> tuple[GHTCurve, GHTCurve]:
+        """The two rails for free parameters ``x``."""
+        p = self.parameters(x)
+        a = GHTCurve(self.rail_a.control_points, p["a.mu"], p["a.nu"], p["a.gamma"])
+        b = GHTCurve(self.rail_b.control_points, p["b.mu"], p["b.nu"], p["b.gamma"])
+        return a, b
+
+    def _rails_full(self, row: np.ndarray) -> tuple[GHTCurve, GHTCurve]:
+        return (GHTCurve(self.rail_a.control_points, *row[:3]), GHTCurve(self.rail_b.control_points, *row[3:]))
+
+    def measures_of(self, loft: DevelopableLoft) -> dict[str, float]:
+        """fan_share, fairness and regression of one loft."""
+        return {
+            "fan_share": float(loft.report.fan_share),
+            "fairness": loft.fairness(),
+            "regression": _regression_penalty(loft, self.margin),
+        }
+
+    def evaluate_full(self, F: np.ndarray) -> np.ndarray:
+        out = np.empty(F.shape[0])
+        for i, row in enumerate(F):
+            try:
+                if not np.all(np.abs(row) <= 1.0):
+                    raise GHTError("outside the box")
+                lf = developable_loft(*self._rails_full(row), **self.loft_options)
+                m = self.measures_of(lf)
+                out[i] = sum(w * m[k] for k, w in self.weights.items())
+            except GHTError:
+                out[i] = math.inf
+        return np.where(np.isfinite(out), out, np.inf)
+
+    def build(self, x: Any) -> DevelopableLoft:
+        """The loft for free parameters ``x``."""
+        return developable_loft(*self.rails(x), **self.loft_options)
+
+    def report(self, x: Any) -> dict[str, float]:
+        """The objective and all three measures at ``x`` (inf where no loft exists)."""
+        try:
+            lf = self.build(x)
+        except GHTError:
+            return {"objective": math.inf, **{k: math.inf for k in LOFT_OBJECTIVES}}
+        m = self.measures_of(lf)
+        return {"objective": sum(w * m[k] for k, w in self.weights.items()), **m}
