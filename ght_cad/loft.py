@@ -192,6 +192,12 @@ class _ObjectRail:
     def evaluate(self, t: Any) -> np.ndarray:
         return self.derivative(t, 0)
 
+    def jet(self, t: np.ndarray, k: int) -> list[np.ndarray]:
+        """``[r, r', ..., r^(k)]`` at t; one pass for a GHTCurve (:meth:`GHTCurve.derivatives`)."""
+        if isinstance(self.obj, GHTCurve) and k <= 3:
+            return self.obj.derivatives(t, k)
+        return [self.derivative(t, r) for r in range(k + 1)]
+
     def __repr__(self) -> str:
         return f"{self.name}={self.obj!r}"
 
@@ -238,8 +244,15 @@ class _Reversed:
     def evaluate(self, t: Any) -> np.ndarray:
         return self.derivative(t, 0)
 
+    def jet(self, t: np.ndarray, k: int) -> list[np.ndarray]:
+        return [(-1.0) ** r * x for r, x in enumerate(_jet(self.rail, 1.0 - np.asarray(t, float), k))]
+
 
 def _jet(rail: Any, t: np.ndarray, k: int) -> list[np.ndarray]:
+    """``[r, r', ..., r^(k)]`` at t (the rail's one-pass ``jet`` where it has one)."""
+    fast = getattr(rail, "jet", None)
+    if fast is not None:
+        return fast(t, k)
     return [rail.derivative(t, r) for r in range(k + 1)]
 
 
@@ -273,15 +286,15 @@ class _Pair:
         return out
 
     def F(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
-        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
-        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
+        A0, A1 = _jet(self.ra, t, 1)
+        B0, B1 = _jet(self.rb, s, 1)
         return _det(A1, B1, B0 - A0)
 
     def f(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Scale-free ``F / (|a'| |b'| |g|)`` (the sine of the angle between the two end planes,
         up to the sines of the ruling angles); 0 where a scale factor vanishes."""
-        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
-        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
+        A0, A1 = _jet(self.ra, t, 1)
+        B0, B1 = _jet(self.rb, s, 1)
         g = B0 - A0
         sc = np.linalg.norm(A1, axis=1) * np.linalg.norm(B1, axis=1) * np.linalg.norm(g, axis=1)
         F = _det(A1, B1, g)
@@ -295,7 +308,7 @@ class _Pair:
         lo = np.maximum(0.0, 2 * lam - 1.0)
         hi = np.minimum(1.0, 2 * lam)
         t = np.clip(np.asarray(t, float).copy(), lo, hi)
-        done = False
+        self.last = None
         for it in range(iters):
             s = 2 * lam - t
             p = self.parts(t, s, 1)
@@ -304,23 +317,17 @@ class _Pair:
                 dt = np.where(dG != 0, p["F"] / dG, 0.0)
             if not np.all(np.isfinite(dt)):
                 return t, 2 * lam - t, False
+            resid = np.abs(p["F"]) <= 4 * _EPS * np.maximum(p["scale"], 1e-300)
+            if np.all(resid | (np.abs(dt) <= 2 * _EPS * np.maximum(1.0, np.abs(t)))):
+                # converged at this t (F at round-off): keep t and its partials
+                self.last = p
+                return t, s, True
             t = np.clip(t - dt, lo, hi)
-            small = np.abs(dt) <= 4 * _EPS * np.maximum(1.0, np.abs(t))
-            resid = np.abs(p["F"]) <= 8 * _EPS * np.maximum(p["scale"], 1e-300)
-            if np.all(small | resid):
-                if done:
-                    break
-                done = True  # one more iteration after convergence: polish to round-off
         s = 2 * lam - t
-        F = self.F(t, s)
-        scale = self._scale(t, s)
-        ok = bool(np.all(np.abs(F) <= 1e-12 * np.maximum(scale, 1e-300)))
+        p = self.parts(t, s, 1)
+        self.last = p
+        ok = bool(np.all(np.abs(p["F"]) <= 1e-12 * np.maximum(p["scale"], 1e-300)))
         return t, s, ok
-
-    def _scale(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
-        A0, A1 = self.ra.derivative(t, 0), self.ra.derivative(t, 1)
-        B0, B1 = self.rb.derivative(s, 0), self.rb.derivative(s, 1)
-        return np.linalg.norm(A1, axis=1) * np.linalg.norm(B1, axis=1) * np.linalg.norm(B0 - A0, axis=1)
 
     def tangent(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(dt/dλ, ds/dλ) = (2 F_s, -2 F_t) / (F_s - F_t)`` on the branch."""
@@ -339,6 +346,12 @@ class _Pair:
             return float(self.F(np.array([x]), np.array([1.0]))[0])
 
         x = min(max(guess, 0.0), 1.0)
+        # the branch may end at a corner, where F is round-off but need not change sign
+        for c in (0.0, 1.0):
+            if abs(x - c) <= 1e-2:
+                tt, ss = (np.array([1.0]), np.array([c])) if side == "t=1" else (np.array([c]), np.array([1.0]))
+                if abs(float(self.f(tt, ss)[0])) <= 1e-12:
+                    return c
         h = 1e-6
         for lo_, hi_ in ((x - h, x + h), (x - 1e-3, x + 1e-3), (x - 0.05, x + 0.05), (0.0, 1.0)):
             lo_, hi_ = max(lo_, 0.0), min(hi_, 1.0)
@@ -506,7 +519,9 @@ def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: 
                     "branches cross or F vanishes on a region there"
                 )
             continue
-        tpn, spn = (float(v[0]) for v in pair.tangent(np.array([tn]), np.array([sn])))
+        q = pair.last
+        den = float(q["Fs"][0] - q["Ft"][0])
+        tpn, spn = (2 * float(q["Fs"][0]) / den, -2 * float(q["Ft"][0]) / den) if den != 0 else (math.nan, math.nan)
         check(tpn, spn, tn, sn)
         lam, t, s, tp, sp = lam_n, tn, sn, tpn, spn
         L.append(lam), T.append(t), S.append(s), TP.append(tp), SP.append(sp)
@@ -538,18 +553,20 @@ class _Path:
 
     def main(self, lam: np.ndarray, k: int) -> list[np.ndarray]:
         """[t, t', t''], [s, s', s''] on the branch at ``lam`` (derivatives w.r.t. λ, up to k)."""
-        key = lam.tobytes() + bytes([k])
+        key = lam.tobytes()
         hit = self._cache.get(key)
-        if hit is not None:
+        if hit is not None and len(hit[0]) >= k + 1:
             return hit
         g = np.clip(self._guess(lam), 0.0, 1.0) if self._guess is not None else np.full(lam.shape, self.branch.t[0])
         t, s, ok = self.pair.correct(lam, g)
+        p = self.pair.last
         if not ok:
             bad = int(np.argmax(np.abs(self.pair.f(t, s))))
             raise NotDevelopableError(
                 f"Newton on F(t, s) = 0 failed at λ={lam[bad]:.9g} (t={t[bad]:.9g}, s={s[bad]:.9g}) of the traced branch"
             )
-        p = self.pair.parts(t, s, 2 if k >= 2 else 1)
+        if k >= 2:
+            p = self.pair.parts(t, s, 2)
         Ft, Fs = p["Ft"], p["Fs"]
         den = Fs - Ft
         tp = 2 * Fs / den
@@ -1102,7 +1119,7 @@ def developable_loft(
     *,
     orientation: str = "auto",
     branch: str | int = "auto",
-    max_step: float = 1.0 / 64,
+    max_step: float = 1.0 / 16,
     step_tol: float = 2e-3,
     samples: int = 257,
     boundary_samples: int = 513,
