@@ -81,7 +81,7 @@ def bench_optimization(iterations: int, pop: int, seed: int = 1) -> dict[str, fl
     after = prob.report(res.x)
     print(f"fan share before optimization: {before['fan_share']:.5f} (fairness {before['fairness']:.4g})")
     print(f"fan share after  optimization: {after['fan_share']:.5f} (fairness {after['fairness']:.4g}) "
-          f"at {dict(zip(prob.names, np.round(res.x, 4)))}; PSO {pop} x {iterations} in {dt:.1f} s")
+          f"at {dict(zip(prob.names, (round(float(v), 4) for v in res.x)))}; PSO {pop} x {iterations} in {dt:.1f} s")
     return {"fan_share_before": before["fan_share"], "fan_share_after": after["fan_share"], "seconds": dt}
 
 
