@@ -19,7 +19,7 @@ import numpy as np
 
 from ._validate import as_parameter_array, check_degree, check_unit_interval
 from .errors import GHTError
-from .seeds import MAX_DERIVATIVE, Seed, make_seed
+from .seeds import MAX_DERIVATIVE, Seed, ght_seed_parameter_derivatives, make_seed
 
 __all__ = [
     "basis",
@@ -29,6 +29,8 @@ __all__ = [
     "basis_from_jets",
     "bernstein",
     "bernstein_recursive_basis",
+    "parameter_jets",
+    "basis_parameter_derivatives",
 ]
 
 _CHUNK = 1 << 15
@@ -311,3 +313,51 @@ def bernstein_recursive_basis(t: Any, degree: int, seed: Seed) -> np.ndarray:
         nb[:, 1:] += tt[:, None] * b
         b = nb
     return b
+
+
+def parameter_jets(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order: int) -> list[list[tuple[np.ndarray, np.ndarray, np.ndarray]]]:
+    r"""Seed jets differentiated by the shape parameters, ready for :func:`basis_from_jets`.
+
+    ``out[j][s] = (∂f0^(s)/∂θ_j, ∂f1^(s)/∂θ_j, ∂f2^(s)/∂θ_j)`` for ``θ = (μ, ν, γ)``, s = 0..K, from
+    :func:`ght_cad.seeds.ght_seed_parameter_derivatives` (``∂f1 = -∂f0 - ∂f2``, ``∂f0/∂ν = ∂f2/∂μ = 0``).
+    Parameters broadcast against ``t`` as in :func:`ght_cad.seeds.ght_seed_jet`; each entry gets a
+    trailing axis of length 1 so that it broadcasts against Bernstein columns.
+    """
+    d = ght_seed_parameter_derivatives(t, mu, nu, gamma, max_order)
+    out: list[list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = [[], [], []]
+    for d0mu, d0ga, d2nu, d2ga in d:
+        z = np.zeros_like(d0mu)[..., None]
+        out[0].append((d0mu[..., None], -d0mu[..., None], z))
+        out[1].append((z, -d2nu[..., None], d2nu[..., None]))
+        out[2].append((d0ga[..., None], -(d0ga + d2ga)[..., None], d2ga[..., None]))
+    return out
+
+
+def basis_parameter_derivatives(t: Any, degree: int, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0,
+                                derivative: int = 0) -> np.ndarray:
+    r"""Derivatives of the GHT basis ``b^{(r)}_{i,m}(t)`` with respect to ``μ, ν, γ`` (spec 8.1).
+
+    ``∂b^{(r)}_{i,m}/∂θ = Σ_{s=0..r} C(r,s) Σ_{k=0..2} B^{(r-s)}_{i-k,n} ∂f_k^{(s)}/∂θ``, ``n = m-2``,
+    with the closed-form seed derivatives of :func:`ght_cad.seeds.ght_seed_parameter_derivatives`
+    (``f0`` is bilinear in (μ, w), ``f2`` in (ν, w), ``w = (1+γ)/2``).
+
+    Args:
+        t: parameter value(s) in [0, 1] (scalar or 1-D array).
+        degree: basis degree m >= 2.
+        mu, nu, gamma: shape parameters in [-1, 1].
+        derivative: t-derivative order r, 0..3.
+
+    Returns:
+        Array of shape (3, len(t), degree+1): ``∂/∂μ``, ``∂/∂ν``, ``∂/∂γ``; for scalar ``t`` (3, degree+1).
+
+    Raises:
+        GHTError: as :func:`basis`.
+    """
+    m = check_degree(degree)
+    r = _check_order(derivative)
+    make_seed("ght", mu, nu, gamma)  # validates the shape parameters
+    tt, scalar = as_parameter_array(t)
+    check_unit_interval("t", tt, slack=1e-9)
+    bern = [bernstein(tt, m - 2, q) for q in range(r + 1)]
+    out = np.stack([basis_from_jets(bern, jets, r) for jets in parameter_jets(tt, mu, nu, gamma, r)])
+    return out[:, 0] if scalar else out

@@ -43,6 +43,7 @@ __all__ = [
     "MAX_DERIVATIVE",
     "ght_seed_jet",
     "ght_seed_derivatives",
+    "ght_seed_parameter_derivatives",
 ]
 
 #: Highest derivative order every seed provides analytically.
@@ -254,6 +255,60 @@ def ght_seed_derivatives(t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order:
     K = int(max_order)
     trig = _trig_values(t, range(K + 1))
     return [_ght_from_trig(t, mu, nu, gamma, r, trig) for r in range(K + 1)]
+
+
+def ght_seed_parameter_derivatives(
+    t: np.ndarray, mu: Any, nu: Any, gamma: Any, max_order: int
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    r"""Exact derivatives of the GHT seed jets with respect to the shape parameters (spec 8.1).
+
+    ``f0`` is bilinear in ``(μ, w)`` and ``f2`` in ``(ν, w)``, ``w = (1+γ)/2``, so for every
+    t-derivative order r:
+
+    * ``∂f0^(r)/∂μ = (1-w) (-s^(r) + (s²)^(r))``  (from ``(1-s)(1-μs) = 1 - (1+μ)s + μs²``),
+    * ``∂f2^(r)/∂ν = (1-w) (-c^(r) + (c²)^(r))``,
+    * ``∂f0^(r)/∂γ = (p0^(r) - g0^(r)) / 2``, ``∂f2^(r)/∂γ = (p2^(r) - g2^(r)) / 2`` with
+      ``g0 = (1-s)(1-μs)``, ``g2 = (1-c)(1-νc)`` (the GBT seed), ``p0 = (1-t)²``, ``p2 = t²``,
+
+    and ``∂f0/∂ν = ∂f2/∂μ = 0``; ``f1 = 1 - f0 - f2`` gives ``∂f1 = -∂f0 - ∂f2``. The sin/cos
+    derivatives are those of :func:`ght_seed_jet` (one shared pass).
+
+    Args:
+        t: parameters, 1-D array (N,).
+        mu, nu, gamma: shape parameters, scalars or arrays broadcasting against ``t``.
+        max_order: highest t-derivative order K >= 0.
+
+    Returns:
+        K+1 tuples ``(∂f0^(r)/∂μ, ∂f0^(r)/∂γ, ∂f2^(r)/∂ν, ∂f2^(r)/∂γ)``, each of the broadcast
+        shape of ``t`` and the parameters.
+    """
+    t = np.asarray(t, dtype=float)
+    K = int(max_order)
+    trig = _trig_values(t, range(K + 1))
+    sa, ca = trig[0], trig[1]
+    v = 1.0 - 0.5 * (1.0 + np.asarray(gamma, dtype=float))
+    zero = np.zeros(np.broadcast_shapes(t.shape, np.shape(mu), np.shape(nu), np.shape(gamma)))
+    out = []
+    for r in range(K + 1):
+        g0, g2 = _ght_from_trig(t, mu, nu, -1.0, r, trig)  # w = 0: the GBT part
+        if r == 0:
+            dmu = sa * sa - sa
+            dnu = ca * ca - ca
+            p0, p2 = (1.0 - t) ** 2, t * t
+        else:
+            hr, pr = _HALF_PI**r, math.pi**r
+            sg_s, cos_s = _SIN_D[r % 4]
+            sg_c, cos_c = _COS_D[r % 4]
+            x_s = ca if cos_s else sa
+            x_c = ca if cos_c else sa
+            x_d = trig[3] if cos_c else trig[2]
+            half_d = 0.5 * pr * sg_c  # (c²)^(r) = -(s²)^(r) = half_d * x_d
+            dmu = -(hr * sg_s) * x_s - half_d * x_d
+            dnu = -(hr * sg_c) * x_c + half_d * x_d
+            p0 = {1: 2.0 * t - 2.0, 2: np.full_like(t, 2.0)}.get(r, np.zeros_like(t))
+            p2 = {1: 2.0 * t, 2: np.full_like(t, 2.0)}.get(r, np.zeros_like(t))
+        out.append((zero + v * dmu, zero + 0.5 * (p0 - g0), zero + v * dnu, zero + 0.5 * (p2 - g2)))
+    return out
 
 
 class GHTSeed(Seed):

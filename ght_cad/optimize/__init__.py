@@ -22,6 +22,7 @@ Example:
 from __future__ import annotations
 
 from .optimizers import (
+    hybrid,
     METHODS,
     OptimizerState,
     OptimizeResult,
@@ -48,6 +49,7 @@ __all__ = [
     "OptimizeResult",
     "as_bounds",
     "differential_evolution",
+    "hybrid",
     "gwo",
     "igwo",
     "minimize",

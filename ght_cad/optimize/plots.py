@@ -49,7 +49,9 @@ def plot_convergence(
 ) -> Path:
     """Best value so far against objective evaluations (or iterations), one colour per method.
 
-    Several runs of one method (e.g. seeds) are drawn thin with their median bold.
+    Several runs of one method (e.g. seeds) are drawn thin with their median bold. Runs with
+    ``phases`` (``hybrid``: global phase, then L-BFGS-B) get a ``|`` marker where the second phase
+    starts (and a dotted vertical line for a single run), labelled with the phase names.
 
     Args:
         results: an OptimizeResult, a list of them (grouped by ``method``) or a mapping
@@ -86,6 +88,15 @@ def plot_convergence(
             ax.plot(xs, r.history + shift, color=c, lw=0.6 if len(rs) > 1 else 1.6,
                     alpha=0.35 if len(rs) > 1 else 1.0,
                     label=None if len(rs) > 1 else label)
+        # multi-phase runs (hybrid): a marker where the local phase starts, the phase names once
+        for j, r in enumerate(rs):
+            for k, (pname, at) in enumerate(getattr(r, "phases", ())[1:]):
+                if 0 < at < r.history.size:
+                    xs = r.history_nfev if x == "nfev" else np.arange(r.history.size)
+                    ax.plot([xs[at - 1]], [r.history[at - 1] + shift], marker="|", ms=12, mew=1.5, color=c,
+                            ls="none", label=(f"{label}: {r.phases[k][0]} | {pname}" if j == 0 else None))
+                    if len(rs) == 1:
+                        ax.axvline(xs[at - 1], color=c, lw=0.6, ls=":")
         if len(rs) > 1:
             n = min(r.history.size for r in rs)
             med = np.median(np.array([r.history[:n] for r in rs]), axis=0) + shift

@@ -29,11 +29,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..basis import basis_from_jets, bernstein
+from ..basis import _compact_differences, basis_from_jets, bernstein, parameter_jets
 from ..curve import GHTCurve, gauss_legendre
 from ..errors import GHTError
 from ..ruled import CurvePairRuledSurface, RuledSurface
-from ..seeds import ght_seed_derivatives, ght_seed_jet
+from ..seeds import ght_seed_derivatives, ght_seed_jet, ght_seed_parameter_derivatives
 
 __all__ = [
     "ght_seed_jets",
@@ -50,6 +50,8 @@ __all__ = [
     "default_strip_problem",
     "default_dual_problem",
     "default_interpolation_problem",
+    "wave_strip_problem",
+    "cone_strip_problem",
 ]
 
 SHAPE_NAMES = ("mu", "nu", "gamma")
@@ -119,6 +121,62 @@ class PopulationBasis:
         for s, (f0, f2) in enumerate(ght_seed_derivatives(self.t, *_columns(mu, nu, gamma), top)):
             jets.append((f0[:, :, None], ((1.0 if s == 0 else 0.0) - f0 - f2)[:, :, None], f2[:, :, None]))
         return {r: basis_from_jets(self._bern, jets, r) for r in orders}
+
+    def parameter_derivatives(self, mu: Any, nu: Any, gamma: Any, orders: Sequence[int]) -> dict[int, np.ndarray]:
+        r"""``{r: ∂b^{(r)}/∂(μ, ν, γ)}`` for the requested orders, each (3, P, N, m+1) (spec 8.1).
+
+        ``∂b^{(r)}_{i,m}/∂θ = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} ∂f_k^{(s)}/∂θ`` with the closed-form
+        seed derivatives (:func:`ght_cad.basis.parameter_jets`).
+        """
+        pj = parameter_jets(self.t, *_columns(mu, nu, gamma), max(orders))
+        return {r: np.stack([basis_from_jets(self._bern, jets, r) for jets in pj]) for r in orders}
+
+
+class CurveParameterJets:
+    r"""``∂X^(r)/∂(μ, ν, γ)`` of a GHT curve with a fixed control polygon, for P parameter sets.
+
+    Compact form ``X = Q1 + f0 (Q0 - Q1) + f2 (Q2 - Q1)`` (``Q_k`` the degree-(m-2) Bézier curves
+    on ``P_k..P_{k+m-2}``, fixed at the nodes), so by Leibniz' rule
+
+    ``∂X^(r)/∂θ = Σ_s C(r,s) (∂f0^(s)/∂θ (Q0-Q1)^(r-s) + ∂f2^(s)/∂θ (Q2-Q1)^(r-s))``
+
+    with the closed-form seed derivatives (:func:`ght_cad.seeds.ght_seed_parameter_derivatives`;
+    ``∂f0/∂ν = ∂f2/∂μ = 0``). Only broadcasting products per call: the Bézier parts are computed once.
+
+    Args:
+        t: nodes (N,).
+        control_points: (m+1, dim), m >= 2.
+        max_order: highest t-derivative order needed.
+    """
+
+    def __init__(self, t: Any, control_points: Any, max_order: int) -> None:
+        self.t = np.asarray(t, dtype=float)
+        P = np.asarray(control_points, dtype=float)
+        self.K = int(max_order)
+        n = P.shape[0] - 3
+        zero = np.zeros((self.t.size, P.shape[1]))
+        # Q[q] = ((Q0 - Q1)^(q), (Q2 - Q1)^(q)) at the nodes, each (N, dim)
+        self.Q = [(zero, zero) if Dq is None else tuple(bernstein(self.t, n - q) @ Dq[k] for k in (0, 1))
+                  for q, Dq in enumerate(_compact_differences(P, self.K))]
+
+    def __call__(self, mu: Any, nu: Any, gamma: Any, orders: Sequence[int]) -> dict[int, np.ndarray]:
+        """``{r: ∂X^(r)/∂(μ, ν, γ)}``, each (3, P, N, dim)."""
+        from math import comb
+
+        d = ght_seed_parameter_derivatives(self.t, *_columns(mu, nu, gamma), max(orders))
+        out = {}
+        for r in orders:
+            acc = None
+            for s_ in range(r + 1):
+                d0mu, d0ga, d2nu, d2ga = (x[..., None] for x in d[s_])
+                E0, E2 = self.Q[r - s_]
+                c = comb(r, s_)
+                term = np.stack([d0mu * E0, d2nu * E2, d0ga * E0 + d2ga * E2])
+                if c != 1:
+                    term *= c
+                acc = term if acc is None else acc + term
+            out[r] = acc
+        return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -218,6 +276,29 @@ class Problem:
         """Objective at one free-parameter vector."""
         return float(self(np.asarray(x, dtype=float).reshape(1, -1))[0])
 
+    #: True for problems with exact gradients (:meth:`value_and_grad`).
+    has_gradient = True
+
+    def value_and_grad_full(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - abstract
+        """Values (pop,) and exact gradients (pop, len(all_names)) on full parameter rows."""
+        raise NotImplementedError
+
+    def value_and_grad(self, X: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Objective values (pop,) and exact gradients (pop, dim) for a population of free parameters.
+
+        The values equal ``self(X)`` bit for bit; the gradient is the chain rule through the
+        basis (spec 8.1: the seed is bilinear in (μ, w) and (ν, w)) and is 0 where the value is
+        ``+inf``.
+        """
+        f, G = self.value_and_grad_full(self.full(X))
+        G = G[:, self._idx]
+        G[~np.isfinite(f)] = 0.0
+        return f, G
+
+    def gradient(self, X: Any) -> np.ndarray:
+        """Exact gradients (pop, dim) of the objective (:meth:`value_and_grad`)."""
+        return self.value_and_grad(X)[1]
+
     # -- result objects --------------------------------------------------------------------
     def build(self, x: Any) -> Any:  # pragma: no cover - abstract
         """The geometric object (curve or surface) for free parameters ``x``."""
@@ -226,6 +307,13 @@ class Problem:
     def report(self, x: Any) -> dict[str, float]:
         """Measures of the design at ``x`` (for before/after tables)."""
         return {"objective": self.value(x)}
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a × b`` over the last axis (length 3) with broadcasting; like ``numpy.cross`` without its axis handling."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _split(all_params: np.ndarray, start: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -279,6 +367,8 @@ class StripProblem(Problem):
         self.curve_a, self.curve_b = curve_a, curve_b
         self.t, self.w = gauss_legendre(int(nodes))
         self._basis = (PopulationBasis(self.t, curve_a.degree), PopulationBasis(self.t, curve_b.degree))
+        self._pjets = (CurveParameterJets(self.t, curve_a.control_points, 1),
+                       CurveParameterJets(self.t, curve_b.control_points, 1))
 
     def jets(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``A, A', B, B'`` at the nodes for full parameter rows F: each (pop, N, 3)."""
@@ -291,6 +381,20 @@ class StripProblem(Problem):
         return out[0], out[1], out[2], out[3]
 
     def evaluate_full(self, F: np.ndarray) -> np.ndarray:
+        return self._r_and_grad(F, False)[0]
+
+    def value_and_grad_full(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r"""``R`` and its exact gradient on full rows (a.mu, a.nu, a.gamma, b.mu, b.nu, b.gamma).
+
+        With ``g = B - A``, ``n_a = A'×g``, ``n_b = B'×g``, ``c = n_a·n_b / (|n_a||n_b|)``:
+        ``∂c = (∂n_a·n_b + n_a·∂n_b)/(|n_a||n_b|) - c (n_a·∂n_a/|n_a|² + n_b·∂n_b/|n_b|²)``,
+        ``∂n_a = ∂A'×g + A'×∂g``, ``∂n_b = ∂B'×g + B'×∂g``, ``∂g = ∂B - ∂A``, and
+        ``∂R = -Σ_j w_j ∂c_j`` (0 where the clip to [-1, 1] is active); ``∂A, ∂A'`` from
+        :class:`CurveParameterJets`.
+        """
+        return self._r_and_grad(F, True)
+
+    def _r_and_grad(self, F: np.ndarray, grad: bool) -> tuple[np.ndarray, Any]:
         A, A1, B, B1 = self.jets(F)
         g = B - A
         na = np.cross(A1, g)
@@ -300,7 +404,28 @@ class StripProblem(Problem):
         with np.errstate(divide="ignore", invalid="ignore"):
             dot = np.sum(na * nb, axis=-1) / (la * lb)
         val = (1.0 - np.clip(dot, -1.0, 1.0)) @ self.w
-        return np.where(np.isfinite(val), val, np.inf)
+        val = np.where(np.isfinite(val), val, np.inf)
+        if not grad:
+            return val, None
+        G = np.zeros((F.shape[0], 6))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            inv = 1.0 / (la * lb)
+            ca, cb = dot / (la * la), dot / (lb * lb)
+            active = (np.abs(dot) < 1.0) & np.isfinite(dot)  # (pop, N): where c is not clipped
+            for k, pj in ((0, self._pjets[0]), (3, self._pjets[1])):
+                dXr = pj(*_split(F, k), (0, 1))
+                dX, dX1 = dXr[0], dXr[1]  # (3, pop, N, 3)
+                if k == 0:  # curve A: dg = -dA
+                    dna = _cross(dX1, g) - _cross(A1, dX)
+                    dnb = -_cross(B1, dX)
+                else:  # curve B: dg = dB
+                    dna = _cross(A1, dX)
+                    dnb = _cross(dX1, g) + _cross(B1, dX)
+                dc = (np.sum(dna * nb, axis=-1) + np.sum(na * dnb, axis=-1)) * inv \
+                    - ca * np.sum(na * dna, axis=-1) - cb * np.sum(nb * dnb, axis=-1)
+                G[:, k:k + 3] = -(np.where(active, dc, 0.0) @ self.w).T
+        G[~np.isfinite(val)] = 0.0
+        return val, G
 
     def curves(self, x: Any) -> tuple[GHTCurve, GHTCurve]:
         """The two boundary curves for free parameters ``x``."""
@@ -369,20 +494,60 @@ class FairnessProblem(Problem):
         """``(AL, En, CVEn)`` for a population of free parameters, shape (pop, 3)."""
         return self.measures_full(self.full(X))
 
+    def control_point_derivatives(self, F: np.ndarray, P: np.ndarray) -> np.ndarray | None:
+        """``∂P/∂(μ, ν, γ)`` per row, shape (3, pop, m+1, dim); None for a fixed control polygon."""
+        return None
+
     def measures_full(self, F: np.ndarray) -> np.ndarray:
+        return self._measures(F, False)[0]
+
+    def _measures(self, F: np.ndarray, grad: bool) -> tuple[np.ndarray, Any]:
+        r"""``(AL, En, CVEn)`` (pop, 3) and, with ``grad``, their derivatives (pop, 3 params, 3 measures).
+
+        ``∂AL = Σ_j w_j X^(1)·∂X^(1)/|X^(1)|``, ``∂En = 2 Σ_j w_j X^(2)·∂X^(2)``,
+        ``∂CVEn = 2 Σ_j w_j X^(3)·∂X^(3)``, ``∂X^(r) = (∂b^(r)) P + b^(r) ∂P``.
+        """
         mu, nu, ga = _split(F, 0)
         P = self.control_points_for(F)
         spec = "pnj,jd->pnd" if P.ndim == 2 else "pnj,pjd->pnd"
         out = np.empty((F.shape[0], 3))
         Bm = self._basis(mu, nu, ga, (1, 2, 3))
+        dout = np.zeros((F.shape[0], 3, 3)) if grad else None
+        if grad:
+            dP = self.control_point_derivatives(F, P)
+            if P.ndim == 2:  # fixed polygon: compact form, Bézier parts once per problem
+                if getattr(self, "_pjets", None) is None:
+                    self._pjets = CurveParameterJets(self.t, P, 3)
+                dX = self._pjets(mu, nu, ga, (1, 2, 3))
+            else:
+                dBm = self._basis.parameter_derivatives(mu, nu, ga, (1, 2, 3))
         for r in (1, 2, 3):
             D = np.einsum(spec, Bm[r], P) if P.ndim == 3 else Bm[r] @ P
             sq = np.sum(D * D, axis=-1)
             out[:, r - 1] = (np.sqrt(sq) if r == 1 else sq) @ self.w
-        return np.where(np.isfinite(out), out, np.inf)
+            if grad:
+                dD = np.einsum("jpnk,pkd->jpnd", dBm[r], P) if P.ndim == 3 else dX[r]
+                if dP is not None:
+                    dD = dD + np.einsum("pnk,jpkd->jpnd", Bm[r], dP)
+                dot = np.sum(D * dD, axis=-1)  # (3, pop, N)
+                if r == 1:
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        dot = np.where(sq > 0, dot / np.sqrt(sq), 0.0)
+                else:
+                    dot = 2.0 * dot
+                dout[:, :, r - 1] = (dot @ self.w).T
+        out = np.where(np.isfinite(out), out, np.inf)
+        if grad:
+            dout[~np.all(np.isfinite(out), axis=1)] = 0.0
+        return out, dout
 
     def evaluate_full(self, F: np.ndarray) -> np.ndarray:
         return self.measures_full(F) @ self.weights
+
+    def value_and_grad_full(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``w·(AL, En, CVEn)`` and its exact gradient with respect to (mu, nu, gamma) (:meth:`_measures`)."""
+        m, dm = self._measures(F, True)
+        return m @ self.weights, dm @ self.weights
 
     def report(self, x: Any) -> dict[str, float]:
         """``AL``, ``En``, ``CVEn`` and the weighted objective at ``x``."""
@@ -469,6 +634,24 @@ class InterpolationFairnessProblem(FairnessProblem):
                         pass
                 return out
 
+    def control_point_derivatives(self, F: np.ndarray, P: np.ndarray) -> np.ndarray:
+        r"""``∂P/∂θ = -M^{-1} (∂M/∂θ) P`` for ``M P = Q`` (``M_{ji} = b_{i,m}(t_j)``), shape (3, pop, k, dim)."""
+        mu, nu, ga = _split(F, 0)
+        dM = PopulationBasis(self.tj, self.degree).parameter_derivatives(mu, nu, ga, (0,))[0]  # (3, pop, k, k)
+        M = population_basis(self.tj, self.degree, mu, nu, ga, 0)
+        out = np.full((3,) + P.shape, np.nan)
+        with np.errstate(all="ignore"):
+            rhs = -(dM @ P)  # (3, pop, k, dim)
+            try:
+                return np.linalg.solve(M[None], rhs)
+            except np.linalg.LinAlgError:  # some rows singular: those stay NaN
+                for i in np.nonzero(np.all(np.isfinite(P), axis=(1, 2)))[0]:
+                    try:
+                        out[:, i] = np.linalg.solve(M[i][None], rhs[:, i])
+                    except np.linalg.LinAlgError:
+                        pass
+        return out
+
     def build(self, x: Any) -> GHTCurve:
         """The interpolating curve for free parameters ``x``."""
         F = self.full(np.asarray(x, dtype=float).reshape(1, -1))
@@ -553,6 +736,13 @@ class DualCurveFairnessProblem(FairnessProblem):
         ``check_surface``)."""
         val = super().evaluate_full(F)
         return np.where(self._admissible_full(F, np.isfinite(val)), val, np.inf)
+
+    def value_and_grad_full(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Weighted fairness and its exact gradient; ``+inf`` (gradient 0) where the surface cannot be built."""
+        val, G = super().value_and_grad_full(F)
+        ok = self._admissible_full(F, np.isfinite(val))
+        G[~ok] = 0.0
+        return np.where(ok, val, np.inf), G
 
     def admissible(self, X: Any) -> np.ndarray:
         """Boolean mask over the rows of ``X`` (free parameters): True where the surface can be
@@ -643,3 +833,29 @@ def default_interpolation_problem(objective: Any = "En", **kw: Any) -> Interpola
     """Five points of a 3-D space curve (a helix-like arc)."""
     pts = [[0.0, 0.0, 0.0], [1.0, 0.8, 0.3], [2.0, 1.0, 0.9], [3.0, 0.4, 1.2], [3.6, -0.5, 1.0]]
     return InterpolationFairnessProblem(pts, objective=objective, **kw)
+
+
+def wave_strip_problem(free: Sequence[str] | None = None, **kw: Any) -> StripProblem:
+    """A strip between two quartic GHT curves over a wavy cross-section (bench problem).
+
+    Unlike :func:`default_strip_problem` (cubics, planar end quadrilaterals) the ends are twisted
+    too; the minimum of R lies on the box boundary in four of the six parameters
+    (``a.mu = -1, a.nu = 1, a.gamma = -1, b.nu = 1``; θ_max 10.4° -> 9.5°).
+    """
+    A = GHTCurve([[0.0, 0.0, 0.0], [1.0, 0.6, 0.2], [2.0, -0.5, 0.1], [3.0, 0.7, -0.2], [4.0, 0.0, 0.0]])
+    B = GHTCurve([[0.1, 0.2, 1.2], [1.1, 1.0, 1.0], [2.1, -0.1, 1.4], [2.9, 1.1, 0.9], [4.1, 0.3, 1.1]])
+    return StripProblem(A, B, free=free, **kw)
+
+
+def cone_strip_problem(free: Sequence[str] | None = None, **kw: Any) -> StripProblem:
+    """A conical strip between two quartic arcs (radius 2 at z ≈ 0, radius 1.1 at z ≈ 1.5) with
+    perturbed heights and angles (bench problem).
+
+    The minimum of R is flat and has ``a.nu = a.gamma = -1``, ``b.nu = 1`` on the box boundary
+    and ``a.mu, b.mu, b.gamma`` inside: a finish must land exactly on the bounds.
+    """
+    ang = np.radians([0.0, 30.0, 60.0, 90.0, 120.0])
+    angb = np.radians([5.0, 40.0, 65.0, 95.0, 118.0])
+    A = GHTCurve(np.column_stack([2.0 * np.cos(ang), 2.0 * np.sin(ang), [0.0, 0.15, -0.1, 0.2, 0.0]]))
+    B = GHTCurve(np.column_stack([1.1 * np.cos(angb), 1.1 * np.sin(angb), [1.5, 1.3, 1.7, 1.45, 1.6]]))
+    return StripProblem(A, B, free=free, **kw)
