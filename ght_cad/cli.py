@@ -621,13 +621,14 @@ def build_parser() -> argparse.ArgumentParser:
         "optimize",
         help="optimize the shape parameters of a design's surface",
         description="Minimize the design's objective (AL, En, CVEn of the dual curve, or R, the "
-        "developability objective of a curve-pair strip) over the shape parameters with PSO, GWO or "
-        "I-GWO. For a composite surface the measure is summed over the strips and every joint keeps "
+        "developability objective of a curve-pair strip) over the shape parameters with the hybrid "
+        "method (default), PSO, GWO or I-GWO. For a composite surface the measure is summed over the strips and every joint keeps "
         "its G1/G2/G3 order. Options override the design's [optimize] block.",
         epilog=_EPILOG,
     )
     design_arg(sp)
-    sp.add_argument("--method", choices=("pso", "gwo", "igwo"), help="optimizer")
+    sp.add_argument("--method", choices=("hybrid", "pso", "gwo", "igwo"),
+                    help="optimizer (default hybrid: Sobol starts + L-BFGS-B finishes)")
     sp.add_argument("--objective", metavar="NAME", help="AL, En, CVEn or R")
     sp.add_argument("--iterations", type=int, metavar="N", help="iterations (>= 1)")
     sp.add_argument("--population", type=int, metavar="N", help="population size (>= 4)")

@@ -94,7 +94,7 @@ def test_user_jacobian():
 ])
 def test_optimum_on_the_box_boundary_is_reached_exactly(make, bound_params):
     p = make()
-    de = differential_evolution(p, p.bounds, pop_size=30, max_iter=300, seed=0)
+    de = differential_evolution(p, p.bounds, pop_size=30, max_iter=150, seed=0)
     for seed in range(3):
         for jac in (None, "fd"):
             r = hybrid(p, p.bounds, seed=seed, jac=jac)

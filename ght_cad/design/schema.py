@@ -25,7 +25,7 @@ FIGURE_OUTPUTS = ("basis", "curve", "curvature", "surface", "flat_pattern", "con
 
 
 #: optimizers
-METHODS = ("pso", "gwo", "igwo")
+METHODS = ("hybrid", "pso", "gwo", "igwo")
 
 
 #: objectives: fairness of the dual curve (planes) or developability R (curve-pair strips)
@@ -132,7 +132,7 @@ class SurfaceSpec:
 class OptimizeSpec:
     """Shape-parameter optimization (spec sections 7, 8)."""
 
-    method: str = "igwo"
+    method: str = "hybrid"
     objective: str = "CVEn"
     weights: list[float] = field(default_factory=lambda: [1.0, 0.0, 0.0])
     parameters: list[str] = field(default_factory=lambda: list(SHAPE_NAMES))
@@ -458,7 +458,7 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         if surface is None:
             raise ck.fail("optimize", "needs a [surface] table to optimize")
         ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
-        method = ck.string(ot, "method", "optimize", "igwo", choices=METHODS)
+        method = ck.string(ot, "method", "optimize", "hybrid", choices=METHODS)
         objs = _objectives_for(surface.type)
         objective = ck.string(ot, "objective", "optimize", objs[0] if surface.type == "curves" else "CVEn", choices=objs)
         weights = [1.0, 0.0, 0.0]

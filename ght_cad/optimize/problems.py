@@ -710,8 +710,9 @@ class DualCurveFairnessProblem(FairnessProblem):
         mu, nu, gamma: base design.
         check_surface: with boundary planes, build (and so check) the surface of every candidate
             with a finite objective and give ``+inf`` to those that degenerate (stationary dual
-            curve, e.g. ``mu = nu = gamma = -1`` with three planes; an edge of regression inside the
-            strip; a boundary plane containing a ruling), so the optimum can always be built.
+            curve, e.g. ``mu = nu = gamma = -1`` with three planes, or nearly so: an end speed
+            ``|U'(0)|`` or ``|U'(1)|`` below 1e-2 of the arc length; an edge of regression inside
+            the strip; a boundary plane containing a ruling), so the optimum can always be built.
             Costs one surface construction per candidate (about 10 ms).
     """
 
@@ -755,6 +756,7 @@ class DualCurveFairnessProblem(FairnessProblem):
         ok = np.array(rows, dtype=bool)
         if self.boundary_planes is None or not self.check_surface:
             return ok
+        ok &= self._end_speeds_ok(F)
         for i in np.nonzero(ok)[0]:
             try:
                 with np.errstate(all="ignore"):
@@ -762,6 +764,20 @@ class DualCurveFairnessProblem(FairnessProblem):
             except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
                 ok[i] = False
         return ok
+
+    #: A dual curve slower than this fraction of its mean speed at an end counts as stationary there.
+    END_SPEED_FRACTION = 1e-2
+
+    def _end_speeds_ok(self, F: np.ndarray) -> np.ndarray:
+        r"""``|U'(0)|, |U'(1)| >= 1e-2 ∫|U'|`` per row (``U'(0) = f0'(0) (U_0 - U_1)``-like end terms
+        vanish at μ = γ = -1 or ν = γ = -1). Near those corners the rulings turn by O(1) within a
+        tiny parameter step: the surface still builds but no B-rep fit reaches tolerance, so such
+        candidates are refused like the stationary ones."""
+        mu, nu, ga = _split(F, 0)
+        ends = PopulationBasis(np.array([0.0, 1.0]), self.degree)(mu, nu, ga, (1,))[1] @ self.planes  # (pop, 2, 4)
+        speed = np.linalg.norm(ends, axis=-1).min(axis=1)
+        with np.errstate(invalid="ignore"):
+            return speed >= self.END_SPEED_FRACTION * self.measures_full(F)[:, 0]
 
     def control_points_for(self, F: np.ndarray) -> np.ndarray:
         return self.planes

@@ -27,7 +27,7 @@ from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, reg
 __all__ = ["OptimizationFeature", "make_optimization", "run_optimization", "PROBLEMS", "METHODS"]
 
 PROBLEMS = ["Fairness", "Developability"]
-METHODS = ["igwo", "pso", "gwo", "de"]
+METHODS = ["hybrid", "igwo", "pso", "gwo", "de"]
 _OUT = ("InitialValue", "BestValue", "CurrentValue", "Evaluations", "Status", "BestParameters")
 
 
@@ -49,7 +49,7 @@ class OptimizationFeature(FeatureProxy):
         obj.addProperty("App::PropertyFloat", "WeightEn", "Problem", "Weight of the bending energy En = ∫|X''|² (Fairness)")
         obj.addProperty("App::PropertyFloat", "WeightCVEn", "Problem", "Weight of the curvature variation CVEn = ∫|X'''|² (Fairness)")
         obj.WeightEn = 1.0
-        obj.addProperty("App::PropertyEnumeration", "Method", "Optimizer", "igwo, pso, gwo or de (scipy differential evolution)")
+        obj.addProperty("App::PropertyEnumeration", "Method", "Optimizer", "hybrid (Sobol starts + L-BFGS-B, default), igwo, pso, gwo or de (scipy differential evolution)")
         obj.Method = METHODS
         obj.addProperty("App::PropertyInteger", "PopulationSize", "Optimizer", "Population size")
         obj.PopulationSize = 20
@@ -162,7 +162,7 @@ class ViewProviderOptimization(ViewProviderBase):
         return []
 
 
-def make_optimization(targets: list, problem: str = "Fairness", *, method: str = "igwo", doc: Any = None, name: str = "Optimization", **props: Any) -> Any:
+def make_optimization(targets: list, problem: str = "Fairness", *, method: str = "hybrid", doc: Any = None, name: str = "Optimization", **props: Any) -> Any:
     """Create an optimization feature driving ``targets`` (see module doc); ``props`` set properties."""
     if problem not in PROBLEMS:
         raise ValueError(f"problem={problem!r} is not allowed; use one of {PROBLEMS}")
