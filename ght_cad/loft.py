@@ -278,7 +278,10 @@ class _Pair:
         out["F"] = _det(A[1], B[1], g)
         out["Ft"] = _det(A[2], B[1], g)
         out["Fs"] = _det(A[1], B[2], g)
-        out["scale"] = np.linalg.norm(A[1], axis=1) * np.linalg.norm(B[1], axis=1) * np.linalg.norm(g, axis=1)
+        ab = np.linalg.norm(A[1], axis=1) * np.linalg.norm(B[1], axis=1)
+        out["scale"] = ab * np.linalg.norm(g, axis=1)
+        # rounding error of F: g = b - a carries eps (|a| + |b|), the product eps |a'||b'||g|
+        out["noise"] = _EPS * ab * (np.linalg.norm(g, axis=1) + np.linalg.norm(A[0], axis=1) + np.linalg.norm(B[0], axis=1))
         if k >= 2:
             out["Ftt"] = _det(A[3], B[1], g) - _det(A[2], B[1], A[1])
             out["Fts"] = _det(A[2], B[2], g)
@@ -317,7 +320,7 @@ class _Pair:
                 dt = np.where(dG != 0, p["F"] / dG, 0.0)
             if not np.all(np.isfinite(dt)):
                 return t, 2 * lam - t, False
-            resid = np.abs(p["F"]) <= 4 * _EPS * np.maximum(p["scale"], 1e-300)
+            resid = np.abs(p["F"]) <= 4 * p["noise"]
             if np.all(resid | (np.abs(dt) <= 2 * _EPS * np.maximum(1.0, np.abs(t)))):
                 # converged at this t (F at round-off): keep t and its partials
                 self.last = p
@@ -326,7 +329,7 @@ class _Pair:
         s = 2 * lam - t
         p = self.parts(t, s, 1)
         self.last = p
-        ok = bool(np.all(np.abs(p["F"]) <= 1e-12 * np.maximum(p["scale"], 1e-300)))
+        ok = bool(np.all(np.abs(p["F"]) <= 1e-12 * p["scale"] + 64 * p["noise"]))
         return t, s, ok
 
     def tangent(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -445,6 +448,33 @@ class _TraceFailure(Exception):
     pass
 
 
+def _meeting_tangent(pair: _Pair, t: float, s: float) -> tuple[float, float]:
+    r"""Branch direction where the rails meet (``a(t) = b(s)``, a zero ruling: F is singular there).
+
+    With ``A1, A2 = a'(t), a''(t)`` and ``B1, B2 = b'(s), b''(s)``, expanding ``g`` to second order
+    gives ``F(t + x, s + y) ≈ (x² D_a - y² D_b) / 2``, ``D_a = det(A1, B1, A2)``,
+    ``D_b = det(A1, B1, B2)``: the zero set leaves the meeting point along ``y / x = ±sqrt(D_a / D_b)``;
+    the increasing branch has ``(dt/dλ, ds/dλ) = (2, 2m) / (1 + m)``, ``m = sqrt(D_a / D_b)``.
+
+    Raises:
+        _TraceFailure: ``D_a / D_b <= 0`` (no increasing branch leaves the meeting point) or the
+            rails do not meet there (a singular point of F with a nonzero ruling).
+    """
+    p = pair.parts(np.array([t]), np.array([s]), 1)
+    A, B = p["A"], p["B"]
+    if float(np.linalg.norm(p["g"][0])) > 1e-9 * pair.size:
+        raise _TraceFailure(f"F is singular (grad F = 0) at t={t:.6g}, s={s:.6g}")
+    Da = float(_det(A[1], B[1], A[2])[0])
+    Db = float(_det(A[1], B[1], B[2])[0])
+    if not (Db != 0 and Da / Db > 0):
+        raise _TraceFailure(
+            f"the rails meet at t={t:.6g}, s={s:.6g} and no increasing branch of F = 0 leaves the meeting point "
+            f"(det(a', b', a'') = {Da:.3g}, det(a', b', b'') = {Db:.3g} must have the same sign)"
+        )
+    m = math.sqrt(Da / Db)
+    return 2.0 / (1.0 + m), 2.0 * m / (1.0 + m)
+
+
 def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: float, tol: float) -> _Branch:
     """Predictor–corrector continuation in λ = (t + s) / 2 from ``start`` to an upper-right side.
 
@@ -459,6 +489,8 @@ def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: 
     t, s = start
     lam = 0.5 * (t + s)
     tp, sp = (float(v[0]) for v in pair.tangent(np.array([t]), np.array([s])))
+    if not (np.isfinite(tp) and np.isfinite(sp)):
+        tp, sp = _meeting_tangent(pair, t, s)
     mono = -1e-9
 
     def check(tp: float, sp: float, t: float, s: float) -> None:
@@ -569,15 +601,30 @@ class _Path:
             p = self.pair.parts(t, s, 2)
         Ft, Fs = p["Ft"], p["Fs"]
         den = Fs - Ft
-        tp = 2 * Fs / den
-        sp = 2.0 - tp
-        out_t, out_s = [t, tp], [s, sp]
-        if k >= 2:
-            dFt = p["Ftt"] * tp + p["Fts"] * sp
-            dFs = p["Fts"] * tp + p["Fss"] * sp
-            tpp = 2 * (Fs * dFt - Ft * dFs) / den**2
-            out_t.append(tpp)
-            out_s.append(-tpp)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = 2 * Fs / den
+            sp = 2.0 - tp
+            out_t, out_s = [t, tp], [s, sp]
+            if k >= 2:
+                dFt = p["Ftt"] * tp + p["Fts"] * sp
+                dFs = p["Fts"] * tp + p["Fss"] * sp
+                tpp = 2 * (Fs * dFt - Ft * dFs) / den**2
+                out_t.append(tpp)
+                out_s.append(-tpp)
+        bad = ~np.all(np.isfinite(np.vstack(out_t[1:])), axis=0)
+        if bad.any():
+            # where the rails meet (a zero ruling at a branch end, F singular): the derivatives'
+            # limits, taken inside the branch: t' at 1e-8 of the branch (F's partials are O(|g|)
+            # there, t' good to ~1e-8); t'' (a quotient of O(|g|²) differences) at 1e-3
+            span = self.lam1 - self.lam0
+            for r in range(1, len(out_t)):
+                d = 1e-8 if r == 1 else 1e-3
+                nudged = np.clip(lam[bad], self.lam0 + d * span, self.lam1 - d * span)
+                if np.any(nudged == lam[bad]):
+                    raise NotDevelopableError(f"F is singular on the traced branch at λ={lam[bad][0]:.9g}")
+                sub_t, sub_s, _ = self.main(nudged, r)
+                out_t[r][bad] = sub_t[r]
+                out_s[r][bad] = sub_s[r]
         res = (out_t, out_s, p)
         if len(self._cache) > 8:
             self._cache.clear()
@@ -663,6 +710,14 @@ class LoftSegment(RuledSurface):
     def s_range(self) -> tuple[float, float]:
         _, s = self.parameters(np.array([0.0, 1.0]))
         return float(s[0]), float(s[1])
+
+    @property
+    def end_order(self) -> int:
+        """Highest end derivative order that is exact at both ends: 2, or 1 where the rails meet
+        at an end of the segment (a zero ruling: the second derivative there is a limit known to
+        about 1e-3 only)."""
+        g = self.ruling_lengths(np.array([0.0, 1.0]))
+        return 1 if float(g.min()) <= 1e-9 * self._loft._pair.size else 2
 
     @property
     def apex(self) -> np.ndarray | None:
@@ -913,7 +968,8 @@ class DevelopableLoft(RuledSurface):
         joint rulings are exact end poles."""
         from .developable import developable_bspline
 
-        return [developable_bspline(sg, tol=tol, degree=degree, theta_tol_deg=theta_tol_deg) for sg in self.segments]
+        return [developable_bspline(sg, tol=tol, degree=degree, theta_tol_deg=theta_tol_deg, end_order=sg.end_order)
+                for sg in self.segments]
 
     def to_dict(self, tol: float | None = None, degree: int = 5) -> dict[str, Any]:
         """Plain data: the report and per segment the B-spline data (poles, knots, degrees)."""

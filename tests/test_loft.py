@@ -348,3 +348,35 @@ def test_dory_box_exact_or_refused(d: list[float]) -> None:
         return
     assert loft.report.theta_max_deg <= 1e-8
     covers_rails(loft)
+
+
+def test_rails_meeting_at_the_bow() -> None:
+    """Chine and sheer meeting at the stem (a zero ruling at t = s = 0, where F is singular): the
+    branch leaves the meeting point along the zero direction of F's quadratic part, the zero
+    ruling is reported, θ ≤ 1e-8° elsewhere, one flat panel with a pointed end."""
+    bow = [0, -800, 900]
+    chine = GHTCurve([bow, [1500, -1050, 200], [3000, -1150, 250], [4500, -950, 450]])
+    sheer = GHTCurve([bow, [1500, -1250, 1150], [3000, -1300, 1180], [4500, -1100, 1300]])
+    loft = developable_loft(chine, sheer)
+    assert [sg.kind for sg in loft.segments] == ["main", "fan_b"]
+    assert loft.report.degenerate_rulings[0] == {"t": 0.0, "s": 0.0, "kind": "zero length", "value": 0.0}
+    assert loft.report.theta_max_deg <= 1e-8
+    covers_rails(loft)
+    # the derivatives at the meeting point are finite limits, so the B-spline export works
+    for sg, data in zip(loft.segments, loft.bspline_data()):
+        assert np.all(np.isfinite(sg.a(np.array([0.0, 1.0]), 2)))
+        assert data.max_deviation <= 1e-7 * 4700
+    pattern = ght_cad.unroll(loft)
+    assert len(pattern.panels) == 1 and pattern.errors["max"] <= 1e-7
+
+
+def test_to_face_shell() -> None:
+    """``to_face()``: one valid shell of B-spline faces (fans and main part), area = loft area."""
+    pytest.importorskip("build123d")
+    from ght_cad.cad.occ import is_valid
+
+    loft = developable_loft(CHINE, SHEER)
+    shell = loft.to_face()
+    assert is_valid(shell)
+    assert len(shell.faces()) == 3
+    assert abs(shell.area - loft.report.area) / loft.report.area <= 1e-6
