@@ -257,7 +257,10 @@ def _jet(rail: Any, t: np.ndarray, k: int) -> list[np.ndarray]:
 
 
 def _det(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
-    return np.einsum("ij,ij->i", x, np.cross(y, z))
+    """Row-wise ``det(x, y, z) = x · (y × z)`` of (n, 3) arrays (explicit: np.cross is slow on small arrays)."""
+    return (x[:, 0] * (y[:, 1] * z[:, 2] - y[:, 2] * z[:, 1])
+            + x[:, 1] * (y[:, 2] * z[:, 0] - y[:, 0] * z[:, 2])
+            + x[:, 2] * (y[:, 0] * z[:, 1] - y[:, 1] * z[:, 0]))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -682,7 +685,8 @@ class LoftSegment(RuledSurface):
         if r == 1:
             return rail.derivative(x[0], 1) * x[1][:, None]
         if r == 2:
-            return rail.derivative(x[0], 2) * (x[1] ** 2)[:, None] + rail.derivative(x[0], 1) * x[2][:, None]
+            J = _jet(rail, x[0], 2)
+            return J[2] * (x[1] ** 2)[:, None] + J[1] * x[2][:, None]
         raise GHTError(f"derivative={r!r} is not allowed; loft segments give derivatives of order 0..2")
 
     def a(self, u: Any, derivative: int = 0) -> np.ndarray:
@@ -1179,6 +1183,7 @@ def developable_loft(
     step_tol: float = 2e-3,
     samples: int = 257,
     boundary_samples: int = 513,
+    sign_png: Any = None,
 ) -> DevelopableLoft:
     r"""The exact developable loft between two rails (spec section 5.7).
 
@@ -1200,6 +1205,8 @@ def developable_loft(
         step_tol: largest corrector displacement (in t + s) of an accepted step.
         samples: rulings per segment sampled for the report (θ, degenerate rulings, regression).
         boundary_samples: samples per side when looking for the zeros of F on the lower-left sides.
+        sign_png: a path; when no loft exists, :func:`plot_loft_sign` writes the sign of F there
+            before the error is raised (the message names the file).
 
     Returns:
         :class:`DevelopableLoft` with ``segments``, ``report``, ``sigma``, ``developability``.
@@ -1253,8 +1260,15 @@ def developable_loft(
             "F(t, s) = det(a', b', b - a) vanishes on the whole square: the rails are coplanar (every ruled "
             "surface between them is planar); use a planar face instead of a loft"
         )
+    def refuse() -> NotDevelopableError:
+        msg = _no_branch_message(ra, rb, size, cands, orients)
+        if sign_png is not None:
+            path = plot_loft_sign(ra, rb, sign_png)
+            msg = msg.replace("ght_cad.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws", f"{path} shows")
+        return NotDevelopableError(msg)
+
     if not found:
-        raise NotDevelopableError(_no_branch_message(ra, rb, size, cands, orients))
+        raise refuse()
     lofts = []
     for i, (pair, br) in enumerate(found):
         if branch != "auto" and i != branch:
@@ -1276,7 +1290,7 @@ def developable_loft(
     if branch != "auto" and not lofts:
         raise GHTError(f"branch={branch} is not a usable candidate; candidates: {cands}")
     if not lofts:
-        raise NotDevelopableError(_no_branch_message(ra, rb, size, cands, orients))
+        raise refuse()
     for lf in lofts:
         for c in cands:
             if c.get("index") == lf._index:

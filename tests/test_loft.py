@@ -230,6 +230,18 @@ def test_skew_lines_refused() -> None:
     assert "no zero on the lower-left sides" in str(exc.value)
 
 
+def test_refusal_writes_the_sign_plot(tmp_path) -> None:
+    pytest.importorskip("matplotlib")
+    from PIL import Image
+
+    a = GHTCurve([(0, 0, 0), (0.5, 0, 0), (1, 0, 0)])
+    b = GHTCurve([(0, 0, 1), (0, 0.5, 1), (0, 1, 1)])
+    png = tmp_path / "why.png"
+    with pytest.raises(NotDevelopableError, match="why.png shows the sign of F"):
+        developable_loft(a, b, sign_png=png)
+    assert Image.open(png).size == (800, 800)
+
+
 def test_bad_input() -> None:
     line, arc = hopper_rails()
     nan_rail = CallableRail(lambda t: np.column_stack([t, np.where(t > 0.5, np.nan, 0 * t), 0 * t]),
@@ -380,3 +392,7 @@ def test_to_face_shell() -> None:
     assert is_valid(shell)
     assert len(shell.faces()) == 3
     assert abs(shell.area - loft.report.area) / loft.report.area <= 1e-6
+    from ght_cad.cad.developable_faces import face_developability
+
+    # θ from OCCT normals on every face, fans included (their apex edge is collapsed)
+    assert max(face_developability(f).theta_max for f in shell.faces()) <= 1e-3

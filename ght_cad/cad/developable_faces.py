@@ -185,6 +185,22 @@ def _normal(adaptor: BRepAdaptor_Surface, u: float, v: float, reversed_: bool) -
     return -vec if reversed_ else vec
 
 
+def _ruling_end_normal(ad: BRepAdaptor_Surface, s: float, w_end: float, w_other: float, rev: bool, across_u: bool) -> np.ndarray:
+    """OCCT normal at the end ``w_end`` of the ruling at ``s``; at a cone apex (a collapsed edge,
+    e.g. a loft's fan, where the normal is undefined) the normal 1e-6 of the ruling inside, which on
+    a developable is the same (the tangent plane is constant along a ruling)."""
+    def at(frac: float) -> np.ndarray:
+        w = w_end + frac * (w_other - w_end)
+        return _normal(ad, w, s, rev) if across_u else _normal(ad, s, w, rev)
+
+    for frac in (0.0, 1e-6):
+        try:
+            return at(frac)
+        except GHTError:
+            pass
+    return at(1e-4)
+
+
 def face_developability(face: Any, rulings: int = 129) -> FaceDevelopability:
     r"""θ along the rulings of a face, from OCCT normals at both ends of each ruling.
 
@@ -217,10 +233,10 @@ def face_developability(face: Any, rulings: int = 129) -> FaceDevelopability:
     for s in np.linspace(0.0, 1.0, rulings):
         if across_u:  # rulings along u, sample v
             v = vmin + s * (vmax - vmin)
-            n0, n1 = _normal(ad, umin, v, rev), _normal(ad, umax, v, rev)
+            n0, n1 = _ruling_end_normal(ad, v, umin, umax, rev, True), _ruling_end_normal(ad, v, umax, umin, rev, True)
         else:
             u = umin + s * (umax - umin)
-            n0, n1 = _normal(ad, u, vmin, rev), _normal(ad, u, vmax, rev)
+            n0, n1 = _ruling_end_normal(ad, u, vmin, vmax, rev, False), _ruling_end_normal(ad, u, vmax, vmin, rev, False)
         th.append(math.degrees(math.atan2(np.linalg.norm(np.cross(n0, n1)), float(n0 @ n1))))
     t = np.array(th)
     return FaceDevelopability(float(t.max()), float(np.sqrt(np.mean(t**2))), float(np.mean(np.cos(np.radians(t)))), rulings)
