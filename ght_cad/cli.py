@@ -427,19 +427,22 @@ def cmd_unroll(args: argparse.Namespace) -> int:
     _check_suffix("--dxf", args.dxf, (".dxf",))
     _check_suffix("--svg", args.svg, (".svg",))
     _check_suffix("--png", args.png, _PNG)
+    _check_suffix("--forming-png", args.forming_png, _PNG)
     if Path(args.design).suffix.lower() in (".step", ".stp"):
         return _unroll_step(args)
     for opt, val in (("--face", args.face), ("--best-effort", args.best_effort or None), ("--units", args.units),
-                     ("--tol-deg", args.tol_deg), ("--rulings", args.rulings)):
+                     ("--tol-deg", args.tol_deg), ("--rulings", args.rulings), ("--thickness", args.thickness),
+                     ("--k-factor", args.k_factor), ("--din-k-factor", args.din_k_factor), ("--side", args.side)):
         if val is not None:
-            raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file); "
-                             "allowed for design files: --dxf, --svg, --png, --json")
+            raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file: give the sheet "
+                             "in its [sheet] table); allowed for design files: --dxf, --svg, --png, --forming-png, --json")
     from .design import build_surface, unroll_surface
 
     design = _load(args)
     built = build_surface(design)
     pattern = unroll_surface(built)
     result: dict[str, Any] = {"command": "unroll", "name": design.name, "errors": _errors_dict(pattern), "outputs": {}}
+    _sheet_result(result, pattern)
     result["outputs"] = _write_pattern(args, pattern, design.name)
 
     def text(r: dict[str, Any]) -> str:
@@ -447,7 +450,7 @@ def cmd_unroll(args: argparse.Namespace) -> int:
             f"{k}={v:.2e}" for k, v in r["errors"].items() if isinstance(v, (int, float))
         )
         out = _outputs_text(r)
-        return s + ("\n" + out if out else "")
+        return s + _sheet_text(r, pattern) + ("\n" + out if out else "")
 
     _emit(args, result, text)
     return EXIT_OK
@@ -461,8 +464,35 @@ def _write_pattern(args: argparse.Namespace, pattern: Any, title: str) -> dict[s
     """
     from .design import plot_pattern
 
+    if args.forming_png and pattern.sheet is None:
+        raise UsageError(f"--forming-png needs a sheet thickness (no thickness was given for {title}); "
+                         "allowed: with --thickness, --k-factor on a plate solid, or a design's [sheet] table")
     return _write_staged([("dxf", args.dxf, pattern.export_dxf), ("svg", args.svg, pattern.export_svg),
-                          ("png", args.png, lambda path: plot_pattern(pattern, path, title=title))])
+                          ("png", args.png, lambda path: plot_pattern(pattern, path, title=title)),
+                          ("forming_png", args.forming_png, lambda path: pattern.plot_roll_chart(path, title=title))])
+
+
+def _sheet_result(result: dict[str, Any], pattern: Any) -> None:
+    """Sheet data of every panel (thickness, K, side, edge lengths inside/neutral/outside, forming
+    rows) into the JSON result (no chart samples)."""
+    sheets = []
+    for p in pattern.panels:
+        sh = p.info.get("sheet")
+        if sh:
+            sheets.append({"panel": p.label, **{k: v for k, v in sh.items() if k != "chart"}})
+    if sheets:
+        result["sheet"] = sheets
+
+
+def _sheet_text(r: dict[str, Any], pattern: Any) -> str:
+    if not r.get("sheet"):
+        return ""
+    lines = []
+    for sh in r["sheet"]:
+        lines.append(f"  {sh['panel']} edges (inside / neutral / outside length):")
+        for e in sh["edges"]:
+            lines.append(f"    {e['edge']}: {e['inside']:.9g} / {e['neutral']:.9g} / {e['outside']:.9g}")
+    return "\n" + "\n".join(lines) + "\n" + pattern.forming_table()
 
 
 def _unroll_step(args: argparse.Namespace) -> int:
@@ -471,7 +501,8 @@ def _unroll_step(args: argparse.Namespace) -> int:
 
     tol = 0.01 if args.tol_deg is None else args.tol_deg
     res = unroll_step(args.design, faces=args.face, best_effort=args.best_effort, units=args.units,
-                      tol_deg=tol, rulings=args.rulings if args.rulings is not None else 16)
+                      tol_deg=tol, rulings=args.rulings if args.rulings is not None else 16,
+                      thickness=args.thickness, k_factor=args.k_factor, din_k_factor=args.din_k_factor, side=args.side)
     pattern = res.pattern
     name = Path(args.design).name
     result: dict[str, Any] = {
@@ -487,6 +518,9 @@ def _unroll_step(args: argparse.Namespace) -> int:
         "faces": res.faces,
         "outputs": {},
     }
+    if res.plate is not None:
+        result["plate"] = res.plate
+    _sheet_result(result, pattern)
     result["outputs"] = _write_pattern(args, pattern, name)
 
     def text(r: dict[str, Any]) -> str:
@@ -497,8 +531,12 @@ def _unroll_step(args: argparse.Namespace) -> int:
             dev = f", theta_max={d['theta_max']:.3e} deg" if d else ""
             lines.append(f"  F{f['face']}: {f['surface_type']} ({f['method']}){dev}, max rel. error "
                          f"{max(f['errors'].get(k, 0.0) for k in ('boundary_length', 'ruling_length', 'area')):.2e}")
+        if r.get("plate"):
+            pl = r["plate"]
+            lines.append(f"  plate solid: inside face F{pl['inside_face']}, outside face F{pl['outside_face']}, "
+                         f"thickness {pl['thickness']:.9g} (found by {pl['found_by']})")
         out = _outputs_text(r)
-        return "\n".join(lines) + ("\n" + out if out else "")
+        return "\n".join(lines) + _sheet_text(r, pattern) + ("\n" + out if out else "")
 
     _emit(args, result, text)
     return EXIT_OK
@@ -663,6 +701,17 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--tol-deg", type=float, metavar="DEG",
                     help="STEP only: largest accepted theta_max in degrees (default 0.01)")
     sp.add_argument("--rulings", type=int, metavar="N", help="STEP only: bend lines per face (default 16)")
+    sp.add_argument("--thickness", type=float, metavar="T",
+                    help="STEP only: sheet thickness; the pattern is the neutral surface at K*T from each face "
+                         "(spec 6.1); a STEP plate solid gives its own thickness")
+    sp.add_argument("--k-factor", type=float, metavar="K",
+                    help="STEP only: ANSI K-factor in [0, 1] (default 0.5); given without --thickness on a "
+                         "plate solid: unroll its inside face with the thickness between its faces")
+    sp.add_argument("--din-k-factor", type=float, metavar="k", help="STEP only: DIN k-factor k = 2K in [0, 2]")
+    sp.add_argument("--side", choices=("normal", "reverse"),
+                    help="STEP only: material along the face normal (normal, default) or against it (reverse)")
+    sp.add_argument("--forming-png", metavar="FILE",
+                    help="roll-bending chart of a sheet pattern (neutral radius along the plate)")
     common(sp)
     sp.set_defaults(func=cmd_unroll)
 

@@ -76,3 +76,21 @@ def test_bad_plates_are_refused(tmp_path) -> None:
     with pytest.raises(SheetError, match="bending radius 10"):
         plate_solid(cylinder(10.0), Sheet(10.5, 0.1, "reverse"))
     assert plate_faces(read_step(write_plate_step(plate_solid(cylinder(10.0), Sheet(1.0)), tmp_path / "x.step"))) is not None
+
+
+def test_build123d_and_cadquery_faces_and_solids() -> None:
+    """The same sheet options on a build123d face and a cadquery face; the plate as both kinds of solid."""
+    cq = pytest.importorskip("cadquery")
+    from build123d import Solid
+
+    r, h, T, K = 30.0, 12.0, 1.5, 0.3
+    b_face = next(f for f in Solid.make_cylinder(r, h, angle=90).faces() if f.geom_type.name == "CYLINDER")
+    c_face = next(f for f in cq.Workplane().cylinder(h, r, angle=90).faces().vals() if f.geomType() == "CYLINDER")
+    for face in (b_face, c_face):
+        pat = unroll(face, thickness=T, k_factor=K)  # face normal away from the axis
+        assert pat.area == pytest.approx(0.5 * math.pi * (r + K * T) * h, rel=1e-9)
+    plate = plate_solid(b_face, Sheet(T, K))
+    exact = 0.25 * math.pi * ((r + T) ** 2 - r**2) * h
+    assert plate.to_build123d().volume == pytest.approx(exact, rel=1e-9)
+    assert plate.to_cadquery().Volume() == pytest.approx(exact, rel=1e-9)
+    assert plate_solid(c_face, thickness=T, side="reverse").volume == pytest.approx(0.25 * math.pi * (r**2 - (r - T) ** 2) * h, rel=1e-9)

@@ -68,9 +68,22 @@ class PlateSolid:
 
     @property
     def volume(self) -> float:
+        """Volume by OCCT's Gauss integration (:func:`ght_cad.cad.occ.volume`)."""
         from .occ import volume
 
         return volume(self.solid)
+
+    def to_build123d(self) -> Any:
+        """The solid as a build123d ``Solid``."""
+        from build123d import Solid
+
+        return Solid(self.solid)
+
+    def to_cadquery(self) -> Any:
+        """The solid as a cadquery ``Solid``."""
+        import cadquery as cq
+
+        return cq.Solid(self.solid)
 
 
 def _faces(shape: TopoDS_Shape) -> list[TopoDS_Face]:
@@ -181,7 +194,8 @@ def plate_solid(
     return PlateSolid(solid, inside, outside, edges, sheet)
 
 
-def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm") -> str:
+def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm",
+                     extra: list[Any] | None = None) -> str:
     """Write plate solid(s) to STEP with named faces, atomically.
 
     The solids go through ``STEPControl_Writer``; each face's ``ADVANCED_FACE`` entity (found by
@@ -192,6 +206,7 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
         plate: one plate or several (written as a compound).
         path: target file.
         units: length unit of the coordinates (mm, cm, m, in, ft).
+        extra: more shapes written with the plates (e.g. the design's curve edges).
 
     Raises:
         GHTError: an invalid solid, an unknown unit or a failed write (the target is untouched).
@@ -213,7 +228,8 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
     for i, p in enumerate(plates):
         if not is_valid(p.solid):
             raise GHTError(f"plate #{i + 1} is not a valid solid (BRepCheck_Analyzer); not exported to {path}")
-    if len(plates) == 1:
+    more = [unwrap(x) for x in (extra or [])]
+    if len(plates) == 1 and not more:
         shape = plates[0].solid
     else:
         shape = TopoDS_Compound()
@@ -221,6 +237,8 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
         bb.MakeCompound(shape)
         for p in plates:
             bb.Add(shape, p.solid)
+        for x in more:
+            bb.Add(shape, x)
     step_unit, mm_per_unit = STEP_UNITS[units]
     with quiet_occt():
         STEPControl_Writer()  # registers the statics

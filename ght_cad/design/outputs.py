@@ -100,14 +100,28 @@ def unroll_surface(built: BuiltSurface) -> Any:
     from ..unroll import unroll
 
     d = built.design
+    sheet = d.sheet.to_sheet() if d.sheet is not None else None  # [sheet]: the neutral surface (spec 6.1)
     if _is_composite(built.surface):
         from ..unroll import unroll_composite
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                                units=d.units, labels=[g.name for g in d.surface.segments or []])
+                                units=d.units, labels=[g.name for g in d.surface.segments or []], sheet=sheet)
     best_effort = d.surface is not None and d.surface.type == "curves"
     return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                  units=d.units, label=d.name[:24])
+                  units=d.units, label=d.name[:24], sheet=sheet)
+
+
+def plate_solids(built: BuiltSurface) -> list[Any]:
+    """The ``[sheet]`` plate of the built surface: one :class:`ght_cad.cad.sheet_solid.PlateSolid`
+    per strip (a composite gives one per segment); empty without a sheet or with T = 0."""
+    d = built.design
+    if d.sheet is None or d.sheet.thickness == 0:
+        return []
+    from ..cad.sheet_solid import plate_solid
+
+    sheet = d.sheet.to_sheet()
+    parts = built.surface.segments if _is_composite(built.surface) else [built.surface]
+    return [plate_solid(s, sheet, label=f"{d.name} part {i + 1}") for i, s in enumerate(parts)]
 
 
 def pattern_report(pattern: Any) -> dict[str, Any]:
@@ -116,7 +130,7 @@ def pattern_report(pattern: Any) -> dict[str, Any]:
     import re
 
     panel_labels = {pn.label for pn in pattern.panels}
-    return {
+    out = {
         "area": float(pattern.area),
         "errors": pattern_errors(pattern),
         "report": pattern.report.as_dict(),
@@ -130,6 +144,12 @@ def pattern_report(pattern: Any) -> dict[str, Any]:
         "edge_marks": sorted({t[2] for t in pattern.labels
                               if t[2] not in panel_labels and re.fullmatch(r"E\d+", t[2])}, key=lambda m: int(m[1:])),
     }
+    # [sheet]: per panel the sheet, inside/neutral/outside edge lengths and forming rows (spec 6.1)
+    sheets = [{"panel": pn.label, **{k: v for k, v in pn.info["sheet"].items() if k != "chart"}}
+              for pn in pattern.panels if pn.info.get("sheet")]
+    if sheets:
+        out["sheet"] = sheets
+    return out
 
 
 def pattern_errors(pattern: Any) -> dict[str, float]:

@@ -97,6 +97,14 @@ def report_markdown(r: dict[str, Any]) -> str:
         for k, v in p["report"].items():
             L.append(f"| {k} | {v['max']:.3e} | {v['rms']:.3e} |")
         L.append("")
+        for sh in p.get("sheet") or []:
+            L += [f"### Sheet {sh['panel']}: T = {sh['thickness']:.6g} {r['units']}, K = {sh['k_factor']:.4g}, "
+                  f"side {sh['side']}", "", "| edge | inside | neutral (cut) | outside |", "|---|---|---|---|"]
+            L += [f"| {e['edge']} | {e['inside']:.9g} | {e['neutral']:.9g} | {e['outside']:.9g} |" for e in sh["edges"]]
+            L += ["", "| bend | u | R at a | R at b | angle (deg) | at |", "|---|---|---|---|---|---|"]
+            L += [f"| {'all' if f['line'] == 0 else f['line']} | {f['u']:.6f} | {f['radius_a']:.9g} | {f['radius_b']:.9g} | "
+                  f"{f['angle_deg']:.6f} | {f['position']:.6g} |" for f in sh["forming"]]
+            L.append("")
     L += ["## Files", ""]
     for f in r.get("files", []):
         L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))

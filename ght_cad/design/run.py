@@ -20,7 +20,8 @@ from ..errors import GHTError
 from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, surface_summary,
                     surface_view)
 from .optimize import optimize_design
-from .outputs import _jsonable, brep_shape, curve_edges, pattern_report, plot_pattern, shared_edge_count, unroll_surface
+from .outputs import (_jsonable, brep_shape, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
+                      unroll_surface)
 from .report import report_markdown
 from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
 
@@ -218,10 +219,19 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
             edges = curve_edges(curves)
             report["brep"]["curve_edges"] = len(edges)
+            plates = plate_solids(built)  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
+            if plates:
+                report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
+                                   **design.sheet.to_sheet().as_dict()}
             if "step" in want_files:
-                from ..cad.occ import write_step
+                if plates:
+                    from ..cad.sheet_solid import write_plate_step
 
-                write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
+                    write_plate_step(plates, stage.path(FILE_NAMES["step"]), units=design.units, extra=edges)
+                else:
+                    from ..cad.occ import write_step
+
+                    write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
             # 6. flat pattern
             step("flat pattern")
             pattern = unroll_surface(built)
@@ -271,6 +281,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             P.plot_surface(surface_view(built), stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
         if "flat_pattern" in want_figs and pattern is not None:
             plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
+            if pattern.sheet is not None:  # roll-bending chart of the sheet's bend lines
+                pattern.plot_roll_chart(stage.path("forming.png"), title=f"{design.name}: roll bending")
         if "convergence" in want_figs and opt is not None:
             P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
                                stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")

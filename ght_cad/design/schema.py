@@ -158,6 +158,27 @@ class OutputSpec:
 
 
 @dataclass
+class SheetSpec:
+    """``[sheet]``: the plate the surface is made of (spec 6.1).
+
+    Attributes:
+        thickness: sheet thickness T >= 0 (0: the surface itself).
+        k_factor: ANSI K-factor in [0, 1] (``din_k_factor = 2K`` in the file is converted).
+        side: "normal" (material along the surface normal) or "reverse".
+    """
+
+    thickness: float
+    k_factor: float = 0.5
+    side: str = "normal"
+
+    def to_sheet(self) -> Any:
+        """The :class:`ght_cad.sheet.Sheet`."""
+        from ..sheet import Sheet
+
+        return Sheet(self.thickness, self.k_factor, self.side)
+
+
+@dataclass
 class Design:
     """A validated design (see ``docs/design-files.md``)."""
 
@@ -170,6 +191,7 @@ class Design:
     unroll: UnrollSpec = field(default_factory=UnrollSpec)
     outputs: OutputSpec = field(default_factory=OutputSpec)
     source: str = "<design>"
+    sheet: SheetSpec | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (as it would be written in TOML)."""
@@ -347,7 +369,7 @@ def _range_text(lo: float | None, hi: float | None, lo_open: bool = False) -> st
     return ""
 
 
-_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "optimize", "unroll", "outputs")
+_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "optimize", "unroll", "outputs", "sheet")
 
 
 def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
@@ -490,6 +512,22 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         unroll = UnrollSpec(ck.integer(ut, "rulings", "unroll", 16, lo=0, hi=1000),
                             ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True))
 
+    # sheet (spec 6.1)
+    sheet = None
+    st = ck.table(data, "sheet", "sheet")
+    if st is not None:
+        ck.keys(st, "sheet", ("thickness", "k_factor", "din_k_factor", "side"))
+        if surface is None:
+            raise ck.fail("sheet", "needs a [surface] table (the sheet is the surface's plate)")
+        T = ck.number(st, "thickness", "sheet", required=True, lo=0.0, allowed="a length >= 0")
+        if "k_factor" in st and "din_k_factor" in st:
+            raise ck.fail("sheet.din_k_factor", "given together with sheet.k_factor; allowed: one of them (DIN k = 2K)")
+        if "din_k_factor" in st:
+            K = ck.number(st, "din_k_factor", "sheet", lo=0.0, hi=2.0, required=True) / 2.0
+        else:
+            K = ck.number(st, "k_factor", "sheet", 0.5, lo=0.0, hi=1.0)
+        sheet = SheetSpec(T, K, ck.string(st, "side", "sheet", "normal", choices=("normal", "reverse")))
+
     # outputs
     outputs = OutputSpec()
     ot2 = ck.table(data, "outputs", "outputs")
@@ -520,7 +558,7 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         outputs.figures = [f for f in outputs.figures if f not in ("curve", "curvature")]
     if not outputs.files and not outputs.figures:
         raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
-    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source)
+    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source, sheet=sheet)
 
 
 def _objectives_for(surface_type: str) -> tuple[str, ...]:

@@ -50,6 +50,9 @@ class StepUnroll:
     file_units: str | None
     face_count: int
     faces: list[dict[str, Any]]
+    #: the plate solid found in the file (sheet options without a face selection): inside_face,
+    #: outside_face (1-based), thickness, side, found_by; None otherwise
+    plate: dict[str, Any] | None = None
 
 
 def _step_unit(name: str | None) -> str | None:
@@ -99,6 +102,10 @@ def unroll_step(
     units: str | None = None,
     tol_deg: float = 0.01,
     rulings: int = 16,
+    thickness: float | None = None,
+    k_factor: float | None = None,
+    din_k_factor: float | None = None,
+    side: str | None = None,
 ) -> StepUnroll:
     r"""Unroll the developable faces of a STEP file: one labelled panel per face (spec section 6).
 
@@ -117,6 +124,13 @@ def unroll_step(
             declared length unit, else mm. Coordinates are converted by OCCT's reader.
         tol_deg: largest accepted ``θ_max`` in degrees.
         rulings: bend lines per face.
+        thickness, k_factor, din_k_factor, side: the sheet (:func:`ght_cad.sheet.make_sheet`,
+            spec 6.1): every face's neutral surface at ``±K T`` along its normal is unrolled. When
+            the file holds one solid plate (:func:`ght_cad.cad.sheet_solid.plate_faces`: its two
+            large faces at a constant distance) and no faces are selected, only its inside face
+            is unrolled, with the thickness between the faces and the side towards the other
+            face (a given ``thickness`` must match it to 1e-6); a K-factor without a thickness
+            needs such a plate.
 
     Returns:
         :class:`StepUnroll`.
@@ -157,13 +171,16 @@ def unroll_step(
             raise DesignError(f"{p}: face {k!r} does not exist; allowed: face numbers 1..{n}")
     if len(set(chosen)) != len(chosen):
         raise DesignError(f"{p}: face numbers {chosen} repeat a face; allowed: each face once")
+    sheet, plate = _step_sheet(p, shape, faces, thickness, k_factor, din_k_factor, side)
+    if plate is not None:
+        chosen = [plate["inside_face"]]
     panels = []
     report: list[dict[str, Any]] = []
     for k in chosen:
         face = all_faces[k - 1]
         kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
         try:
-            pat = unroll(face, best_effort=best_effort, **kw)
+            pat = unroll(face, best_effort=best_effort, sheet=sheet, **kw)
         except NotDevelopableError as exc:
             info_be: dict[str, Any] = {}
             be_error = ""
@@ -205,7 +222,46 @@ def unroll_step(
         panels.extend(pat.panels)
     mark_shared_edges(panels)
     layout_panels(panels)
-    return StepUnroll(FlatPattern(panels, units=unit), unit, file_unit, n, report)
+    return StepUnroll(FlatPattern(panels, units=unit), unit, file_unit, n, report, plate)
+
+
+def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any, k_factor: Any,
+                din_k_factor: Any, side: str | None) -> tuple[Any, dict[str, Any] | None]:
+    """The sheet of :func:`unroll_step` and the plate found in the file (see there)."""
+    from ..sheet import SheetError, make_sheet
+
+    if thickness is None and k_factor is None and din_k_factor is None and side is None:
+        return None, None
+    plate = None
+    if not faces and thickness != 0:
+        from ..cad.sheet_solid import plate_faces
+
+        from OCP.TopAbs import TopAbs_SOLID
+        from OCP.TopExp import TopExp_Explorer
+
+        exp, solids = TopExp_Explorer(shape, TopAbs_SOLID), 0
+        while exp.More():
+            solids += 1
+            exp.Next()
+        found = plate_faces(shape) if solids == 1 else None
+        if found is not None:
+            if thickness is not None:
+                make_sheet(thickness, k_factor, din_k_factor=din_k_factor)  # the value itself first
+                if abs(float(thickness) - found.thickness) > 1e-6 * found.thickness:
+                    raise SheetError(
+                        f"{p}: --thickness={float(thickness)!r} does not match the plate solid in the file, which is "
+                        f"{found.thickness:.9g} thick (faces {found.inside_index + 1} and {found.outside_index + 1}); "
+                        "allowed: its own thickness, or leave --thickness out"
+                    )
+            plate = {"inside_face": found.inside_index + 1, "outside_face": found.outside_index + 1,
+                     "thickness": found.thickness, "spread": found.spread, "side": found.side, "found_by": found.how}
+            return make_sheet(found.thickness, k_factor, din_k_factor=din_k_factor, side=found.side), plate
+    if thickness is None:
+        raise SheetError(
+            f"{p}: a K-factor or side was given but no thickness, and the file holds no plate solid (one solid "
+            "whose two large faces lie at a constant distance) to read it from; allowed: --thickness T"
+        )
+    return make_sheet(thickness, k_factor, din_k_factor=din_k_factor, side=side or "normal"), None
 
 
 def _face_type_name(face: Any) -> str:
