@@ -835,7 +835,8 @@ class FlatPattern:
         return write_text_atomic(path, self.svg_text())
 
     def plot_png(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
-        """PNG preview (matplotlib Agg): outline, dashed bend lines, marks, labels, error summary."""
+        """PNG preview (matplotlib Agg): outline, dashed bend lines, marks, labels (and a sheet's
+        forming labels), error summary."""
         from matplotlib.figure import Figure  # object API: no pyplot, no global backend switch
 
         fig = Figure(figsize=(8, 6))
@@ -849,6 +850,8 @@ class FlatPattern:
             ax.plot(mk[:, 0], mk[:, 1], "b-", lw=1.0)
         for x, y, s, h in self.labels:
             ax.text(x, y, s, ha="center", va="center", color="green", fontsize=9)
+        for x, y, s, h, a in self.forming_labels:  # sheet: bend radius and angle along each bend line
+            ax.text(x, y, s, ha="center", va="center", color="magenta", fontsize=5, rotation=a)
         ax.set_aspect("equal")
         ax.set_xlabel(self.units)
         e = self.errors
