@@ -42,7 +42,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import GHTError
-from .ruled import RuledSurface
+from .ruled import SINGULAR_NORMAL_TOL, RuledSurface
 
 __all__ = [
     "SIDES",
@@ -260,7 +260,10 @@ def bending_radius(surface: RuledSurface, u: Any, v: Any) -> np.ndarray:
 
 def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *, sign: float = 1.0, samples: int = 513) -> float:
     r"""Refuse a sheet the surface cannot carry (spec 6.1): ``|δ| ≥ |ρ_0|`` or material through a
-    centre of curvature (``ρ_0 (ρ_0 + σ T) ≤ 0``), at ``samples`` rulings, both ruling ends.
+    centre of curvature (``ρ_0 (ρ_0 + σ T) ≤ 0``), at ``samples`` rulings, both ruling ends. An
+    apex end (a stationary boundary, ``|a'| ≤ 1e-10 |g|``: the point of a cone or of a loft's fan,
+    ``ρ_0 = 0``) is regular when the material lies on the convex side (the offset turns the apex into
+    an arc of radius ``|t|``) and refused on the concave side.
 
     Args:
         surface: the design surface.
@@ -279,12 +282,28 @@ def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *,
     uu = np.concatenate([u, u])
     vv = np.concatenate([np.zeros_like(u), np.ones_like(u)])
     rho = sign * bending_radius(surface, uu, vv)  # radius relative to the sheet's normal
+    # apex ends (a stationary boundary: the point of a cone / loft fan, ρ_0 = 0 there): the offset is
+    # regular on the convex side (the apex becomes an arc of radius |t|), singular on the concave one
+    g = np.linalg.norm(surface.ruling(u), axis=1)
+    tang = np.concatenate([np.linalg.norm(surface.a(u, 1), axis=1), np.linalg.norm(surface.b(u, 1), axis=1)])
+    apex = tang <= SINGULAR_NORMAL_TOL * np.concatenate([g, g])
+    delta, out = sheet.neutral_offset, sheet.outside_offset
+    if apex.any():
+        mid = sign * bending_radius(surface, uu[apex], np.full(int(apex.sum()), 0.5))
+        bad = np.isfinite(mid) & ((mid * delta < 0) | (mid * out < 0))
+        if bad.any():
+            j = int(np.nonzero(apex)[0][np.argmax(bad)])
+            raise SheetError(
+                f"thickness={sheet.thickness!r} (side={sheet.side!r}) is not allowed on {label}: the ruling at "
+                f"u={uu[j]:.6g} ends in an apex ({'b' if vv[j] else 'a'} end, bending radius 0) and the material lies "
+                "on its concave side; allowed: the material on the convex side of an apex (flip the side)"
+            )
+        rho = np.where(apex, np.inf, rho)
     finite = np.isfinite(rho)
     if not finite.any():
         return math.inf
     i = int(np.argmin(np.where(finite, np.abs(rho), np.inf)))
     rmin = float(abs(rho[i]))
-    delta, out = sheet.neutral_offset, sheet.outside_offset
     where = f"the ruling at u={uu[i]:.6g} ({'b' if vv[i] else 'a'} end)"
     if abs(delta) >= rmin:
         raise SheetError(

@@ -236,3 +236,28 @@ def test_make_sheet() -> None:
     assert Sheet(2.0, 0.25, "reverse").neutral_offset == -0.5
     with pytest.raises(SheetError, match="not both"):
         unroll(cylinder(10.0), sheet=sh, thickness=1.0)
+
+
+def test_rails_loft_plate_and_its_fan_apex() -> None:
+    """A rails loft with fans (cones at the rail ends): material on the convex side of the fan apex
+    is regular (the neutral surface turns the apex into an arc), on the concave side refused."""
+    import ght_cad
+
+    chine = GHTCurve([(0, -700, 300), (1500, -1050, 200), (3000, -1150, 250), (4500, -950, 450)])
+    sheer = GHTCurve([(0, -900, 1200), (1500, -1250, 1150), (3000, -1300, 1180), (4500, -1100, 1300)])
+    loft = ght_cad.developable_loft(chine, sheer)
+    sides = {}
+    for side in ("normal", "reverse"):
+        try:
+            sides[side] = unroll(loft, thickness=6.0, k_factor=0.4, side=side, rulings=4)
+        except SheetError as exc:
+            sides[side] = str(exc)
+    ok = [p for p in sides.values() if not isinstance(p, str)]
+    bad = [p for p in sides.values() if isinstance(p, str)]
+    assert len(ok) == 1 and len(bad) == 1
+    assert "ends in an apex" in bad[0] and "concave side" in bad[0]
+    pat = ok[0]
+    assert pat.errors["max"] < 1e-8
+    for e in pat.sheet["edges"]:
+        assert e["flat"] == pytest.approx(e["neutral"], rel=1e-8)
+    assert len(pat.sheet["forming"]) == 4
