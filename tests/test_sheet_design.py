@@ -103,3 +103,19 @@ def test_bad_sheet_tables_exit_2_and_write_nothing(tmp_path, capsys, sheet: str,
     err = capsys.readouterr().err
     assert rc == EXIT_USAGE and word in err and len(err.strip().splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_export_and_surface_step_are_the_plate(tmp_path, capsys) -> None:
+    from ght_cad.cad.occ import is_valid, volume
+    from ght_cad.cad.sheet_solid import read_step_face_names
+
+    d = _design(tmp_path, f"thickness = {T}\nk_factor = {K}\n")
+    exact = 0.25 * math.pi * ((R + T) ** 2 - R**2) * H
+    for argv, path in ((["export", str(d), str(tmp_path / "e.step")], tmp_path / "e.step"),
+                       (["surface", str(d), "--step", str(tmp_path / "s.step")], tmp_path / "s.step")):
+        assert main(argv) == EXIT_OK, capsys.readouterr().err
+        shape, names = read_step_face_names(path)
+        assert is_valid(shape) and "inside" in names.values()
+        assert volume(shape) == pytest.approx(exact, rel=1e-6)
+    rc = main(["unroll", str(d), "--forming-png", str(tmp_path / "roll.png")])
+    assert rc == EXIT_OK and (tmp_path / "roll.png").read_bytes()[:4] == b"\x89PNG"

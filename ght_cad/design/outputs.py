@@ -81,13 +81,19 @@ def curve_edges(curves: dict[str, Any]) -> list[Any]:
 
 
 def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bool = True) -> Path:
-    """Write the surface face (and the design's curves as edges) to one STEP file, atomically."""
+    """Write the surface face (and the design's curves as edges) to one STEP file, atomically; with a
+    ``[sheet]`` of thickness > 0 the plate solid(s) instead of the face (:func:`plate_solids`, faces
+    named inside/outside/edgeN)."""
     from ..cad.occ import write_step
 
-    shapes = [brep_shape(built)]
-    if with_curves:
-        shapes += curve_edges(built.curves)
-    write_step(shapes, path, units=built.design.units)
+    edges = curve_edges(built.curves) if with_curves else []
+    plates = plate_solids(built)
+    if plates:
+        from ..cad.sheet_solid import write_plate_step
+
+        write_plate_step(plates, path, units=built.design.units, extra=edges)
+        return Path(path)
+    write_step([brep_shape(built)] + edges, path, units=built.design.units)
     return Path(path)
 
 
