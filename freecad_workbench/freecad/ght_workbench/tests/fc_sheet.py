@@ -4,6 +4,7 @@
 * a plate made by FreeCAD (``makeThickness`` of a quarter cylinder, either face picked, Thickness
   0): thickness, inside face and side read from the solid, same pattern; written to STEP
   (``$GHT_FC_OUT/fc_plate.step``) for the pytest driver to unroll with the core;
+* a developable feature of this workbench as Source: the core's neutral pattern;
 * a bad K-factor refuses naming the value; the DXF carries layer FORMING; save/reopen keeps it.
 
 Run: ``PYTHONPATH=<repo>/freecad_workbench:<repo> freecadcmd -t freecad.ght_workbench.tests.fc_sheet``
@@ -94,6 +95,34 @@ class SheetTest(unittest.TestCase):
         plate.exportStep(os.path.join(OUT, "fc_plate.step"))
         with open(os.path.join(OUT, "fc_plate.json"), "w") as fh:
             json.dump({"R": R, "H": H, "T": T, "K": K, "area": areas[0]}, fh)
+
+    def test_developable_feature_source(self):
+        """A quarter cylinder r = 10, h = 20 from linked plane features: the feature's core surface
+        with Thickness 1, KFactor 0.5 unrolls as the core does; width φ (10 ± 0.5) by the side."""
+        from freecad.ght_workbench import developable
+        from freecad.ght_workbench.tests.fc_features import quarter_cylinder_planes
+        from ght_cad import unroll
+        from ght_cad.sheet import Sheet
+
+        p0, p1, p2 = quarter_cylinder_planes(self.doc)
+        box = self.doc.addObject("Part::Box", "Box")
+        box.Length, box.Width, box.Height = 3, 3, 20
+        self.doc.recompute()
+        bottom, top = (f"Face{i + 1}" for z in (0.0, 20.0) for i, f in enumerate(box.Shape.Faces)
+                       if abs(f.CenterOfMass.z - z) < 1e-9 and abs(abs(f.normalAt(0, 0).z) - 1) < 1e-12)
+        dev = developable.make_developable([(p0, ""), (p1, ""), (p2, "")], [(box, [bottom]), (box, [top])], gamma=-1.0,
+                                           weights=[1.0, math.sqrt(2), 1.0], doc=self.doc)
+        areas = {}
+        for side in ("normal", "reverse"):
+            fp = flat_pattern.make_flat_pattern(dev, "", 4, doc=self.doc, name=f"FPdev_{side}", thickness=1.0, k_factor=0.5, side=side)
+            self.assertEqual(_recompute(self.doc), [])
+            core = unroll(dev.Proxy.surface(dev), sheet=Sheet(1.0, 0.5, side), rulings=4)
+            self.assertAlmostEqual(fp.AreaFlat / core.area, 1.0, delta=1e-12)
+            areas[side] = fp.AreaFlat
+        exact = sorted(0.5 * math.pi * (10.0 + s * 0.5) * 20.0 for s in (-1.0, 1.0))
+        got = sorted(areas.values())
+        for g, e in zip(got, exact):
+            self.assertAlmostEqual(g / e, 1.0, delta=1e-9)
 
     def test_bad_k_factor_names_the_value(self):
         c = self._quarter_cylinder()
