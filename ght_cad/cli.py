@@ -10,6 +10,7 @@ Subcommands::
     ght-cad unroll DESIGN.toml|FILE.step  flat pattern of a design's surface or a STEP file's faces
     ght-cad export DESIGN.toml FILE...  write a design's result to STEP/DXF/SVG/JSON/PNG by suffix
     ght-cad plot-basis ...              PNG of the GHT-Bernstein basis for chosen shape parameters
+    ght-cad batch DESIGN... --out DIR   many designs (and [sweep] variants) in parallel or on Dask
 
 Exit codes (stable, scripts may rely on them):
 
@@ -548,6 +549,29 @@ def _errors_dict(pattern: Any) -> dict[str, Any]:
     return pattern_errors(pattern)
 
 
+def cmd_batch(args: argparse.Namespace) -> int:
+    """``ght-cad batch``: :func:`ght_cad.batch.run_batch`; exit 0 all ok, 2 any bad input, 1 any failed."""
+    from .batch import run_batch
+
+    if args.jobs is not None and args.scheduler:
+        raise UsageError("--jobs and --scheduler exclude each other: --jobs runs local processes, "
+                         "--scheduler a Dask cluster's workers")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"--jobs {args.jobs}: allowed: an integer >= 1")
+    res = run_batch(args.designs, args.out, jobs=args.jobs, scheduler=args.scheduler, progress=not args.no_progress)
+    summary = res.as_dict()
+    for r in summary["rows"]:
+        if r["status"] != "ok":
+            sys.stderr.write(f"{PROG}: {r['status']}: {r['name']}: {r['error']}\n")
+    if getattr(args, "json", False):
+        args._json_out = dumps({"ok": res.exit_code == EXIT_OK, "command": "batch", **summary})
+    else:
+        print(f"{summary['designs']} design(s) in {summary['out_dir']}: {summary['succeeded']} ok, "
+              f"{summary['bad_input']} bad input, {summary['failed']} failed ({summary['executor']}, "
+              f"{summary['elapsed_s']:.1f} s); summary: batch.json, batch.md")
+    return res.exit_code
+
+
 _EXPORT_SUFFIXES = (".step", ".stp", ".dxf", ".svg", ".json", ".png")
 _STEP = (".step", ".stp")
 _PNG = (".png",)
@@ -727,6 +751,27 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("files", nargs="+", metavar="FILE", help="output files (.step .stp .dxf .svg .json .png)")
     common(sp)
     sp.set_defaults(func=cmd_export)
+
+    sp = sub.add_parser(
+        "batch",
+        help="run many designs (and [sweep] variants) in parallel processes or on a Dask cluster",
+        description="Run every DESIGN.toml through the pipeline of 'ght-cad run' into DIR/<name>/ (the "
+        "same files, written atomically), and write DIR/batch.json and DIR/batch.md with one row per "
+        "design: status, error, flat area, theta_max, pattern error, optimization result, time and "
+        "where it ran. A design with a [sweep] table expands into named variants (table and PNG in "
+        "the summary). A bad design is reported and the others go on. Exit 0 if all succeeded, 2 if "
+        "any design was bad input, 1 for internal failures.",
+        epilog=_EPILOG,
+    )
+    sp.add_argument("designs", nargs="+", metavar="DESIGN.toml", help="design files (docs/design-files.md)")
+    sp.add_argument("--out", required=True, metavar="DIR", help="batch folder (created)")
+    sp.add_argument("--jobs", type=int, metavar="N", help="local worker processes (default: the machine's cores)")
+    sp.add_argument("--scheduler", metavar="ADDRESS",
+                    help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786 (needs pip install 'ght_cad[dask]'; "
+                    "start workers with --nthreads 1)")
+    sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    common(sp)
+    sp.set_defaults(func=cmd_batch)
 
     sp = sub.add_parser(
         "plot-basis",
