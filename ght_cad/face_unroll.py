@@ -367,10 +367,10 @@ def face_area(
         one, the others holes): independent of the loops' orientations.
     """
     xg, wg = np.polynomial.legendre.leggauss(12)
-    totals = []
     u_breaks = np.asarray(u_breaks, dtype=float)
-    for loop in edges_uv:
-        total = 0.0
+    # outer nodes of every edge of every loop; then one surface evaluation for all inner nodes
+    parts = []  # (loop, outer weights dv * tw, u, v) per edge
+    for k, loop in enumerate(edges_uv):
         for uvf, duv in loop:
             te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
             tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
@@ -379,29 +379,62 @@ def face_area(
             if np.max(np.abs(dv)) == 0.0:
                 continue
             u, v = uvf(tn)
-            S, Vv, W, owner = [], [], [], []
-            for i, (ui, vi) in enumerate(zip(u, v)):
-                lo, hi = (u_lo, ui) if ui >= u_lo else (ui, u_lo)
-                sign = 1.0 if ui >= u_lo else -1.0
-                br = u_breaks[(u_breaks > lo) & (u_breaks < hi)]
-                ed = np.unique(np.concatenate([[lo, hi], br, 0.5 * (np.concatenate([[lo], br]) + np.concatenate([br, [hi]]))]))
-                if u_span:
-                    n = np.maximum(1, np.ceil(np.diff(ed) * 8.0 / abs(u_span))).astype(int)
-                    if n.size and n.max() > 1:
-                        ed = np.concatenate([np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(ed[:-1], ed[1:], n)] + [ed[-1:]])
-                h = 0.5 * np.diff(ed)
-                s = ((ed[:-1] + h)[:, None] + h[:, None] * xg[None, :]).ravel()
-                S.append(s)
-                Vv.append(np.full_like(s, vi))
-                W.append(sign * (h[:, None] * wg[None, :]).ravel())
-                owner.append(np.full(s.size, i))
-            s_all, v_all, w_all, own = (np.concatenate(x) for x in (S, Vv, W, owner))
-            d = ev.d1(s_all, v_all)
-            f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
-            P = np.bincount(own, weights=f * w_all, minlength=tn.size)
-            total += float(np.sum(P * dv * tw))
-        totals.append(abs(total))
+            parts.append((k, dv * tw, np.asarray(u, dtype=float), np.asarray(v, dtype=float)))
+    totals = [0.0] * len(edges_uv)
+    if not parts:
+        return 0.0
+    u = np.concatenate([p[2] for p in parts])
+    v = np.concatenate([p[3] for p in parts])
+    s_all, v_all, w_all, own = _inner_nodes(u, v, u_lo, u_breaks, u_span, xg, wg)
+    d = ev.d1(s_all, v_all)
+    f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
+    P = np.bincount(own, weights=f * w_all, minlength=u.size)
+    i = 0
+    for k, wdv, uu, _ in parts:
+        totals[k] += float(np.sum(P[i:i + uu.size] * wdv))
+        i += uu.size
+    totals = [abs(t) for t in totals]
     return totals[0] - sum(totals[1:]) if totals else 0.0
+
+
+def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: float, u_breaks: np.ndarray, u_span: float | None,
+                 xg: np.ndarray, wg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    r"""Gauss–Legendre nodes of ``P(u_i, v_i) = ∫_{u_lo}^{u_i} f(s, v_i) ds`` for all i at once.
+
+    Per i: the interval between ``u_lo`` and ``u_i`` cut at the ``u_breaks`` inside it, each piece
+    halved, each half cut into ``max(1, ceil(8 L / |u_span|))`` equal panels (L its length; one
+    panel without ``u_span``), ``len(xg)`` nodes per panel, weights signed by ``u_i >= u_lo``.
+
+    Returns:
+        (s, v, w, owner): node parameters, their v, weights, and the index i each belongs to.
+    """
+    n = u.size
+    lo = np.minimum(u, u_lo)
+    hi = np.maximum(u, u_lo)
+    sign = np.where(u >= u_lo, 1.0, -1.0)
+    br = np.broadcast_to(u_breaks, (n, u_breaks.size))
+    inside = (br > lo[:, None]) & (br < hi[:, None])
+    # every row: lo, the breaks inside (others pushed to hi, giving empty pieces), hi; sorted
+    cuts = np.sort(np.concatenate([lo[:, None], np.where(inside, br, hi[:, None]), hi[:, None]], axis=1), axis=1)
+    a, b = cuts[:, :-1], cuts[:, 1:]
+    m = 0.5 * (a + b)
+    a = np.stack([a, m], axis=2).reshape(n, -1)  # halves [a, m], [m, b]
+    b = np.stack([m, b], axis=2).reshape(n, -1)
+    owner = np.repeat(np.arange(n), a.shape[1])
+    a, b = a.ravel(), b.ravel()
+    keep = b > a
+    a, b, owner = a[keep], b[keep], owner[keep]
+    if u_span:
+        cnt = np.maximum(1, np.ceil((b - a) * 8.0 / abs(u_span))).astype(int)
+        rep = np.repeat(np.arange(a.size), cnt)
+        j = np.arange(rep.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        step = (b - a)[rep] / cnt[rep]
+        a, b, owner = a[rep] + j * step, a[rep] + (j + 1) * step, owner[rep]
+    h = 0.5 * (b - a)
+    s = ((a + h)[:, None] + h[:, None] * xg[None, :]).ravel()
+    w = (sign[owner][:, None] * h[:, None] * wg[None, :]).ravel()
+    own = np.repeat(owner, xg.size)
+    return s, v[own], w, own
 
 
 def loop_uv_area(loop: list[tuple[Callable, Callable]]) -> float:
