@@ -146,20 +146,36 @@ class _SurfEval(SurfaceAdapter):
                 self.ruled_hint = "v"
             elif adaptor.UDegree() == 1 and adaptor.NbUPoles() == 2:
                 self.ruled_hint = "u"
+            self._nurbs = _Nurbs.of(adaptor)
+            if self._nurbs is not None and not self._agrees():
+                self._nurbs = None  # pragma: no cover - a representation we do not read right: use OCCT
+
+    _nurbs: "_Nurbs | None" = None
+
+    def _probe(self) -> tuple[np.ndarray, np.ndarray]:
+        ad = self.ad
+        u0, u1, v0, v1 = ad.FirstUParameter(), ad.LastUParameter(), ad.FirstVParameter(), ad.LastVParameter()
+        lo = [max(u0, -1e3), max(v0, -1e3)]
+        hi = [min(u1, 1e3), min(v1, 1e3)]
+        return (np.array([lo[0], 0.5 * (lo[0] + hi[0]), 0.3 * lo[0] + 0.7 * hi[0], hi[0]]),
+                np.array([lo[1], 0.6 * lo[1] + 0.4 * hi[1], hi[1], 0.2 * lo[1] + 0.8 * hi[1]]))
+
+    def _agrees(self) -> bool:
+        """The numpy evaluation matches ``BRepAdaptor_Surface.D2`` at four points to 1e-12 of the size
+        (first derivatives and second derivatives relative to their own size)."""
+        uu, vv = self._probe()
+        ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
+        for a, b in zip(ours, theirs):
+            scale = max(1.0, float(np.abs(b).max()), self.radius)
+            if not float(np.abs(a - b).max()) <= 1e-12 * scale:
+                return False
+        return True
 
     def _set_axes(self, ax3: Any) -> None:
         """Numpy evaluation from ``(O, X, Y, Z)`` after checking it against OCCT at three points."""
         self._ax = tuple(np.array(x.Coord()) for x in (ax3.Location(), ax3.XDirection(), ax3.YDirection(),
                                                         ax3.Direction()))
-        ad = self.ad
-        u0, u1, v0, v1 = ad.FirstUParameter(), ad.LastUParameter(), ad.FirstVParameter(), ad.LastVParameter()
-        lo = [max(u0, -1e3), max(v0, -1e3)]
-        hi = [min(u1, 1e3), min(v1, 1e3)]
-        uu = np.array([lo[0], 0.5 * (lo[0] + hi[0]), 0.3 * lo[0] + 0.7 * hi[0]])
-        vv = np.array([lo[1], 0.6 * lo[1] + 0.4 * hi[1], hi[1]])
-        ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
-        scale = max(1.0, float(np.abs(theirs[0]).max()), self.radius)
-        if max(float(np.abs(a - b).max()) for a, b in zip(ours, theirs)) > 1e-12 * scale:
+        if not self._agrees():
             self._ax = None  # pragma: no cover - an OCCT convention we do not know: use OCCT itself
 
     def breaks(self, direction: str) -> np.ndarray:
@@ -195,6 +211,8 @@ class _SurfEval(SurfaceAdapter):
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self._ax is not None:
             return self._analytic(u, v, 0)[0]
+        if self._nurbs is not None:
+            return self._nurbs.eval(u, v, 0)[0]
         ad = self.ad
         return np.array([ad.Value(uu, vv).Coord() for uu, vv in zip(u.tolist(), v.tolist())], dtype=float).reshape(-1, 3)
 
@@ -202,6 +220,8 @@ class _SurfEval(SurfaceAdapter):
         """[S_u, S_v] at the points."""
         if self._ax is not None:
             return self._analytic(u, v, 1)[1:3]
+        if self._nurbs is not None:
+            return self._nurbs.eval(u, v, 1)[1:3]
         p, (du, dv) = self._p, self._v[:2]
         ad = self.ad
         rows = []
@@ -215,6 +235,8 @@ class _SurfEval(SurfaceAdapter):
         """[S, S_u, S_v, S_uu, S_vv, S_uv] at the points."""
         if self._ax is not None:
             return self._analytic(u, v, 2)
+        if self._nurbs is not None:
+            return self._nurbs.eval(u, v, 2)
         return self._occ_d2(u, v)
 
     def _occ_d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
@@ -226,6 +248,81 @@ class _SurfEval(SurfaceAdapter):
             rows.append(p.Coord() + du.Coord() + dv.Coord() + duu.Coord() + dvv.Coord() + duv.Coord())
         a = np.array(rows, dtype=float).reshape(-1, 18)
         return [a[:, 3 * k:3 * k + 3] for k in range(6)]
+
+
+class _Nurbs:
+    r"""Vectorized evaluation of a (rational) B-spline or Bézier surface read once from OCCT.
+
+    With basis functions ``N_i(u)``, ``M_j(v)`` (scipy ``BSpline`` of the flat knot vectors) and
+    homogeneous poles ``(w_ij P_ij, w_ij)``: ``A = Σ N_i M_j w_ij P_ij``, ``W = Σ N_i M_j w_ij``,
+    ``S = A / W``, ``S_u = (A_u - W_u S) / W``, ``S_uu = (A_uu - 2 W_u S_u - W_uu S) / W``,
+    ``S_uv = (A_uv - W_u S_v - W_v S_u - W_uv S) / W`` (v likewise). Periodic surfaces are left
+    to OCCT (:meth:`of` returns None).
+    """
+
+    def __init__(self, uknots: np.ndarray, vknots: np.ndarray, pu: int, pv: int, cw: np.ndarray) -> None:
+        from scipy.interpolate import BSpline
+
+        nu, nv = cw.shape[:2]
+        self.bu = BSpline(uknots, np.eye(nu), pu)
+        self.bv = BSpline(vknots, np.eye(nv), pv)
+        self.cw = cw  # (nu, nv, 4)
+
+    @classmethod
+    def of(cls, ad: BRepAdaptor_Surface) -> "_Nurbs | None":
+        """The evaluator of the adaptor's B-spline/Bézier surface (None: periodic, or another kind)."""
+        if ad.GetType() == GeomAbs_BSplineSurface:
+            g = ad.BSpline()
+            if g.IsUPeriodic() or g.IsVPeriodic():
+                return None
+            nu, nv = g.NbUPoles(), g.NbVPoles()
+            uk = np.array([g.UKnotSequence().Value(i) for i in range(1, g.UKnotSequence().Length() + 1)])
+            vk = np.array([g.VKnotSequence().Value(i) for i in range(1, g.VKnotSequence().Length() + 1)])
+            pu, pv = g.UDegree(), g.VDegree()
+        elif ad.GetType() == GeomAbs_BezierSurface:
+            g = ad.Bezier()
+            nu, nv = g.NbUPoles(), g.NbVPoles()
+            pu, pv = g.UDegree(), g.VDegree()
+            uk = np.r_[np.zeros(pu + 1), np.ones(pu + 1)]
+            vk = np.r_[np.zeros(pv + 1), np.ones(pv + 1)]
+        else:
+            return None
+        cw = np.empty((nu, nv, 4))
+        for i in range(1, nu + 1):
+            for j in range(1, nv + 1):
+                w = g.Weight(i, j)
+                cw[i - 1, j - 1, :3] = np.array(g.Pole(i, j).Coord()) * w
+                cw[i - 1, j - 1, 3] = w
+        if uk.size != nu + pu + 1 or vk.size != nv + pv + 1:
+            return None  # pragma: no cover - not a clamped flat knot vector
+        return cls(uk, vk, pu, pv, cw)
+
+    def _hom(self, Nu: np.ndarray, Nv: np.ndarray) -> np.ndarray:
+        """``Σ_ij Nu[:, i] Nv[:, j] cw[i, j]``, shape (n, 4)."""
+        T = (Nu @ self.cw.reshape(self.cw.shape[0], -1)).reshape(Nu.shape[0], self.cw.shape[1], 4)
+        return np.einsum("nj,njk->nk", Nv, T)
+
+    def eval(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        """``[S]``, ``[S, S_u, S_v]`` or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` for ``order`` 0, 1, 2."""
+        u = np.asarray(u, dtype=float).ravel()
+        v = np.asarray(v, dtype=float).ravel()
+        Nu = [self.bu(u, nu=k) if k <= self.bu.k else np.zeros((u.size, self.cw.shape[0])) for k in range(order + 1)]
+        Nv = [self.bv(v, nu=k) if k <= self.bv.k else np.zeros((v.size, self.cw.shape[1])) for k in range(order + 1)]
+        H = self._hom(Nu[0], Nv[0])
+        W = H[:, 3:4]
+        S = H[:, :3] / W
+        if order == 0:
+            return [S]
+        Hu, Hv = self._hom(Nu[1], Nv[0]), self._hom(Nu[0], Nv[1])
+        Su = (Hu[:, :3] - Hu[:, 3:4] * S) / W
+        Sv = (Hv[:, :3] - Hv[:, 3:4] * S) / W
+        if order == 1:
+            return [S, Su, Sv]
+        Huu, Hvv, Huv = self._hom(Nu[2], Nv[0]), self._hom(Nu[0], Nv[2]), self._hom(Nu[1], Nv[1])
+        Suu = (Huu[:, :3] - 2 * Hu[:, 3:4] * Su - Huu[:, 3:4] * S) / W
+        Svv = (Hvv[:, :3] - 2 * Hv[:, 3:4] * Sv - Hvv[:, 3:4] * S) / W
+        Suv = (Huv[:, :3] - Hu[:, 3:4] * Sv - Hv[:, 3:4] * Su - Huv[:, 3:4] * S) / W
+        return [S, Su, Sv, Suu, Svv, Suv]
 
 
 class FaceRuledSurface(_core.FaceRuledSurface):
