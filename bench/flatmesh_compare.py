@@ -194,17 +194,28 @@ def main(argv: list[str] | None = None) -> int:
     faces = default_faces()
     print("relative errors against the exact face (boundary length, area); times in seconds")
     hdr = (f"{'face':22s} {'defl':>7s} | {'ours err':>9s} {'ours t':>7s} | {'fm err':>9s} {'fm intr':>9s} "
-           f"{'fm edge':>9s} {'nodes':>6s} {'fm t':>7s} | {'err ratio':>9s} {'t ratio':>7s}")
+           f"{'fm edge':>9s} {'nodes':>6s} {'fm t':>7s} | {'err ratio':>9s} {'t ratio':>7s} {'ours/fm':>7s}")
     print(hdr)
     print("-" * len(hdr))
+    verdict = []
     for defl in args.deflection:
-        for r in compare(faces, defl, exe):
+        rows = compare(faces, defl, exe)
+        for r in rows:
             ratio = r["fm_err"] / max(r["ours_err"], 1e-16)
             print(f"{r['face']:22s} {defl:7.0e} | {r['ours_err']:9.2e} {r['ours_time']:7.3f} | {r['fm_err']:9.2e} "
                   f"{r['fm_err_intrinsic']:9.2e} {r['fm_edge_len_max']:9.2e} {r['fm_nodes']:6d} {r['fm_time']:7.3f} | "
-                  f"{ratio:9.1e} {r['fm_time'] / r['ours_time']:7.2f}")
+                  f"{ratio:9.1e} {r['fm_time'] / r['ours_time']:7.2f} {r['ours_time'] / r['fm_time']:7.2f}")
         print(f"(FreeCAD process start-up and I/O overhead: {r['process_overhead']:.2f} s, not in 'fm t')")
-    print("err ratio = flatmesh error / our error (ours floored at 1e-16); t ratio = flatmesh time / our time")
+        worst = max(rows, key=lambda r: r["ours_time"] / r["fm_time"])
+        acc = max(r["ours_err"] for r in rows)
+        verdict.append(f"deflection {defl:.0e}: per-face time ours/flatmesh max {worst['ours_time'] / worst['fm_time']:.2f} "
+                       f"({worst['face']}; target <= 2 at 1e-3: "
+                       f"{'met' if worst['ours_time'] <= 2 * worst['fm_time'] else 'NOT met'}), our largest error "
+                       f"{acc:.1e} (target <= 1e-9: {'met' if acc <= 1e-9 else 'NOT met'})")
+    print("err ratio = flatmesh error / our error (ours floored at 1e-16); t ratio = flatmesh time / our time; "
+          "ours/fm = our time / flatmesh time")
+    for line in verdict:
+        print(line)
     return 0
 
 

@@ -500,22 +500,32 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
     items = [(pi, e) for pi, p in enumerate(panels) for lp in p.loops for e in lp]
     sags = [_sagitta3(e.xyz) for _, e in items]
     used: set[int] = set()
+    # cheap prefilter on the end points for all pairs (i, j > i) of one row at once (either
+    # direction; closed edges must both be closed); the exact test below runs on the survivors only
+    starts = np.array([e.xyz[0] for _, e in items]).reshape(-1, 3)
+    ends = np.array([e.xyz[-1] for _, e in items]).reshape(-1, 3)
+    gap = np.linalg.norm(starts - ends, axis=1)
+    sag = np.asarray(sags, dtype=float)
+    live = np.array([e.length_3d != 0 for _, e in items], dtype=bool)
+
+    def dist(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(q - p, axis=1)
+
     for i in range(len(items)):
-        for j in range(i + 1, len(items)):
+        if not live[i]:
+            continue
+        js = np.arange(i + 1, len(items))
+        tols = rel_tol * size + np.maximum(sag[i], sag[js])
+        c1 = gap[i] <= tols
+        ok = live[js] & (c1 == (gap[js] <= tols))
+        fwd = np.maximum(dist(starts[i], starts[js]), dist(ends[i], ends[js]))
+        bwd = np.maximum(dist(starts[i], ends[js]), dist(ends[i], starts[js]))
+        ok &= c1 | (np.minimum(fwd, bwd) <= tols)
+        for j in js[ok].tolist():
             (pi, e1), (pj, e2) = items[i], items[j]
-            if i in used or j in used or e1.length_3d == 0 or e2.length_3d == 0:
+            if i in used or j in used:
                 continue
             tol = rel_tol * size + max(sags[i], sags[j])
-            # cheap prefilter on the end points (either direction; closed edges must both be closed)
-            c1 = np.linalg.norm(e1.xyz[0] - e1.xyz[-1]) <= tol
-            c2 = np.linalg.norm(e2.xyz[0] - e2.xyz[-1]) <= tol
-            if c1 != c2:
-                continue
-            if not c1:
-                fwd = max(np.linalg.norm(e1.xyz[0] - e2.xyz[0]), np.linalg.norm(e1.xyz[-1] - e2.xyz[-1]))
-                bwd = max(np.linalg.norm(e1.xyz[0] - e2.xyz[-1]), np.linalg.norm(e1.xyz[-1] - e2.xyz[0]))
-                if min(fwd, bwd) > tol:
-                    continue
             d12, _ = _polyline_param(e2.xyz, e1.xyz)
             if d12.max() > tol:
                 continue
