@@ -433,7 +433,8 @@ def cmd_unroll(args: argparse.Namespace) -> int:
         return _unroll_step(args)
     for opt, val in (("--face", args.face), ("--best-effort", args.best_effort or None), ("--units", args.units),
                      ("--tol-deg", args.tol_deg), ("--rulings", args.rulings), ("--thickness", args.thickness),
-                     ("--k-factor", args.k_factor), ("--din-k-factor", args.din_k_factor), ("--side", args.side)):
+                     ("--k-factor", args.k_factor), ("--din-k-factor", args.din_k_factor), ("--side", args.side),
+                     ("--jobs", args.jobs), ("--scheduler", args.scheduler)):
         if val is not None:
             raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file: give the sheet "
                              "in its [sheet] table); allowed for design files: --dxf, --svg, --png, --forming-png, --json")
@@ -501,9 +502,15 @@ def _unroll_step(args: argparse.Namespace) -> int:
     from .design import unroll_step
 
     tol = 0.01 if args.tol_deg is None else args.tol_deg
+    if args.jobs is not None and args.scheduler:
+        raise UsageError("--jobs and --scheduler exclude each other: --jobs runs local processes, "
+                         "--scheduler a Dask cluster's workers")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"--jobs {args.jobs}: allowed: an integer >= 1")
     res = unroll_step(args.design, faces=args.face, best_effort=args.best_effort, units=args.units,
                       tol_deg=tol, rulings=args.rulings if args.rulings is not None else 16,
-                      thickness=args.thickness, k_factor=args.k_factor, din_k_factor=args.din_k_factor, side=args.side)
+                      thickness=args.thickness, k_factor=args.k_factor, din_k_factor=args.din_k_factor, side=args.side,
+                      jobs=1 if args.jobs is None else args.jobs, scheduler=args.scheduler)
     pattern = res.pattern
     name = Path(args.design).name
     result: dict[str, Any] = {
@@ -736,6 +743,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="STEP only: material along the face normal (normal, default) or against it (reverse)")
     sp.add_argument("--forming-png", metavar="FILE",
                     help="roll-bending chart of a sheet pattern (neutral radius along the plate)")
+    sp.add_argument("--jobs", type=int, metavar="N",
+                    help="STEP only: unroll the faces in N local processes (default 1; panels identical to serial)")
+    sp.add_argument("--scheduler", metavar="ADDRESS",
+                    help="STEP only: unroll the faces on a dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     common(sp)
     sp.set_defaults(func=cmd_unroll)
 

@@ -238,6 +238,26 @@ def test_batch_dask_cluster(designs, dask_cluster, tmp_path, capsys):
     assert (local / "cone-01" / "flat_pattern.svg").read_bytes() == (out / "cone-01" / "flat_pattern.svg").read_bytes()
 
 
+def test_unroll_step_on_dask_identical_to_serial(dask_cluster, tmp_path):
+    import importlib.util
+
+    from ght_cad.design import unroll_step
+
+    address, _ = dask_cluster
+    spec = importlib.util.spec_from_file_location("bench_batch", Path(__file__).parents[1] / "bench" / "bench_batch.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    step = tmp_path / "few.step"
+    bench.many_faces_step(step, 24)
+    serial = unroll_step(step)
+    remote = unroll_step(step, scheduler=address)
+    assert remote.faces == serial.faces
+    for a, b in zip(serial.pattern.panels, remote.pattern.panels):
+        assert a.label == b.label and a.offset.tobytes() == b.offset.tobytes()
+        assert [e.flat.tobytes() for lp in a.loops for e in lp] == [e.flat.tobytes() for lp in b.loops for e in lp]
+        assert [m.tobytes() for m in a.marks] == [m.tobytes() for m in b.marks] and a.texts == b.texts
+
+
 def test_batch_dask_worker_killed(designs, dask_cluster, tmp_path):
     """SIGKILL one of the two Dask workers mid-run: the scheduler reruns its task, all complete."""
     paths, areas = designs

@@ -106,6 +106,8 @@ def unroll_step(
     k_factor: float | None = None,
     din_k_factor: float | None = None,
     side: str | None = None,
+    jobs: int = 1,
+    scheduler: str | None = None,
 ) -> StepUnroll:
     r"""Unroll the developable faces of a STEP file: one labelled panel per face (spec section 6).
 
@@ -131,6 +133,11 @@ def unroll_step(
             is unrolled, with the thickness between the faces and the side towards the other
             face (a given ``thickness`` must match it to 1e-6); a K-factor without a thickness
             needs such a plate.
+        jobs: local worker processes for the faces (1: in this process); with ``scheduler``,
+            the faces go to that ``dask.distributed`` cluster instead
+            (:func:`ght_cad.batch.map_step_faces`). The panels are identical to the serial ones;
+            those computed elsewhere carry no development map (``panel.map`` raises).
+        scheduler: address of a Dask scheduler (``tcp://host:port``).
 
     Returns:
         :class:`StepUnroll`.
@@ -142,9 +149,7 @@ def unroll_step(
             ``best_effort``); the one-line message names the file, the face number and the
             measured ``θ_max`` and ``DD``.
     """
-    from ..errors import NotDevelopableError
     from ..flat_pattern import FlatPattern, layout_panels, mark_shared_edges
-    from ..unroll import unroll
 
     p = Path(path)
     if p.suffix.lower() not in STEP_SUFFIXES:
@@ -176,50 +181,16 @@ def unroll_step(
         chosen = [plate["inside_face"]]
     panels = []
     report: list[dict[str, Any]] = []
-    for k in chosen:
-        face = all_faces[k - 1]
-        kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
-        try:
-            pat = unroll(face, best_effort=best_effort, sheet=sheet, **kw)
-        except NotDevelopableError as exc:
-            info_be: dict[str, Any] = {}
-            be_error = ""
-            try:  # measure how far off it is (for a non-ruled face: the ruled surface between its boundary isolines)
-                info_be = unroll(face, best_effort=True, **kw).panels[0].info or {}
-            except GHTError as be_exc:  # e.g. a full sphere: no two boundary curves to span rulings between
-                info_be = {}
-                be_error = " ".join(str(be_exc).split())
-            dev = info_be.get("developability")
-            straight = min(info_be.get("deviation_u", 0.0), info_be.get("deviation_v", 0.0))
-            how = (f"theta_max={dev['theta_max']:.6g} deg, developability degree DD={dev['dd']:.12f} (1 = developable)"
-                   if dev else " ".join(str(exc).split()))
-            if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
-                how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
-                       "relative to their lengths (allowed 1e-9), so it has no rulings to unroll along")
-            if be_error and "cannot be flattened" not in how and "cannot flatten" not in how:
-                how += f"; --best-effort cannot flatten it either: {be_error}"
-            allowed = ("allowed: developable faces" if be_error else
-                       "allowed: developable faces, or --best-effort to flatten it with a distortion report")
-            raise NotDevelopableError(
-                f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; {allowed}"
-            ) from None
-        except GHTError as exc:
-            raise type(exc)(f"{p}: face {k} of {n}: {' '.join(str(exc).split())}") from None
-        panel = pat.panels[0]
-        info = panel.info or {}
-        rep = panel.report.as_dict() if panel.report is not None else {}
-        report.append({
-            "face": k,
-            "label": panel.label,
-            "surface_type": _face_type_name(face),
-            "method": info.get("method"),
-            "best_effort": bool(best_effort),
-            "area_3d": float(panel.area_3d),
-            "area_flat": float(panel.area_flat),
-            "developability": info.get("developability"),
-            "errors": {q: v["max"] for q, v in rep.items()},
-        })
-        panels.extend(pat.panels)
+    fkw = dict(best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, unit=unit, sheet=sheet)
+    if (jobs == 1 or len(chosen) < 2) and scheduler is None:
+        results = [unroll_step_face(p, all_faces[k - 1], k, n, **fkw) for k in chosen]
+    else:
+        from ..batch import map_step_faces
+
+        results = map_step_faces(p, all_faces, chosen, fkw, jobs=jobs, scheduler=scheduler)
+    for pans, row in results:
+        panels.extend(pans)
+        report.append(row)
     mark_shared_edges(panels)
     layout_panels(panels)
     return StepUnroll(FlatPattern(panels, units=unit), unit, file_unit, n, report, plate)
@@ -262,6 +233,61 @@ def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any
             "whose two large faces lie at a constant distance) to read it from; allowed: --thickness T"
         )
     return make_sheet(thickness, k_factor, din_k_factor=din_k_factor, side=side or "normal"), None
+
+
+def unroll_step_face(p: Path, face: Any, k: int, n: int, *, best_effort: bool, tol_deg: float, rulings: int,
+                     unit: str, sheet: Any = None) -> tuple[list[Any], dict[str, Any]]:
+    """Unroll face ``k`` (of ``n``) of the STEP file ``p`` for :func:`unroll_step`: its panels and report row.
+
+    Raises:
+        NotDevelopableError: the face is not developable within ``tol_deg`` (and not ``best_effort``).
+        GHTError: any other refusal, the message prefixed with the file and face number.
+    """
+    from ..errors import NotDevelopableError
+    from ..unroll import unroll
+
+    kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
+    try:
+        pat = unroll(face, best_effort=best_effort, sheet=sheet, **kw)
+    except NotDevelopableError as exc:
+        info_be: dict[str, Any] = {}
+        be_error = ""
+        try:  # measure how far off it is (for a non-ruled face: the ruled surface between its boundary isolines)
+            info_be = unroll(face, best_effort=True, **kw).panels[0].info or {}
+        except GHTError as be_exc:  # e.g. a full sphere: no two boundary curves to span rulings between
+            info_be = {}
+            be_error = " ".join(str(be_exc).split())
+        dev = info_be.get("developability")
+        straight = min(info_be.get("deviation_u", 0.0), info_be.get("deviation_v", 0.0))
+        how = (f"theta_max={dev['theta_max']:.6g} deg, developability degree DD={dev['dd']:.12f} (1 = developable)"
+               if dev else " ".join(str(exc).split()))
+        if straight > 1e-9:  # θ_max and DD (spec 5) are defined along rulings: report the straightness
+            how = (f"it is not ruled: its straightest isolines deviate {straight:.3g} from straight lines "
+                   "relative to their lengths (allowed 1e-9), so it has no rulings to unroll along")
+        if be_error and "cannot be flattened" not in how and "cannot flatten" not in how:
+            how += f"; --best-effort cannot flatten it either: {be_error}"
+        allowed = ("allowed: developable faces" if be_error else
+                   "allowed: developable faces, or --best-effort to flatten it with a distortion report")
+        raise NotDevelopableError(
+            f"{p}: face {k} of {n} is not developable within tol_deg={tol_deg:g}: {how}; {allowed}"
+        ) from None
+    except GHTError as exc:
+        raise type(exc)(f"{p}: face {k} of {n}: {' '.join(str(exc).split())}") from None
+    panel = pat.panels[0]
+    info = panel.info or {}
+    rep = panel.report.as_dict() if panel.report is not None else {}
+    row = {
+        "face": k,
+        "label": panel.label,
+        "surface_type": _face_type_name(face),
+        "method": info.get("method"),
+        "best_effort": bool(best_effort),
+        "area_3d": float(panel.area_3d),
+        "area_flat": float(panel.area_flat),
+        "developability": info.get("developability"),
+        "errors": {q: v["max"] for q, v in rep.items()},
+    }
+    return list(pat.panels), row
 
 
 def _face_type_name(face: Any) -> str:

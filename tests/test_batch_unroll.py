@@ -1,0 +1,87 @@
+"""Parallel unrolling of a STEP file with 200 developable faces: panel for panel identical to serial."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+from ght_cad.cli import main
+from ght_cad.design import unroll_step
+from ght_cad.errors import NotDevelopableError
+
+pytestmark = pytest.mark.timeout(600)
+
+BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_batch.py"
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_batch", BENCH)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def many_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    p = tmp_path_factory.mktemp("many") / "hull.step"
+    n = _bench().many_faces_step(p, 200)
+    assert n >= 200
+    return p
+
+
+def signature(res) -> list:
+    """Everything a pattern's files are made of, per panel, bit for bit."""
+    out = []
+    for x in res.pattern.panels:
+        out.append((x.label, [(e.name, e.flat.tobytes(), e.xyz.tobytes(), e.length_3d, e.length_flat)
+                              for lp in x.loops for e in lp],
+                    x.bend_lines.tobytes(), [m.tobytes() for m in x.marks], x.texts, x.offset.tobytes(),
+                    x.area_flat, x.area_3d, x.report.as_dict() if x.report else None))
+    return out
+
+
+def test_200_faces_parallel_identical_to_serial(many_step):
+    serial = unroll_step(many_step)
+    parallel = unroll_step(many_step, jobs=2)
+    assert len(serial.pattern.panels) >= 200
+    kinds = {f["surface_type"] for f in serial.faces}
+    assert {"cylinder", "cone", "bsplinesurface", "plane"} <= kinds
+    assert signature(parallel) == signature(serial)
+    assert parallel.faces == serial.faces
+    assert sum(len(p.marks) for p in serial.pattern.panels) > 0  # the whole cylinders share edges
+    # exact: every panel's flat area is its 3-D area
+    for f in serial.faces:
+        assert abs(f["area_flat"] - f["area_3d"]) <= 1e-9 * f["area_3d"]
+    # the exports are the same files
+    d = many_step.parent
+    serial.pattern.export_svg(d / "s.svg")
+    parallel.pattern.export_svg(d / "p.svg")
+    assert (d / "s.svg").read_bytes() == (d / "p.svg").read_bytes()
+
+
+def test_unroll_cli_jobs(many_step, capsys):
+    code = main(["unroll", str(many_step), "--jobs", "2", "--face", "1", "--face", "2", "--face", "3", "--json"])
+    assert code == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["panels"] == 3 and [f["face"] for f in res["faces"]] == [1, 2, 3]
+    assert main(["unroll", str(many_step), "--jobs", "0"]) == 2
+    assert "--jobs 0" in capsys.readouterr().err
+
+
+def test_parallel_error_is_the_serial_one(tmp_path):
+    import build123d as bd
+
+    from ght_cad.cad.occ import write_step
+
+    shapes = [bd.Solid.make_cylinder(5, 10).translate((20 * i, 0, 0)) for i in range(3)]
+    shapes.append(bd.Solid.make_sphere(5).translate((0, 30, 0)))
+    p = tmp_path / "sphere.step"
+    write_step(bd.Compound(shapes), p)
+    with pytest.raises(NotDevelopableError) as e1:
+        unroll_step(p)
+    with pytest.raises(NotDevelopableError) as e2:
+        unroll_step(p, jobs=2)
+    assert str(e1.value) == str(e2.value) and "face 10 of 10" in str(e1.value)
