@@ -29,6 +29,7 @@ numpy/scipy only (runs inside FreeCAD's Python with numpy 1.24 / scipy 1.10).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
@@ -339,6 +340,15 @@ def best_effort_direction(info: dict[str, float], label: str) -> str:
     )
 
 
+@functools.lru_cache(maxsize=1)
+def _gauss12() -> tuple[np.ndarray, np.ndarray]:
+    """12-point Gauss–Legendre nodes and weights on [-1, 1] (computed once; read-only arrays)."""
+    xg, wg = np.polynomial.legendre.leggauss(12)
+    xg.flags.writeable = False
+    wg.flags.writeable = False
+    return xg, wg
+
+
 def face_area(
     ev: SurfaceAdapter,
     edges_uv: list[list[tuple[Callable, Callable]]],
@@ -366,7 +376,7 @@ def face_area(
         ``|I_0| - Σ_{k≥1} |I_k|`` where ``I_k = ∮_{loop k} P dv`` (the first loop is the outer
         one, the others holes): independent of the loops' orientations.
     """
-    xg, wg = np.polynomial.legendre.leggauss(12)
+    xg, wg = _gauss12()
     u_breaks = np.asarray(u_breaks, dtype=float)
     # outer nodes of every edge of every loop; then one surface evaluation for all inner nodes
     parts = []  # (loop, outer weights dv * tw, u, v) per edge
@@ -447,7 +457,7 @@ def loop_uv_area(loop: list[tuple[Callable, Callable]]) -> float:
     Returns:
         The signed (u, v)-area (positive counter-clockwise).
     """
-    xg, wg = np.polynomial.legendre.leggauss(12)
+    xg, wg = _gauss12()
     total = 0.0
     for uvf, duv in loop:
         te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))

@@ -303,6 +303,9 @@ def test_batch_sweep(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     md = (tmp_path / "out" / "batch.md").read_text()
     assert "## Sweep of swept" in md and "sweep-swept.png" in md
+    # ght-cad run does not silently ignore the sweep: it says where sweeps run
+    assert main(["run", str(p), "--out", str(tmp_path / "run")]) == 2
+    assert not (tmp_path / "run").exists()
 
 
 def test_sweep_expansion_grid_zip_and_errors():
