@@ -94,3 +94,25 @@ def test_face_thickness_beyond_radius_is_refused() -> None:
     f = _face(Solid.make_cylinder(5, 20, angle=90), "CYLINDER")
     with pytest.raises(SheetError, match=r"thickness=6.0 .*bending radius 5 "):
         unroll(f, thickness=6.0, k_factor=1.0)
+
+
+def test_forming_label_avoids_a_hole() -> None:
+    """A drilled cylinder plate: the one forming label sits on the plate, not in the hole at its centre."""
+    from build123d import Plane
+
+    from ght_cad.flat_pattern import _inside
+
+    cyl = Solid.make_cylinder(50, 40, angle=120)
+    c, s = math.cos(math.radians(60)), math.sin(math.radians(60))
+    drill = Solid.make_cylinder(6, 200, Plane(origin=(0, 0, 20), z_dir=(c, s, 0)))
+    face = _face(cyl - drill, "CYLINDER")
+    pat = unroll(face, thickness=1.0, k_factor=0.5)
+    assert len(pat.panels[0].loops) == 2  # outline and hole
+    (label,) = pat.forming_labels
+    loops = pat.panels[0].loop_polylines()
+    assert _inside(np.array([label[:2]]), loops)[0]
+    # the plate centre (where the label would go) is in the hole
+    lo, hi = pat.panels[0].bbox()
+    assert not _inside(np.array([0.5 * (lo + hi)]), loops)[0]
+    # neutral sector minus the developed drill hole (about a disc of radius 6: loose, 2e-3)
+    assert pat.area == pytest.approx((2 * math.pi / 3) * 50.5 * 40 - math.pi * 6**2, rel=2e-3)
