@@ -1,4 +1,15 @@
-"""Benchmark of the shape-parameter optimizers (issue 6, spec section 8).
+"""Benchmark of the shape-parameter optimizers (issues 6 and 13, spec sections 8, 8.1).
+
+**Default optimizer** (issue 13, ``--section default``, first): ``hybrid`` with exact gradients,
+``hybrid`` on the same objective as a plain black-box callable (finite differences, every point
+counted), PSO, GWO, I-GWO, scipy DE and DE with ``polish=True`` on every problem (the thesis'
+problems plus two strips between other curves: quartic "wave" curves with the optimum on the box
+boundary in four parameters, quartic arcs of a cone); 10 seeds; evaluations to 99.9 % of the
+achievable improvement (median over seeds; an exact gradient counts as its cost measured here, in
+objective evaluations), success rate, wall time; the acceptance ratios to DE; and the wall time of
+one 6-parameter strip optimization (hybrid) against 0.2 s, with its ratio to DE in the same run.
+
+**Thesis section** (issue 6, ``--section thesis``): the tables below, unchanged.
 
 For every problem: ``--seeds`` runs (default 10) of PSO, GWO, I-GWO and scipy's
 ``differential_evolution`` (the baseline, measured in the same run) with the same population and
@@ -13,7 +24,11 @@ problem against the 2 s target, and a Pareto front of (AL, En, CVEn).
 
 Usage::
 
-    python bench/bench_optimize.py [--seeds 10] [--iters 200] [--pop 30] [--out DIR] [--no-sweep]
+    python bench/bench_optimize.py [--section default|thesis|all] [--quick] [--seeds 10] [--iters 200]
+                                   [--pop 30] [--out DIR] [--no-sweep]
+
+``--quick``: only the default-optimizer section with hybrid, hybrid-fd and DE (the acceptance
+columns; a few minutes on a loaded 2-core machine).
 
 With ``--out`` it also writes ``comparison.md`` and convergence PNGs there.
 """
@@ -28,10 +43,16 @@ from pathlib import Path
 import numpy as np
 
 from ght_cad.io import write_text_atomic
-from ght_cad.optimize import METHODS
+from ght_cad.optimize import METHODS, differential_evolution, hybrid
 from ght_cad.optimize.compare import budget_sweep, compare, format_table, set_target
 from ght_cad.optimize.pareto import pareto_front
-from ght_cad.optimize.problems import default_dual_problem, default_interpolation_problem, default_strip_problem
+from ght_cad.optimize.problems import (
+    cone_strip_problem,
+    default_dual_problem,
+    default_interpolation_problem,
+    default_strip_problem,
+    wave_strip_problem,
+)
 from ght_cad.progress import Progress
 
 
@@ -69,8 +90,98 @@ def de_default_nfev_to_target(fun, bounds, target: float, seed: int) -> float:
     return float(state["hit"])
 
 
+def black_box(problem):
+    """The problem as a plain callable ``f(X) -> (pop,)`` (no ``value_and_grad``: finite differences)."""
+    return lambda X: problem(X)
+
+
+def gradient_cost(problem, reps: int = 30) -> float:
+    """Measured cost of one exact gradient in objective evaluations, at one point (as L-BFGS-B calls it):
+    ``time(value_and_grad) / time(value) - 1`` (the value is counted in nfev already), minimum over
+    5 repetitions of ``reps`` calls each, at the problem's base design."""
+    x = np.asarray(problem.x0, dtype=float)[None, :]
+
+    def best(fn) -> float:
+        out = np.inf
+        for _ in range(5):
+            t = time.perf_counter()
+            for _ in range(reps):
+                fn(x)
+            out = min(out, time.perf_counter() - t)
+        return out
+
+    return max(best(problem.value_and_grad) / best(problem) - 1.0, 0.0)
+
+
+def default_section(args, problems: dict, seeds: tuple, quick: bool) -> bool:
+    """Issue 13: hybrid against the thesis' optimizers and DE; returns True if every acceptance item holds."""
+    variants = {
+        "hybrid": lambda fun, bounds, *, pop_size, max_iter, seed, x0: hybrid(fun, bounds, seed=seed, x0=x0),
+        "hybrid-fd": lambda fun, bounds, *, pop_size, max_iter, seed, x0: hybrid(black_box(fun), bounds, seed=seed,
+                                                                                 x0=x0),
+        "de-polish": lambda fun, bounds, *, pop_size, max_iter, seed, x0: differential_evolution(
+            fun, bounds, pop_size=pop_size, max_iter=max_iter, seed=seed, x0=x0, polish=True),
+    }
+    methods = ("hybrid", "hybrid-fd", "de") if quick else ("hybrid", "hybrid-fd", "pso", "gwo", "igwo", "de", "de-polish")
+    probs = {k: v for k, v in problems.items() if hasattr(v[0], "value_and_grad")}
+    cost = {k: gradient_cost(f) for k, (f, _) in probs.items()}
+    print("# default optimizer (issue 13): hybrid vs " + ("DE" if quick else "PSO, GWO, I-GWO, DE, DE polish=True")
+          + f"; {len(seeds)} seeds, pop {args.pop}, {args.iters} iterations for the")
+    print("# population methods; hybrid at its defaults (32 Sobol starts, <= 4 L-BFGS-B finishes); 'hybrid-fd' is hybrid")
+    print("# on the same objective as a plain callable (finite differences). Target: 99.9 % of the achievable improvement;")
+    print("# exact gradients count as their measured cost in evaluations (column 'grad cost').\n")
+    t0 = time.perf_counter()
+    with Progress(len(probs) * len(methods) * len(seeds), "bench default") as bar:
+        rows = compare(probs, methods, seeds=seeds, pop_size=args.pop, max_iter=args.iters,
+                       progress=lambda *a: bar.update(), variants=variants, grad_cost=cost)
+    print("| problem | grad cost | method | nfev to target (median) | success | ratio to DE | median wall time [s] |")
+    print("|---|---|---|---|---|---|---|")
+    ok_all = True
+    verdicts = []
+    for name in probs:
+        rs = {r.method: r for r in rows if r.problem == name}
+        de = rs["de"].nfev_to_target
+        for m in methods:
+            r = rs[m]
+            n = "never" if not np.isfinite(r.nfev_to_target) else f"{r.nfev_to_target:.0f}"
+            ratio = "-" if not (np.isfinite(r.nfev_to_target) and np.isfinite(de)) else f"{r.nfev_to_target / de:.3f}"
+            print(f"| {name} | {cost[name] if m == 'hybrid' else 0:.2f} | {m} | {n} | {r.reached}/{len(r.runs)} | {ratio} "
+                  f"| {r.time:.3f} |")
+        h, hf = rs["hybrid"], rs["hybrid-fd"]
+        ok = (h.reached == len(h.runs) and hf.reached == len(hf.runs) and np.isfinite(de)
+              and h.nfev_to_target <= de / 3 and hf.nfev_to_target <= de / 2)
+        verdicts.append((name, ok, h.nfev_to_target / de if np.isfinite(de) else np.nan,
+                         hf.nfev_to_target / de if np.isfinite(de) else np.nan))
+        ok_all &= ok
+    print(f"\n(total {time.perf_counter() - t0:.1f} s)\n")
+    print("## acceptance: hybrid 10/10 and <= 1/3 of DE's median evaluations; hybrid-fd 10/10 and <= 1/2")
+    for name, ok, a, b in verdicts:
+        print(f"  {name:30s} hybrid {a:.3f} DE, hybrid-fd {b:.3f} DE: {'yes' if ok else 'NO'}")
+    # wall time of one 6-parameter strip optimization, ratio to DE in the same run
+    strip = problems["strip R (6 params)"][0]
+    th, td = [], []
+    for s in range(5):
+        th.append(hybrid(strip, strip.bounds, seed=s).time)
+        td.append(differential_evolution(strip, strip.bounds, pop_size=args.pop, max_iter=args.iters, seed=s).time)
+    t_h, t_d = float(np.median(th)), float(np.median(td))
+    fast = t_h < 0.2
+    print(f"\n## one 6-parameter strip optimization (hybrid defaults, median of 5 seeds): {t_h:.3f} s "
+          f"({'OK' if fast else 'OVER'} 0.2 s); DE {args.pop} x {args.iters}: {t_d:.3f} s; ratio hybrid/DE {t_h / t_d:.3f}")
+    if args.out is not None:
+        from ght_cad.optimize.plots import plot_convergence
+
+        args.out.mkdir(parents=True, exist_ok=True)
+        for name in probs:
+            runs = {r.method: r.runs for r in rows if r.problem == name and r.method in ("hybrid", "hybrid-fd", "igwo", "de")}
+            safe = "".join(c if c.isalnum() else "_" for c in name).strip("_")
+            plot_convergence(runs, args.out / f"default_{safe}.png", title=f"{name}: hybrid vs I-GWO, DE")
+    return ok_all and fast
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--section", choices=("default", "thesis", "all"), default="all")
+    ap.add_argument("--quick", action="store_true", help="default-optimizer section only: hybrid, hybrid-fd and DE")
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--iters", type=int, default=200)
     ap.add_argument("--pop", type=int, default=30)
@@ -95,8 +206,17 @@ def main(argv: list[str] | None = None) -> int:
         "rastrigin 5-D": (rastrigin, (-5.12 * np.ones(5), 5.12 * np.ones(5))),
         "rosenbrock 5-D": (rosenbrock, (-2.048 * np.ones(5), 2.048 * np.ones(5))),
     }
-    methods = ("pso", "gwo", "igwo", "de")
     seeds = tuple(range(args.seeds))
+    if args.quick or args.section in ("default", "all"):
+        wave, cone = wave_strip_problem(), cone_strip_problem()
+        new = {"wave strip R (quartics, boundary optimum)": (wave, wave.bounds),
+               "cone strip R (quartic arcs)": (cone, cone.bounds)}
+        keys = [k for k in problems if not k.startswith(("rastrigin", "rosenbrock"))]
+        ok = default_section(args, {**{k: problems[k] for k in keys}, **new}, seeds, args.quick)
+        print(f"\nissue 13 acceptance (all problems, 0.2 s): {'met' if ok else 'NOT met'}\n")
+        if args.quick or args.section == "default":
+            return 0
+    methods = ("pso", "gwo", "igwo", "de")
     print(f"# optimizer comparison: {args.seeds} seeds, pop {args.pop}, {args.iters} iterations "
           f"(I-GWO evaluates 2*pop per iteration)\n")
     total = len(problems) * len(methods) * len(seeds)

@@ -194,3 +194,21 @@ def test_out_dir_that_is_a_file_is_refused_before_the_run(tmp_path):
         optimize_design(default_dual_problem("CVEn"), pop_size=5, max_iter=2, out_dir=f,
                         callback=lambda s: calls.append(s.nit))
     assert calls == [] and f.read_text() == "keep"
+
+
+def test_compare_variants_and_gradient_cost():
+    """Variants by label (hybrid with finite differences) and exact gradients charged at grad_cost."""
+    from ght_cad.optimize import hybrid
+    from ght_cad.optimize.problems import default_dual_problem
+
+    p = default_dual_problem("En", check_surface=False)
+    fd = {"hybrid-fd": lambda f, b, *, pop_size, max_iter, seed, x0: hybrid(lambda X: f(X), b, seed=seed)}
+    rows = compare({"dual": (p, p.bounds)}, ("hybrid", "hybrid-fd", "de"), seeds=(0, 1), pop_size=10, max_iter=20,
+                   variants=fd, grad_cost={"dual": 3.0})
+    h, hf, de = rows
+    assert h.grad_cost == 3.0 and all(run.njev > 0 for run in h.runs) and all(run.njev == 0 for run in hf.runs)
+    for run in h.runs:  # the count to target includes 3 evaluations per gradient
+        n = run.nfev_to_reach(h.target, 3.0)
+        k = int(np.nonzero(run.history <= h.target)[0][0])
+        assert n == run.history_nfev[k] + 3.0 * run.history_njev[k] > run.nfev_to_reach(h.target)
+    assert h.nfev_to_target == float(np.median([run.nfev_to_reach(h.target, 3.0) for run in h.runs]))

@@ -11,6 +11,8 @@ of the initial populations (so ``rtol = 1e-3`` means 99.9 % of the achievable im
 each run the evaluations after which its best value was first ``<= target`` (per-iteration
 resolution); a run that never reaches it counts as infinite; the median over seeds is reported
 with its ratio to the baseline method (``de`` by default; < 1 means fewer evaluations).
+Exact gradient evaluations (``hybrid`` on a problem with ``value_and_grad``) count as
+``grad_cost`` objective evaluations each (:meth:`OptimizeResult.cost`; the bench measures it).
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ class MethodStats:
     nfev_to_target: float = math.inf
     reached: int = 0
     ratio: float = math.nan
+    grad_cost: float = 0.0
     runs: list[OptimizeResult] = field(default_factory=list, repr=False)
 
 
@@ -56,6 +59,8 @@ def compare(
     rtol: float = 1e-3,
     x0: Mapping[str, Any] | None = None,
     progress: Callable[[str, str, int], Any] | None = None,
+    variants: Mapping[str, Callable[..., OptimizeResult]] | None = None,
+    grad_cost: Mapping[str, float] | None = None,
 ) -> list[MethodStats]:
     """Run every method on every problem for every seed and summarize.
 
@@ -69,6 +74,10 @@ def compare(
         rtol: fraction of the achievable improvement left at the target (see module docstring).
         x0: optional ``name -> starting point`` placed in every initial population.
         progress: ``progress(problem, method, seed)`` called before each run.
+        variants: further methods by label, ``label -> opt(fun, bounds, *, pop_size, max_iter,
+            seed, x0) -> OptimizeResult`` (e.g. ``hybrid`` with finite differences, DE with
+            ``polish=True``); their labels may appear in ``methods``.
+        grad_cost: ``problem name -> evaluations one exact gradient costs`` (default 0).
 
     Returns:
         One :class:`MethodStats` per (problem, method), in input order.
@@ -76,9 +85,10 @@ def compare(
     Raises:
         GHTError: unknown method names or no seeds.
     """
+    table = {**METHODS, **(variants or {})}
     for m in methods:
-        if m not in METHODS:
-            raise GHTError(f"method {m!r} is unknown; choose from {', '.join(METHODS)}")
+        if m not in table:
+            raise GHTError(f"method {m!r} is unknown; choose from {', '.join(table)}")
     if not len(seeds):
         raise GHTError("seeds is empty; give at least one seed")
     out: list[MethodStats] = []
@@ -89,13 +99,14 @@ def compare(
             for s in seeds:
                 if progress is not None:
                     progress(pname, m, s)
-                runs.append(METHODS[m](fun, bounds, pop_size=pop_size, max_iter=max_iter, seed=int(s),
-                                       x0=None if x0 is None else x0.get(pname)))
+                runs.append(table[m](fun, bounds, pop_size=pop_size, max_iter=max_iter, seed=int(s),
+                                     x0=None if x0 is None else x0.get(pname)))
             vals = np.array([r.fun for r in runs])
             rows.append(MethodStats(
                 problem=pname, method=m, best=float(vals.min()), median=float(np.median(vals)),
                 worst=float(vals.max()), nfev=float(np.mean([r.nfev for r in runs])),
                 time=float(np.median([r.time for r in runs])), runs=runs,
+                grad_cost=float((grad_cost or {}).get(pname, 0.0)),
             ))
         set_target(rows, rtol, baseline)
         out.extend(rows)
@@ -118,7 +129,7 @@ def set_target(rows: Sequence[MethodStats], rtol: float = 1e-3, baseline: str = 
     f_init = float(np.median([run.history[0] for r in rows for run in r.runs]))
     target = f_best + rtol * (f_init - f_best) if math.isfinite(f_init) else f_best
     for r in rows:
-        hits = [run.nfev_to_reach(target) for run in r.runs]
+        hits = [run.nfev_to_reach(target, r.grad_cost) for run in r.runs]
         n = np.array([math.inf if h is None else h for h in hits], dtype=float)
         r.target = target
         r.reached = int(np.sum(np.isfinite(n)))
