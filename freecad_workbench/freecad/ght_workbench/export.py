@@ -19,6 +19,7 @@ from . import _ensure_core  # noqa: F401
 from ._base import BaseCommand, register_command
 from ght_cad.errors import GHTError
 from ght_cad.io import atomic_path, write_text_atomic
+from ght_cad.outdir import lock_target
 
 __all__ = [
     "export_step",
@@ -105,6 +106,7 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
         GHTError: nothing to export, an object without shape, a stale shape (:func:`stale_reason`:
             its or an input's last recompute failed, or changes are pending), or an invalid shape
             (when ``check``).
+        FolderBusy: another process is writing ``path`` (its lock, :func:`ght_cad.outdir.lock_target`).
         OSError: the write failed; the target file is then untouched and no partial file is left.
 
     Returns:
@@ -122,16 +124,21 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
     units = Part.exportUnits().get("write.step.unit", "MM")
     Part.exportUnits("MM")  # FreeCAD's lengths are mm: write them as they are, whatever the user preference
     try:
-        # the exporter picks the format from the suffix: the temporary name must end in .step
-        with atomic_path(path, suffix=".step") as tmp:
-            step_tmp = tmp.with_name(tmp.name[: -len(".part")])
-            try:
-                writer(objects, str(step_tmp))
-                if step_tmp.exists():
-                    os.replace(step_tmp, tmp)
-            finally:
-                if step_tmp.exists():
-                    step_tmp.unlink()
+        # another process (a second FreeCAD, a ght-cad run) writing this very file: refused, naming it
+        lock = lock_target(path)
+        try:
+            # the exporter picks the format from the suffix: the temporary name must end in .step
+            with atomic_path(path, suffix=".step") as tmp:
+                step_tmp = tmp.with_name(tmp.name[: -len(".part")])
+                try:
+                    writer(objects, str(step_tmp))
+                    if step_tmp.exists():
+                        os.replace(step_tmp, tmp)
+                finally:
+                    if step_tmp.exists():
+                        step_tmp.unlink()
+        finally:
+            lock.release()
     finally:
         Part.exportUnits(units)
     return str(path)
@@ -221,14 +228,16 @@ def export_flat_pattern_dxf(obj: Any, path: str | os.PathLike, deflection: float
         GHTError: the feature is stale (see :func:`stale_reason`) or has never been computed.
     """
     _current_flat_shape(obj)
-    obj.Proxy.pattern(obj).export_dxf(path)
+    with lock_target(path):
+        obj.Proxy.pattern(obj).export_dxf(path)
     return str(path)
 
 
 def export_flat_pattern_svg(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
     """SVG of a flat pattern feature: group OUTLINE (black) and BEND (red dashed)."""
     outline, bends = flat_pattern_polylines(obj, deflection)
-    return write_svg(path, {"OUTLINE": outline, "BEND": bends})
+    with lock_target(path):
+        return write_svg(path, {"OUTLINE": outline, "BEND": bends})
 
 
 def _ask_path(title: str, filt: str, default: str) -> str | None:

@@ -180,6 +180,43 @@ class NamedStepExportTest(unittest.TestCase):
         self.assertEqual(step_products(stp), ["Box"])
         self.assertEqual(listing(), ["part.step", "part.stp"])
 
+    def test_a_file_another_process_writes_is_refused(self):
+        """Two writers of one file: the second export is refused naming the file and the holder's
+        pid (the lock of :mod:`ght_cad.outdir`, which a ``ght-cad`` process takes too), the file
+        stays as it was; once the lock is gone the export works and leaves no lock file."""
+        import subprocess
+        import sys
+
+        from ght_cad.outdir import FolderBusy, lock_path_for
+
+        folder = tempfile.mkdtemp(prefix="busy_", dir=OUT)
+        paths = {ext: os.path.join(folder, "part" + ext) for ext in (".step", ".dxf", ".svg")}
+        export.export_step([self.box], paths[".step"])
+        original = open(paths[".step"], "rb").read()
+        code = ("import sys, time\nfrom ght_cad.outdir import lock_target\n"
+                "locks = [lock_target(p) for p in sys.argv[1:]]\nprint('held', flush=True)\ntime.sleep(60)\n")
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+        # FreeCAD's own Python interpreter (sys.executable is freecadcmd there)
+        exe = sys.executable if os.path.basename(sys.executable).startswith("python") else "/usr/bin/python3"
+        holder = subprocess.Popen([exe, "-c", code, *paths.values()], stdout=subprocess.PIPE, env=env, text=True)
+        try:
+            self.assertEqual(holder.stdout.readline().strip(), "held")
+            calls = ((export.export_step, [self.box], ".step"), (export.export_flat_pattern_dxf, self.flat, ".dxf"),
+                     (export.export_flat_pattern_svg, self.flat, ".svg"))
+            for fn, arg, ext in calls:
+                with self.subTest(ext):
+                    with self.assertRaises(FolderBusy) as cm:
+                        fn(arg, paths[ext])
+                    self.assertIn(paths[ext], str(cm.exception))
+                    self.assertIn(f"pid {holder.pid}", str(cm.exception))
+        finally:
+            holder.kill()
+            holder.wait()
+        self.assertEqual(open(paths[".step"], "rb").read(), original)
+        self.assertEqual(sorted(os.listdir(folder)), sorted(["part.step"] + [os.path.basename(str(lock_path_for(p))) for p in paths.values()]))
+        for fn, arg, ext in calls:  # the killed holder's locks are gone with it
+            fn(arg, paths[ext])
+        self.assertEqual(sorted(os.listdir(folder)), ["part.dxf", "part.step", "part.svg"])
 
     def test_stale_inputs_are_refused(self):
         """A shape that does not match its inputs is never written: pending changes (Touched), or an

@@ -1,0 +1,687 @@
+"""Output folders and files under faults and concurrency: locks, staging folders, manifests.
+
+Every ght_cad writer that puts results on disk goes through this module (``ght-cad run``/``demo``/
+``batch`` folders, the single-file outputs of ``curve``/``surface``/``unroll``/``export``, the
+FreeCAD workbench's exports). Three mechanisms, all plain ``os``/``fcntl`` (no third-party code):
+
+**Locks.** A run that writes a folder (or a file) first takes an exclusive ``fcntl.flock`` on a
+lock file beside it, ``.<name>.ght-cad-lock``, which holds the owner's pid and command line. A
+second process on the same target either waits for it (``wait=True``, optional ``timeout``) or
+is refused with :class:`FolderBusy` (a :class:`~ght_cad.errors.GHTError`: exit code 2 on the
+command line) naming the target and the other process. The kernel drops a flock when its
+process dies, so a killed run (SIGKILL, OOM) never leaves a stuck lock; the lock file itself is
+removed on release (a waiter that locked the removed file notices the changed inode and retries).
+
+**Staging folders.** Results are computed into ``.<name>.<pid>-<random>.ght-cad-tmp`` beside the
+target, with a lock file ``.lock`` inside that the live process holds. A later run tells a dead
+run's folder from a live one: the lock is free (its process is gone), or there is no lock yet
+and the pid in the name does not exist. :func:`sweep_dead` removes dead runs' folders (also the
+pid-less ``.<name>.<random>.ght-cad-tmp`` and ``.ght-cad-export.<random>`` folders of earlier
+versions, which had no lock) and never touches a live one.
+
+**Manifests.** A folder holds one design's results: ``.ght-cad-manifest.json`` in it lists every
+file the last run wrote (``report.json`` lists the same under ``files``). :meth:`OutputFolder.commit`
+moves the new files in, then removes the files the previous manifest listed and this run did not
+write again; files a person put there are never listed, so they are kept. The manifest is first
+rewritten as the union of old and new names, so a run killed half-way through the moves leaves a
+manifest that still covers every file of ours in the folder, and the next run cleans up exactly.
+
+Typical use::
+
+    with OutputFolder("duct-out", wait=False) as out:   # lock, sweep dead staging folders
+        write_step(shape, out.path("model.step"))         # write into the staging folder
+        names = out.commit()                              # move in, remove stale files
+
+    with StagedFiles(["a.step", "plots/a.png"]) as stage:  # single files, all or nothing
+        write(stage.path(Path("a.step"))) ...
+        stage.commit()
+"""
+
+from __future__ import annotations
+
+import errno
+import fcntl
+import json
+import os
+import re
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+from .errors import GHTError
+
+__all__ = [
+    "FolderBusy",
+    "TargetLock",
+    "lock_target",
+    "StagingDir",
+    "sweep_dead",
+    "is_dead",
+    "read_manifest",
+    "write_manifest",
+    "OutputFolder",
+    "StagedFiles",
+    "MANIFEST_NAME",
+    "LOCK_SUFFIX",
+    "STAGING_SUFFIX",
+]
+
+#: file in an output folder listing the files the last run wrote (one JSON object)
+MANIFEST_NAME = ".ght-cad-manifest.json"
+#: suffix of the lock file beside a locked target: ``.<name>.ght-cad-lock``
+LOCK_SUFFIX = ".ght-cad-lock"
+#: suffix of a staging folder: ``.<name>.<pid>-<random>.ght-cad-tmp``
+STAGING_SUFFIX = ".ght-cad-tmp"
+#: the lock file inside a staging folder
+_STAGING_LOCK = ".lock"
+#: earlier versions' pid-less staging folders of single-file exports
+_LEGACY_EXPORT_PREFIX = ".ght-cad-export."
+_PID_RE = re.compile(r"\.(\d+)-[A-Za-z0-9_]+" + re.escape(STAGING_SUFFIX) + r"$")
+#: seconds between two attempts while waiting for a busy target
+POLL_S = 0.05
+
+
+class FolderBusy(GHTError):
+    """The target folder (or file) is in use by another live process.
+
+    Attributes:
+        path: the target.
+        pid: the other process's pid (None if it could not be read).
+        owner: its command line as recorded in the lock file ("" if unknown).
+    """
+
+    def __init__(self, message: str, path: Path, pid: int | None, owner: str) -> None:
+        super().__init__(message)
+        self.path = path
+        self.pid = pid
+        self.owner = owner
+
+
+def _owner_text() -> str:
+    argv = [Path(sys.argv[0]).name if sys.argv and sys.argv[0] else "python", *sys.argv[1:]]
+    return " ".join(argv)[:300]
+
+
+def _pid_alive(pid: int) -> bool:
+    """True if a process ``pid`` exists (a zombie counts as existing)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, another user's
+        return True
+    except OSError:  # pragma: no cover - be safe: do not delete
+        return True
+    return True
+
+
+def _read_owner(fd_or_path: int | Path) -> tuple[int | None, str]:
+    """(pid, command) recorded in a lock file ("<pid> <command>"), (None, "") if empty/unreadable."""
+    try:
+        if isinstance(fd_or_path, int):
+            os.lseek(fd_or_path, 0, os.SEEK_SET)
+            data = os.read(fd_or_path, 4096)
+        else:
+            data = fd_or_path.read_bytes()[:4096]
+    except OSError:
+        return None, ""
+    text = data.decode("utf-8", "replace").strip()
+    head, _, rest = text.partition(" ")
+    return (int(head), rest) if head.isdigit() else (None, "")
+
+
+def _write_owner(fd: int) -> None:
+    os.ftruncate(fd, 0)
+    os.lseek(fd, 0, os.SEEK_SET)
+    os.write(fd, f"{os.getpid()} {_owner_text()}\n".encode("utf-8", "replace"))
+
+
+def _try_flock(fd: int) -> bool:
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except OSError as exc:
+        if exc.errno in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
+            return False
+        raise
+
+
+# ---------------------------------------------------------------------------------------------
+# locks on targets
+# ---------------------------------------------------------------------------------------------
+def lock_path_for(target: str | os.PathLike) -> Path:
+    """The lock file of ``target``: ``<parent>/.<name>.ght-cad-lock``."""
+    t = Path(target).absolute()
+    return t.parent / f".{t.name}{LOCK_SUFFIX}"
+
+
+class TargetLock:
+    """An exclusive lock on a folder or file path (see the module docstring); a context manager.
+
+    Args:
+        target: the folder or file to protect (need not exist; its parent is created).
+        wait: wait while another process holds the lock instead of raising :class:`FolderBusy`.
+        timeout: with ``wait``, give up after this many seconds (None: wait as long as it takes).
+        what: "folder" or "file", for messages.
+        hint: how to resolve the conflict, appended to the refusal message.
+        on_wait: called once with the FolderBusy describing the holder when a wait begins.
+    """
+
+    def __init__(self, target: str | os.PathLike, *, wait: bool = False, timeout: float | None = None,
+                 what: str = "folder", hint: str = "run again with --wait, or choose another output",
+                 on_wait: Callable[[FolderBusy], None] | None = None) -> None:
+        if timeout is not None and not (timeout >= 0 and timeout == timeout):
+            raise GHTError(f"timeout={timeout!r} is not allowed; allowed: a number of seconds >= 0 or none")
+        self.target = Path(target)
+        self.path = lock_path_for(target)
+        self.wait = wait
+        self.timeout = timeout
+        self.what = what
+        self.hint = hint
+        self.on_wait = on_wait
+        self.fd: int | None = None
+
+    def _busy(self, fd: int, waited: float | None = None) -> FolderBusy:
+        pid, owner = _read_owner(fd)
+        who = f"pid {pid}" if pid is not None else "a process that is starting"
+        if owner:
+            who += f": {owner}"
+        if waited is not None:
+            msg = (f"{self.what} {self.target} is still in use by another ght-cad process ({who}) after waiting "
+                   f"{waited:g} s; allowed: a longer --wait-timeout, or another output")
+        else:
+            msg = f"{self.what} {self.target} is in use by another ght-cad process ({who}); allowed: {self.hint}"
+        return FolderBusy(msg, self.target, pid, owner)
+
+    def acquire(self) -> "TargetLock":
+        """Take the lock (waiting if asked); raises :class:`FolderBusy` or ``GHTError``."""
+        if self.fd is not None:
+            return self
+        parent = self.path.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise GHTError(f"cannot create the folder {parent} for {self.target}: {exc.strerror or exc}; "
+                           "allowed: a path whose parent folders can be created") from None
+        t0 = time.monotonic()
+        told = False
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+            except OSError as exc:
+                raise GHTError(f"cannot lock {self.target} (lock file {self.path}): {exc.strerror or exc}; "
+                               "allowed: a writable folder") from None
+            if _try_flock(fd):
+                # the holder before us may have removed the file we opened: then lock the new one
+                try:
+                    same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+                except FileNotFoundError:
+                    same = False
+                if same:
+                    _write_owner(fd)
+                    self.fd = fd
+                    return self
+                os.close(fd)
+                continue
+            if not self.wait:
+                err = self._busy(fd)
+                os.close(fd)
+                raise err
+            if not told and self.on_wait is not None:
+                told = True
+                self.on_wait(self._busy(fd))
+            waited = time.monotonic() - t0
+            if self.timeout is not None and waited >= self.timeout:
+                err = self._busy(fd, waited=self.timeout)
+                os.close(fd)
+                raise err
+            os.close(fd)
+            time.sleep(POLL_S if self.timeout is None else max(0.0, min(POLL_S, self.timeout - waited)))
+
+    def release(self) -> None:
+        """Remove the lock file and drop the lock (no-op if not held)."""
+        if self.fd is None:
+            return
+        try:
+            if os.fstat(self.fd).st_ino == os.stat(self.path).st_ino:
+                os.unlink(self.path)
+        except OSError:
+            pass
+        os.close(self.fd)  # closing drops the flock
+        self.fd = None
+
+    @property
+    def held(self) -> bool:
+        return self.fd is not None
+
+    def __enter__(self) -> "TargetLock":
+        return self.acquire()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.release()
+
+
+def lock_target(target: str | os.PathLike, *, wait: bool = False, timeout: float | None = None,
+                what: str = "file", hint: str = "try again when the other export has finished") -> TargetLock:
+    """An acquired :class:`TargetLock` on ``target`` (use as ``with lock_target(p): ...``)."""
+    return TargetLock(target, wait=wait, timeout=timeout, what=what, hint=hint).acquire()
+
+
+# ---------------------------------------------------------------------------------------------
+# staging folders
+# ---------------------------------------------------------------------------------------------
+class StagingDir:
+    """A staging folder ``<parent>/.<label>.<pid>-<random>.ght-cad-tmp`` whose ``.lock`` this
+    process holds while it lives; :meth:`remove` deletes it.
+
+    Args:
+        parent: folder to create it in (created if missing).
+        label: readable part of the name (the target's name).
+    """
+
+    def __init__(self, parent: str | os.PathLike, label: str) -> None:
+        self.parent = Path(parent)
+        label = label.lstrip(".") or "out"
+        self.path = Path(tempfile.mkdtemp(prefix=f".{label}.{os.getpid()}-", suffix=STAGING_SUFFIX, dir=self.parent))
+        self.lock_file = self.path / _STAGING_LOCK
+        try:
+            self.fd: int | None = os.open(self.lock_file, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            _write_owner(self.fd)
+        except BaseException:
+            shutil.rmtree(self.path, ignore_errors=True)
+            raise
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self.path, 0o777 & ~umask)  # mkdtemp makes 0700; the result is an ordinary folder
+
+    def files(self) -> list[str]:
+        """Names of the finished files in the folder (no lock file, no ``.part`` leftovers)."""
+        return sorted(p.name for p in self.path.iterdir()
+                      if p.is_file() and p.name != _STAGING_LOCK and not p.name.endswith(".part"))
+
+    def drop_lock_file(self) -> None:
+        """Delete the lock file (keeping the lock itself) before the folder is renamed into place."""
+        try:
+            self.lock_file.unlink()
+        except FileNotFoundError:
+            pass
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+    def remove(self) -> None:
+        """Delete the folder (if still there) and drop its lock."""
+        shutil.rmtree(self.path, ignore_errors=True)
+        self.release()
+
+
+def is_dead(folder: str | os.PathLike) -> bool:
+    """True if ``folder`` is a staging folder whose run is gone (see the module docstring).
+
+    Live: its ``.lock`` is held by a process, or it has no (or an empty) lock file yet and the pid
+    in its name exists. Dead: the lock can be taken, or no lock and no such pid (or no pid in the
+    name: an earlier version's folder).
+    """
+    folder = Path(folder)
+    m = _PID_RE.search(folder.name)
+    pid = int(m.group(1)) if m else None
+    lock = folder / _STAGING_LOCK
+    try:
+        fd = os.open(lock, os.O_RDWR)
+    except FileNotFoundError:
+        return pid is None or not _pid_alive(pid)
+    except OSError:
+        return False
+    try:
+        if not _try_flock(fd):
+            return False
+        owner, _ = _read_owner(fd)
+        if owner is None and pid is not None and _pid_alive(pid):
+            return False  # created, not yet stamped by its (live) process
+        return True
+    finally:
+        os.close(fd)
+
+
+def _staging_candidates(parent: Path) -> list[Path]:
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return []
+    out = []
+    for e in entries:
+        if (e.name.endswith(STAGING_SUFFIX) or e.name.startswith(_LEGACY_EXPORT_PREFIX)) and e.name.startswith("."):
+            try:
+                if e.is_dir(follow_symlinks=False):
+                    out.append(Path(e.path))
+            except OSError:
+                pass
+    return out
+
+
+def sweep_dead(parent: str | os.PathLike) -> list[Path]:
+    """Remove the dead runs' staging folders in ``parent``; returns those removed.
+
+    Only hidden folders named ``*.ght-cad-tmp`` (or ``.ght-cad-export.*`` of earlier versions)
+    are looked at, and only the dead ones (:func:`is_dead`) removed; a live run's folder is
+    never touched.
+    """
+    removed = []
+    for d in _staging_candidates(Path(parent)):
+        if is_dead(d):
+            shutil.rmtree(d, ignore_errors=True)
+            if not d.exists():
+                removed.append(d)
+    return removed
+
+
+# ---------------------------------------------------------------------------------------------
+# manifests
+# ---------------------------------------------------------------------------------------------
+def _safe_names(names: Iterable[Any]) -> list[str]:
+    """Plain file names only (a manifest can never name a path outside its folder)."""
+    out = []
+    for n in names:
+        if isinstance(n, str) and n and n not in (".", "..") and "/" not in n and "\\" not in n and "\0" not in n \
+                and n != MANIFEST_NAME:
+            out.append(n)
+    return out
+
+
+def read_manifest(folder: str | os.PathLike) -> list[str]:
+    """The files the last run listed for ``folder`` ([] for a folder no ght-cad run wrote).
+
+    Reads ``.ght-cad-manifest.json``; for folders written by earlier versions, which had none,
+    the ``files`` list of a ght-cad ``report.json`` (one with ``ght_definition`` and ``files``).
+    """
+    folder = Path(folder)
+    for name, key in ((MANIFEST_NAME, "files"), ("report.json", "files")):
+        p = folder / name
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if not isinstance(data, dict) or not isinstance(data.get(key), list):
+            continue
+        if name == "report.json":
+            if "ght_definition" not in data:
+                continue  # not a ght-cad report: a person's file
+            return _safe_names(data[key]) + ["report.json"]
+        return _safe_names(data[key])
+    return []
+
+
+def write_manifest(folder: str | os.PathLike, files: Iterable[str], *, pending: bool = False) -> Path:
+    """Write ``.ght-cad-manifest.json`` (``{"tool", "files", "pending"}``) into ``folder`` atomically."""
+    from .io import write_text_atomic
+
+    body = {"tool": "ght-cad", "files": sorted(set(_safe_names(files))), "pending": bool(pending)}
+    return write_text_atomic(Path(folder) / MANIFEST_NAME, json.dumps(body, indent=1) + "\n")
+
+
+def _remove_part_leftovers(folder: Path) -> None:
+    """Remove half-written manifests (``..ght-cad-manifest.*.json.part``, named by
+    :func:`ght_cad.io.atomic_path`) a killed run left in ``folder``."""
+    stem = Path(MANIFEST_NAME).stem
+    try:
+        for p in folder.glob(f".{stem}.*.part"):
+            if p.is_file():
+                p.unlink()
+    except OSError:
+        pass
+
+
+# ---------------------------------------------------------------------------------------------
+# the two writers' front ends
+# ---------------------------------------------------------------------------------------------
+class OutputFolder:
+    """An output folder written by one run: locked, staged, committed with a manifest.
+
+    ``with OutputFolder(out) as f:`` takes the folder's lock (:class:`TargetLock`; ``wait``,
+    ``timeout``), removes dead runs' staging folders beside it (:func:`sweep_dead`) and creates
+    this run's staging folder; write each result to ``f.path(name)`` and call :meth:`commit`.
+    Leaving the block without a commit (an exception, Ctrl-C) removes the staging folder and the
+    parent folders made for it; the output folder is then exactly as it was.
+
+    Args:
+        out_dir: the output folder (new, or an existing folder).
+        wait, timeout: see :class:`TargetLock`.
+        on_wait: called once if the run has to wait (e.g. to print "waiting for pid N").
+
+    Raises:
+        FolderBusy: another live process writes ``out_dir`` (and not ``wait``, or the timeout passed).
+        GHTError: ``out_dir`` is a file, or its parent cannot be created.
+    """
+
+    def __init__(self, out_dir: str | os.PathLike, *, wait: bool = False, timeout: float | None = None,
+                 on_wait: Callable[[FolderBusy], None] | None = None) -> None:
+        self.out = Path(out_dir)
+        self.wait = wait
+        self.timeout = timeout
+        self.on_wait = on_wait
+        self.lock: TargetLock | None = None
+        self.stage: StagingDir | None = None
+        self.made_parents: list[Path] = []
+        self.committed: list[str] | None = None
+
+    def open(self) -> "OutputFolder":
+        """Lock, sweep and stage (what ``__enter__`` does)."""
+        out = self.out
+        if out.exists() and not out.is_dir():
+            raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
+        parent = out.absolute().parent
+        self.made_parents = [d for d in (parent, *parent.parents) if not d.exists()][::-1]
+        try:
+            self.lock = TargetLock(out, wait=self.wait, timeout=self.timeout, what="output folder",
+                                   hint="run again with --wait (waits until it has finished), or choose another --out",
+                                   on_wait=self.on_wait).acquire()
+            sweep_dead(parent)
+            if out.is_dir():
+                _remove_part_leftovers(out)
+            try:
+                self.stage = StagingDir(parent, out.name)
+            except OSError as exc:
+                raise GHTError(
+                    f"cannot create the output folder {out}: {exc.strerror or exc}"
+                    f"{f' ({exc.filename})' if exc.filename else ''}; allowed: a folder or a new path "
+                    "whose parent folders can be created") from None
+        except BaseException:
+            self.close(failed=True)
+            raise
+        return self
+
+    def path(self, name: str) -> Path:
+        """Where to write the result file ``name`` (inside the staging folder)."""
+        if self.stage is None:
+            raise RuntimeError("OutputFolder is not open")
+        return self.stage.path / name
+
+    def files(self) -> list[str]:
+        """Names of the files written into the staging folder so far."""
+        return self.stage.files() if self.stage is not None else []
+
+    def commit(self) -> list[str]:
+        """Move the staged files into the output folder; returns their names (sorted).
+
+        A new folder appears by one rename. Into an existing folder: the manifest is first
+        rewritten as old ∪ new (pending), every new file replaces its target (``os.replace``),
+        the files of the previous manifest not written again are removed, and the manifest is
+        rewritten as the new names. Files not in the previous manifest (a person's) are kept.
+
+        Raises:
+            GHTError: a staged name is a folder in the output folder (checked before any move).
+        """
+        if self.stage is None:
+            raise RuntimeError("OutputFolder is not open")
+        out = self.out
+        names = self.stage.files()
+        if not out.exists():
+            write_manifest(self.stage.path, names)
+            self.stage.drop_lock_file()
+            try:
+                os.replace(self.stage.path, out)  # one atomic rename: the folder appears complete
+                self.stage.release()
+                self.stage = None
+                self.made_parents = []
+                self.committed = names
+                return names
+            except OSError:
+                if not out.is_dir():
+                    raise
+                # a folder appeared meanwhile (made by hand): fall through to the file moves
+                os.unlink(self.stage.path / MANIFEST_NAME)
+        if not out.is_dir():
+            raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
+        for n in names:  # checked before the first move: a failure must not leave a mixed folder
+            if (out / n).is_dir():
+                raise GHTError(f"cannot write {out / n}: it is a folder; allowed: a file path "
+                               "(remove or rename the folder)")
+        previous = read_manifest(out)
+        write_manifest(out, set(previous) | set(names), pending=True)
+        for n in names:
+            os.replace(self.stage.path / n, out / n)
+        for n in sorted(set(previous) - set(names)):
+            p = out / n
+            try:
+                if p.is_file() or p.is_symlink():
+                    p.unlink()
+            except OSError:
+                pass
+        write_manifest(out, names)
+        self.stage.remove()
+        self.stage = None
+        self.made_parents = []
+        self.committed = names
+        return names
+
+    def close(self, failed: bool = False) -> None:
+        """Remove the staging folder (and, after a failure, the parents made for it); unlock."""
+        if self.stage is not None:
+            self.stage.remove()
+            self.stage = None
+        if self.lock is not None:
+            self.lock.release()
+            self.lock = None
+        if failed or self.committed is None:
+            for d in reversed(self.made_parents):
+                try:
+                    d.rmdir()  # only if still empty
+                except OSError:
+                    pass
+            self.made_parents = []
+
+    def __enter__(self) -> "OutputFolder":
+        return self.open()
+
+    def __exit__(self, exc_type: Any, *exc: Any) -> None:
+        self.close(failed=exc_type is not None)
+
+
+class StagedFiles:
+    """Several single output files written all or nothing (``curve``/``surface``/``unroll``/``export``).
+
+    One :class:`StagingDir` per target folder (pid + lock, swept by later runs if this process
+    dies); :meth:`commit` moves every staged file onto its target only when each writer produced
+    one. Leaving the block without commit removes the staging folders and the folders made for
+    missing parents; every existing target is then as it was.
+
+    Args:
+        targets: the files to write.
+        lock: take a :class:`TargetLock` on every target first, so that two processes writing the
+            same file never leave one's set mixed with the other's.
+        wait, timeout: see :class:`TargetLock`.
+
+    Raises:
+        FolderBusy: (with ``lock``) another live process writes one of the targets.
+        GHTError: a target is a folder, or a target folder cannot be created or written.
+    """
+
+    def __init__(self, targets: Sequence[str | os.PathLike], *, lock: bool = True, wait: bool = False,
+                 timeout: float | None = None) -> None:
+        self.dirs: dict[Path, StagingDir] = {}
+        self.made: list[Path] = []
+        self.map: dict[Path, Path] = {}
+        self.locks: list[TargetLock] = []
+        try:
+            paths = [Path(t) for t in targets]
+            for t in paths:
+                if t.exists() and t.is_dir():
+                    raise GHTError(f"cannot write {t}: it is a folder; allowed: a file path")
+            if lock:
+                for t in sorted({p.absolute() for p in paths}):
+                    self._mkdirs(t.parent, t)
+                    self.locks.append(TargetLock(t, wait=wait, timeout=timeout, what="file",
+                                                 hint="try again when the other process has finished").acquire())
+            for t in paths:
+                parent = t.parent.absolute()
+                if t.exists() and t.is_dir():
+                    raise GHTError(f"cannot write {t}: it is a folder; allowed: a file path")
+                if parent not in self.dirs:
+                    self._mkdirs(parent, t)
+                    sweep_dead(parent)
+                    try:
+                        self.dirs[parent] = StagingDir(parent, "ght-cad-export")
+                    except OSError as exc:
+                        raise GHTError(
+                            f"cannot write {t}: folder {parent} is not writable ({exc.strerror or exc})"
+                        ) from None
+                # a numbered name keeps repeated or equal base names apart; the suffix is kept for writers
+                self.map[t] = self.dirs[parent].path / f"{len(self.map)}{t.suffix}"
+        except BaseException:
+            self.cleanup()
+            raise
+
+    def _mkdirs(self, parent: Path, target: Path) -> None:
+        missing = []
+        p = parent
+        while not p.exists() and p != p.parent:
+            missing.append(p)
+            p = p.parent
+        for d in reversed(missing):
+            try:
+                d.mkdir()
+            except OSError as exc:
+                raise GHTError(f"cannot write {target}: cannot create folder {d} ({exc.strerror or exc})") from None
+            self.made.append(d)
+
+    def path(self, target: str | os.PathLike) -> Path:
+        """The staging path for ``target``."""
+        return self.map[Path(target)]
+
+    def commit(self) -> None:
+        """Move every staged file onto its target (same file system: ``os.replace`` each)."""
+        for t, tmp in self.map.items():
+            if not tmp.is_file():
+                raise GHTError(f"writing {t} produced no file")
+        for t, tmp in self.map.items():
+            os.replace(tmp, t)
+        self.made = []  # the folders now hold results
+
+    def cleanup(self) -> None:
+        """Remove the staging folders (and the folders made for missing parents, if uncommitted)."""
+        for d in self.dirs.values():
+            d.remove()
+        self.dirs = {}
+        for lk in self.locks:
+            lk.release()
+        self.locks = []
+        for d in reversed(self.made):
+            try:
+                d.rmdir()
+            except OSError:
+                pass
+        self.made = []
+
+    def __enter__(self) -> "StagedFiles":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.cleanup()
