@@ -5,34 +5,172 @@
 The workbench must be installed in the user's Mod folder (the pytest side links it there). Once
 the event loop runs, the script activates the workbench, checks every command is registered, runs
 each one on a prepared document (selection set as a user would), exercises a task panel's live
-preview, exports STEP/DXF/SVG, saves a screenshot and writes ``gui_result.json``, then exits.
+preview, opens every feature's task panel by the double-click path (``ViewProvider.doubleClicked``
+-> ``setEdit``), also of features whose links are unset, exports STEP/DXF/SVG, saves a screenshot
+and writes ``gui_result.json``, then exits.
+
+Errors are watched during the whole scripted session, not only the steps' return values:
+
+* FreeCAD's **Report view** widget is read back after every step: every line its highlighter
+  paints in the error colour (``Console.PrintError``, Python's stderr, the tracebacks FreeCAD
+  prints when a Python callback such as ``setEdit`` raises) and every line that starts a Python
+  traceback is collected;
+* ``sys.excepthook`` (exceptions raised in Qt slots: a slider or button callback) and
+  ``sys.stderr`` are hooked;
+* the **Python console** widget is read for tracebacks.
+
+A step may declare the error lines it provokes on purpose (``allow=`` regular expressions, e.g.
+the recompute error of a feature given a negative tolerance); every other line lands in
+``RESULT["unexpected_errors"]``, and the pytest side fails on any.
 """
 
 import json
 import os
+import re
+import sys
 import traceback
 
 import FreeCAD as App
 import FreeCADGui as Gui
 
 try:
-    from PySide2 import QtCore
+    from PySide2 import QtCore, QtWidgets
 except ImportError:  # pragma: no cover
     from PySide import QtCore  # type: ignore
+    from PySide import QtGui as QtWidgets  # type: ignore
 
 OUT = os.environ.get("GHT_FC_OUT", "/tmp")
-RESULT = {"steps": [], "errors": []}
+RESULT = {"steps": [], "errors": [], "unexpected_errors": [], "report_errors": []}
+TRACEBACK_RE = re.compile(r"Traceback \(most recent call last\)|^\s*File \".*\", line \d+|\b\w*(Error|Exception)\b: ")
 
 
-def step(name, fn):
+class ErrorWatch:
+    """Collects error lines from the Report view, sys.excepthook, sys.stderr and the Python console."""
+
+    def __init__(self):
+        mw = Gui.getMainWindow()
+        self.report = mw.findChild(QtWidgets.QTextEdit, "Report view")
+        self.console = mw.findChild(QtWidgets.QPlainTextEdit, "Python console")
+        if self.report is None:
+            raise RuntimeError("FreeCAD's Report view widget was not found: the check cannot see errors")
+        packed = App.ParamGet("User parameter:BaseApp/Preferences/OutputWindow").GetUnsigned("colorError", 0xFF000000)
+        self.error_colour = "#{:02x}{:02x}{:02x}".format((packed >> 24) & 255, (packed >> 16) & 255, (packed >> 8) & 255)
+        self.hooked = []  # (source, text)
+        self._excepthook = sys.excepthook
+        sys.excepthook = self._hook
+        self._stderr = sys.stderr
+        sys.stderr = _Tee(self._stderr, self.hooked)
+        self.start = self.mark()
+
+    def _hook(self, etype, value, tb):
+        self.hooked.append(("excepthook", "".join(traceback.format_exception(etype, value, tb))))
+        self._excepthook(etype, value, tb)
+
+    def mark(self):
+        QtWidgets.QApplication.processEvents()
+        return (self.report.document().blockCount() - 1, self.console.document().blockCount() - 1 if self.console else 0,
+                len(self.hooked))
+
+    def _blocks(self, doc, first):
+        b = doc.findBlockByNumber(max(first, 0))
+        while b.isValid():
+            yield b
+            b = b.next()
+
+    def since(self, mark):
+        """Error lines that appeared after ``mark`` (a :meth:`mark` value), in order."""
+        QtWidgets.QApplication.processEvents()
+        lines = []
+        for b in self._blocks(self.report.document(), mark[0]):
+            text = b.text()
+            if not text.strip():
+                continue
+            colours = {r.format.foreground().color().name() for r in b.layout().formats()}
+            if self.error_colour in colours or TRACEBACK_RE.search(text):
+                lines.append("report view: " + text)
+        if self.console is not None:
+            for b in self._blocks(self.console.document(), mark[1]):
+                if TRACEBACK_RE.search(b.text()):
+                    lines.append("python console: " + b.text())
+        for source, text in self.hooked[mark[2]:]:
+            lines.extend(f"{source}: {l}" for l in text.splitlines() if l.strip())
+        return lines
+
+    def report_text(self):
+        return self.report.toPlainText()
+
+
+class _Tee:
+    """sys.stderr replacement that also records what is written (FreeCAD's stream stays in use)."""
+
+    def __init__(self, stream, sink):
+        self.stream, self.sink = stream, sink
+
+    def write(self, text):
+        if text.strip():
+            self.sink.append(("stderr", text))
+        return self.stream.write(text)
+
+    def flush(self):
+        return self.stream.flush()
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
+WATCH = None
+
+
+def _entries(lines):
+    """Group error lines into entries: a Python traceback (from its "Traceback" line through the
+    indented frame lines to the exception line) is one entry, with that last line as its message;
+    every other line is an entry of its own. Returns ``[(message, [lines])]``."""
+    out, block = [], None
+    for line in lines:
+        body = line.split(": ", 1)[1] if ": " in line else line
+        body = re.sub(r"^\d\d:\d\d:\d\d\s+", "", body)  # the Report view's time stamp
+        if "Traceback (most recent call last)" in body:
+            block = [line]
+            continue
+        if block is not None:
+            block.append(line)
+            if body[:1].isspace():
+                continue
+            out.append((body, block))
+            block = None
+            continue
+        out.append((body, [line]))
+    if block is not None:
+        out.append((block[-1], block))
+    return out
+
+
+def step(name, fn, allow=()):
+    """Run one step; record its value, its error lines, and those not matched by ``allow``.
+
+    ``allow`` holds regular expressions of error messages the step provokes on purpose; a
+    traceback is allowed only if its exception line matches one (the frames above it are
+    FreeCAD's report of a failed recompute), and FreeCAD's "Recompute failed!" line only in a
+    step with an allowed error.
+    """
+    mark = WATCH.mark()
     try:
         value = fn()
-        RESULT["steps"].append({"name": name, "ok": True, "value": value})
+        entry = {"name": name, "ok": True, "value": value}
     except Exception:
-        RESULT["steps"].append({"name": name, "ok": False, "error": traceback.format_exc()})
+        entry = {"name": name, "ok": False, "error": traceback.format_exc()}
     finally:
         if Gui.Control.activeDialog():
             Gui.Control.closeDialog()
+    lines = WATCH.since(mark)
+    entry["report_errors"] = lines
+    patterns = list(allow) + ([r"^Recompute failed! Please check report view\.$"] if allow else [])
+    unexpected = [l for msg, block in _entries(lines) if not any(re.search(a, msg) for a in patterns) for l in block]
+    entry["unexpected_errors"] = unexpected
+    RESULT["unexpected_errors"].extend(f"{name}: {l}" for l in unexpected)
+    RESULT["report_errors"].extend(f"{name}: {l}" for l in lines)
+    RESULT["steps"].append(entry)
+    return entry
 
 
 def new_objects(doc, before):
@@ -52,6 +190,8 @@ def run_command(doc, name, select=()):
 
 
 def main():
+    global WATCH
+    WATCH = ErrorWatch()
     from freecad.ght_workbench import _base
 
     RESULT["workbenches"] = "GHTWorkbench" in Gui.listWorkbenches()
@@ -94,7 +234,7 @@ def main():
         comp = [o for o in created if o.Proxy.Type == "GHT::CompositeCurve"][0]
         return {"created": len(created), "valid": ok, "joints": list(comp.JointOrders)}
 
-    step("GHT_Curve", curve)
+    step("GHT_Curve", curve, allow=[r"Tolerance=-1\.0 is not allowed"])
 
     def curve_from_vertices():
         import Part
@@ -230,25 +370,83 @@ def main():
                 return {"exists": os.path.getsize(cls.target) > 0}
             step(name, exp_flat)
 
-    def panel_without_input():
-        # double-click on a spine whose Curve link is empty: no crash, no dialog, a message instead
-        from freecad.ght_workbench import spine_developable
+    def open_by_double_click(obj, shot=None):
+        """What a double-click in the tree does: ViewProvider.doubleClicked -> setEdit -> a panel
+        (with ``shot``: the main window with the panel open is saved there)."""
+        _base.ViewProviderBase.last_panel = None
+        vobj = obj.ViewObject
+        handled = vobj.Proxy.doubleClicked(vobj)
+        QtWidgets.QApplication.processEvents()
+        panel = _base.ViewProviderBase.last_panel
+        info = {"handled": bool(handled), "dialog": bool(Gui.Control.activeDialog()),
+                "panel": type(panel).__name__ if panel is not None else None,
+                "title": panel.form.windowTitle() if panel is not None else None,
+                "message": getattr(panel, "message", None)}
+        if shot:
+            mw = Gui.getMainWindow()
+            mw.resize(1280, 860)
+            QtWidgets.QApplication.processEvents()
+            info["shot"] = shot if mw.grab().save(shot) else None
+        if panel is not None and Gui.Control.activeDialog():
+            panel.reject()  # Cancel: the values the feature had
+        if Gui.Control.activeDialog():
+            Gui.Control.closeDialog()
+        Gui.ActiveDocument.resetEdit()
+        QtWidgets.QApplication.processEvents()
+        return info
 
-        orphan = spine_developable.make_spine_developable(ctx["curve"], doc=doc, name="Orphan")
-        orphan.Curve = None
+    def double_click_every_feature():
+        feats = [o for o in doc.Objects if hasattr(getattr(o, "Proxy", None), "Type") and o.ViewObject is not None]
+        return {o.Proxy.Type: open_by_double_click(o) for o in feats}
+
+    step("double-click every feature", double_click_every_feature)
+
+    # features whose links are unset (the linked object was never set, or removed): their
+    # recompute fails with a clear message, and a double-click shows that message in a panel
+    UNSET = {  # the recompute error each feature reports once its link is unset
+        "GHT::SpineDevelopable": "OrphanSpine: no Curve linked",
+        "GHT::CompositeCurve": "a composite curve needs >= 2 segments; OrphanComposite has 0",
+        "GHT::JoinedDevelopable": "Previous is not set; link a developable",
+        "GHT::FlatPattern": "OrphanFlat: no Source linked",
+    }
+
+    def make_orphans():
+        from freecad.ght_workbench import composite_curve, developable, flat_pattern, ght_curve, joined_developable, optimization, spine_developable
+
+        c1 = ght_curve.make_ght_curve([(0, 60, 0), (10, 70, 5), (20, 70, 5), (30, 60, 0)], doc=doc, name="OrphanInput1")
+        c2 = ght_curve.make_ght_curve([(30, 60, 0), (40, 50, 0), (50, 55, 0), (60, 60, 0)], doc=doc, name="OrphanInput2")
+        orphans = [
+            spine_developable.make_spine_developable(c1, doc=doc, name="OrphanSpine"),
+            composite_curve.make_composite_curve([c1, c2], "G1", doc=doc, name="OrphanComposite"),
+            joined_developable.make_joined_developable(ctx["developable"], "G2", doc=doc, name="OrphanJoined"),
+            flat_pattern.make_flat_pattern(ctx["developable"], doc=doc, name="OrphanFlat"),
+            optimization.make_optimization([c1], doc=doc, name="OrphanOptimization"),
+        ]
+        ok_before = {o.Proxy.Type: not ("Invalid" in o.State or "Error" in o.State) for o in orphans}
+        for o in orphans:
+            for prop, empty in (("Curve", None), ("Segments", []), ("Previous", None), ("Source", None), ("Targets", [])):
+                if prop in o.PropertiesList:
+                    setattr(o, prop, empty)
         doc.recompute()
-        try:
-            opened = Gui.ActiveDocument.setEdit(orphan.Name, 0)
-            dialog = bool(Gui.Control.activeDialog())
-        finally:
-            if Gui.Control.activeDialog():
-                Gui.Control.closeDialog()
-            Gui.ActiveDocument.resetEdit()
-            doc.removeObject(orphan.Name)
-            doc.recompute()
-        return {"opened": bool(opened), "dialog": dialog}
+        ctx["orphans"] = orphans
+        return {"valid_before": ok_before,
+                "states": {o.Proxy.Type: list(o.State) for o in orphans},
+                "status": {o.Proxy.Type: o.getStatusString() for o in orphans}}
 
-    step("panel without input", panel_without_input)
+    step("features with unset links: recompute", make_orphans, allow=[re.escape(m) for m in UNSET.values()])
+
+    def double_click_orphans():
+        shots = {"GHT::SpineDevelopable": os.path.join(OUT, "ght_workbench_unset_link.png")}
+        out = {o.Proxy.Type: open_by_double_click(o, shots.get(o.Proxy.Type)) for o in ctx["orphans"]}
+        for o in ctx["orphans"]:
+            doc.removeObject(o.Name)
+        for n in ("OrphanInput2", "OrphanInput1"):
+            doc.removeObject(n)
+        doc.recompute()
+        return out
+
+    # the panels' Cancel recomputes the document: the orphans' recompute errors come again
+    step("features with unset links: double-click", double_click_orphans, allow=[re.escape(m) for m in UNSET.values()])
 
     def screenshot():
         Gui.Selection.clearSelection()
@@ -292,6 +490,17 @@ def main():
 def finish():
     try:
         main()
+    except Exception:
+        RESULT["errors"].append(traceback.format_exc())
+    try:
+        # error lines outside every step (workbench activation, between steps)
+        in_steps = [l for s in RESULT["steps"] for l in s.get("report_errors", [])]
+        for line in WATCH.since(WATCH.start):
+            if line in in_steps:
+                in_steps.remove(line)
+            else:
+                RESULT["unexpected_errors"].append("outside the steps: " + line)
+        RESULT["report_view"] = WATCH.report_text()
     except Exception:
         RESULT["errors"].append(traceback.format_exc())
     with open(os.path.join(OUT, "gui_result.json"), "w") as fh:
