@@ -20,6 +20,10 @@ __all__ = [
     "FeatureProxy",
     "ViewProviderBase",
     "ShapeParameterPanel",
+    "MessagePanel",
+    "MissingInput",
+    "require_links",
+    "info_panel",
     "BaseCommand",
     "add_shape_parameters",
     "check_shape",
@@ -159,11 +163,60 @@ class FeatureProxy:
         return self.__setstate__(state)
 
 
+class MissingInput(Exception):
+    """A task panel cannot edit its feature: a link it needs is unset (the message says which)."""
+
+
+def _link_empty(value: Any) -> bool:
+    """True for an unset link value: None, [], a LinkSub ``(None, ...)`` or a list of such."""
+    if value is None:
+        return True
+    if isinstance(value, (list, tuple)):
+        if not value:
+            return True
+        if isinstance(value, tuple) and len(value) == 2 and not isinstance(value[0], tuple):
+            return value[0] is None  # LinkSub (object, sub-names)
+        return all(_link_empty(v) if isinstance(v, tuple) else v is None for v in value)
+    return False
+
+
+def require_links(obj: Any, *names: str) -> None:
+    """Raise :class:`MissingInput` naming the first of the link properties ``names`` that is unset.
+
+    The message says where to set it: ``"<Label>: Curve is not linked; set it in the property
+    editor (Input → Curve: <the property's tooltip>), then double-click again"``.
+    """
+    for n in names:
+        if _link_empty(getattr(obj, n, None)):
+            group = obj.getGroupOfProperty(n) if n in obj.PropertiesList else "Data"
+            tip = obj.getDocumentationOfProperty(n) if n in obj.PropertiesList else ""
+            raise MissingInput(f"{obj.Label}: {n} is not linked; set it in the property editor ({group} → {n}"
+                               + (f": {tip}" if tip else "") + "), then double-click again")
+
+
+def info_panel(obj: Any, links: Sequence[str], hint: str) -> "MessagePanel":
+    """Panel of a feature without shape parameters of its own: its state and what to edit where.
+
+    Raises:
+        MissingInput: one of ``links`` is unset (see :func:`require_links`).
+    """
+    require_links(obj, *links)
+    bad = "Invalid" in obj.State or "Error" in obj.State
+    state = f"last recompute failed: {obj.getStatusString()}" if bad else "up to date" if "Touched" not in obj.State else "not yet recomputed"
+    return MessagePanel(obj, f"{obj.Label}: {state}.\n{hint}")
+
+
 class ViewProviderBase:
-    """View provider: icon, double-click opens the feature's task panel."""
+    """View provider: icon, double-click opens the feature's task panel.
+
+    ``panel_factory(obj)`` builds the panel; one that raises :class:`MissingInput` (an unset link)
+    gets a :class:`MessagePanel` with that message instead, never a traceback.
+    """
 
     icon_name = "GHT_Workbench"
     panel_factory: Callable[[Any], Any] | None = None
+    #: the panel the most recent setEdit opened (for macros and the GUI check)
+    last_panel: Any = None
     #: default colours (r, g, b in 0..1) and line width of new objects
     shape_color: tuple | None = None
     line_color: tuple | None = None
@@ -194,7 +247,12 @@ class ViewProviderBase:
             return False
         import FreeCADGui as Gui
 
-        Gui.Control.showDialog(type(self).panel_factory(vobj.Object))
+        try:
+            panel = type(self).panel_factory(vobj.Object)
+        except MissingInput as exc:
+            panel = MessagePanel(vobj.Object, str(exc))
+        ViewProviderBase.last_panel = panel
+        Gui.Control.showDialog(panel)
         return True
 
     def unsetEdit(self, vobj: Any, mode: int = 0) -> bool:
@@ -242,9 +300,14 @@ class ShapeParameterPanel:
 
     def __init__(self, obj: Any, names: Sequence[str] | None = None, title: str = "Shape parameters") -> None:
         QtCore, QtWidgets = _qt()
+        if obj is None:
+            raise MissingInput(f"{title}: no feature to edit; link one in the property editor")
+        names = list(names) if names is not None else [n for n, _ in SHAPE_PARAMETERS if n in obj.PropertiesList]
+        if not names:
+            raise MissingInput(f"{obj.Label} has no shape parameters (Mu, Nu, Gamma) to edit; link a GHT feature")
         ShapeParameterPanel.last = self
         self.obj = obj
-        self.names = list(names) if names is not None else [n for n, _ in SHAPE_PARAMETERS if n in obj.PropertiesList]
+        self.names = names
         self.saved = {n: float(getattr(obj, n)) for n in self.names}
         self.form = QtWidgets.QWidget()
         self.form.setWindowTitle(f"{obj.Label}: {title}")
@@ -270,7 +333,14 @@ class ShapeParameterPanel:
             self.spins[n] = spin
             self.sliders[n] = slider
         self.status = QtWidgets.QLabel("")
+        self.status.setWordWrap(True)
         layout.addRow(self.status)
+        self.status.setText(self.errors())  # a feature that fails already (e.g. an unset link) says why
+
+    @property
+    def message(self) -> str:
+        """The status line (recompute errors of the feature and its dependants; "" if none)."""
+        return self.status.text()
 
     def _changed(self, name: str, value: float, source: str) -> None:
         if source == "slider":
@@ -325,6 +395,44 @@ class ShapeParameterPanel:
     def getStandardButtons(self) -> int:
         _, QtWidgets = _qt()
         return int(QtWidgets.QDialogButtonBox.Ok | QtWidgets.QDialogButtonBox.Cancel)
+
+
+class MessagePanel:
+    """Task panel that only shows a message (a feature with an unset link, or without parameters).
+
+    Attributes:
+        message: the text shown.
+    """
+
+    def __init__(self, obj: Any, message: str, title: str | None = None) -> None:
+        QtCore, QtWidgets = _qt()
+        self.obj = obj
+        self.message = message
+        self.form = QtWidgets.QWidget()
+        self.form.setWindowTitle(title or f"{obj.Label}")
+        layout = QtWidgets.QVBoxLayout(self.form)
+        self.label = QtWidgets.QLabel(message)
+        self.label.setWordWrap(True)
+        self.label.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+        layout.addWidget(self.label)
+
+    def _close(self) -> bool:
+        import FreeCADGui as Gui
+
+        Gui.Control.closeDialog()
+        if Gui.ActiveDocument is not None:
+            Gui.ActiveDocument.resetEdit()
+        return True
+
+    def accept(self) -> bool:
+        return self._close()
+
+    def reject(self) -> bool:
+        return self._close()
+
+    def getStandardButtons(self) -> int:
+        _, QtWidgets = _qt()
+        return int(QtWidgets.QDialogButtonBox.Close)
 
 
 def new_feature(

@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import FreeCAD as App
 import Part
 
-from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, set_read_only, tolerance_property
+from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only, tolerance_property
 from .convert import DEFAULT_TOL, curve_data, edge_from_data
 from .ght_curve import core_curve
 
@@ -93,6 +93,7 @@ class ViewProviderCompositeCurve(ViewProviderBase):
 
 def _panel(obj: Any) -> ShapeParameterPanel:
     """Live preview of the last segment's shape parameters (the joint re-solves as they change)."""
+    require_links(obj, "Segments")
     return ShapeParameterPanel(obj.Segments[-1], title="last segment of " + obj.Label)
 
 

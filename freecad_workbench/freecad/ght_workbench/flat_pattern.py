@@ -35,7 +35,7 @@ import Part
 
 from ght_cad.face_unroll import EdgeData, FaceData, SurfaceAdapter, chain_loop, fd_derivative, unroll_face_data
 
-from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only
+from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 from .convert import edge_from_data
 
 __all__ = [
@@ -429,6 +429,8 @@ class ViewProviderFlatPattern(ViewProviderBase):
     icon_name = "GHT_FlatPattern"
     shape_color = (0.91, 0.85, 0.66)
     line_color = (0.7, 0.1, 0.1)
+    panel_factory = staticmethod(lambda obj: info_panel(obj, ("Source",), "Edit Source and BendLines in the property "
+                                                       "editor; export with Export flat pattern DXF / SVG."))
 
 
 def make_flat_pattern(

@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 import FreeCAD as App
 
-from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only
+from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 
 __all__ = ["OptimizationFeature", "make_optimization", "run_optimization", "PROBLEMS", "METHODS"]
 
@@ -157,6 +157,8 @@ class OptimizationFeature(FeatureProxy):
 
 class ViewProviderOptimization(ViewProviderBase):
     icon_name = "GHT_Optimization"
+    panel_factory = staticmethod(lambda obj: info_panel(obj, ("Targets",), "Edit Problem, Method and Targets in the "
+                                                       "property editor; run it with Run optimization."))
 
     def claimChildren(self) -> list:
         return []

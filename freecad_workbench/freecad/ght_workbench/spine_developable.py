@@ -16,7 +16,7 @@ import numpy as np
 
 import FreeCAD as App
 
-from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, set_read_only
+from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only
 from .developable import SurfaceOutputs
 from .ght_curve import core_curve
 
@@ -70,7 +70,13 @@ class ViewProviderSpineDevelopable(ViewProviderBase):
         return [c] if c is not None else []
 
 
-ViewProviderSpineDevelopable.panel_factory = staticmethod(lambda obj: ShapeParameterPanel(obj.Curve, title="curve of " + obj.Label))
+def _panel(obj: Any) -> ShapeParameterPanel:
+    """Live preview of the linked curve's shape parameters (an unset Curve: a message instead)."""
+    require_links(obj, "Curve")
+    return ShapeParameterPanel(obj.Curve, title="curve of " + obj.Label)
+
+
+ViewProviderSpineDevelopable.panel_factory = staticmethod(_panel)
 
 
 def make_spine_developable(curve_obj: Any, kind: str = "Spine", v0: float = 2.0, v1: float = 10.0, *, doc: Any = None, name: str = "SpineDevelopable") -> Any:
