@@ -14,7 +14,7 @@ from typing import Any, Iterable
 import numpy as np
 
 from ._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
-from .basis import _check_order, bernstein, seed_basis
+from .basis import MAX_DIRECT_DEGREE, _check_order, bernstein, bernstein_log, seed_basis
 from .errors import GHTError
 from .seeds import Seed, make_seed
 
@@ -60,14 +60,32 @@ def integrate(
         panels *= 2
 
 
+def curvature_from_derivatives(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    r"""Curvature ``κ = |X'' - (X'·X''/|X'|²) X'| / |X'|²`` (``= |X' × X''| / |X'|³``) from the
+    first and second derivatives (arrays (..., dim)); inf/NaN where ``X' = 0``.
+
+    The normal part of ``X''`` keeps a straight line's curvature at round-off level (~1e-16
+    ``|X''|/|X'|²``); the Gram form ``sqrt(|X'|²|X''|² - (X'·X'')²)`` loses half the digits there.
+    """
+    d1 = np.asarray(d1, dtype=float)
+    d2 = np.asarray(d2, dtype=float)
+    a = np.sum(d1 * d1, axis=-1)
+    c = np.sum(d1 * d2, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        normal = d2 - (c / a)[..., None] * d1
+        return np.linalg.norm(normal, axis=-1) / a
+
+
 class GHTCurve:
     r"""A GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i``, t ∈ [0, 1].
 
     Args:
         control_points: array-like of shape (degree+1, dim), degree >= 2, any dim >= 1.
-        mu, nu, gamma: shape parameters in [-1, 1] (γ = 1: classical Bézier, γ = -1: GBT).
+        mu, nu, gamma: shape parameters in [-1, 1] (γ = 1: classical Bézier, γ = -1: GBT); None
+            (the default) is the seed family's default (0 for GHT).
         seed: seed family name or a :class:`~ght_cad.seeds.Seed` instance (then mu, nu, gamma
-            come from the seed).
+            come from the seed). A parameter the seed does not use (``gamma`` with ``"gbt"``,
+            ``mu`` with ``"bernstein"``) is refused, not ignored (:func:`~ght_cad.seeds.make_seed`).
 
     Raises:
         GHTError: fewer than 3 control points, wrong array shape, NaN/inf coordinates, or a
@@ -82,9 +100,9 @@ class GHTCurve:
     def __init__(
         self,
         control_points: Any,
-        mu: float = 0.0,
-        nu: float = 0.0,
-        gamma: float = 0.0,
+        mu: float | None = None,
+        nu: float | None = None,
+        gamma: float | None = None,
         *,
         seed: str | Seed = "ght",
     ) -> None:
@@ -168,6 +186,8 @@ class GHTCurve:
     def _compact_weights(self) -> np.ndarray:
         """Stacked, binomial-scaled control points of the compact form (3(n+1), dim)."""
         n = self.degree - 2
+        if n > MAX_DIRECT_DEGREE:  # the log-space Bernstein values carry C(n, j) themselves
+            return np.vstack([self._points[k : k + n + 1] for k in range(3)])
         binom = np.array([comb(n, j) for j in range(n + 1)], dtype=float)[:, None]
         return np.vstack([self._points[k : k + n + 1] * binom for k in range(3)])
 
@@ -191,9 +211,12 @@ class GHTCurve:
             if k < K:
                 T, U, F = T[:k], U[:k], F[:k]
             f = self._seed.jet(tt, 0)
-            T[:, 0] = 1.0
-            U[:, n] = 1.0
-            if n:
+            if n > MAX_DIRECT_DEGREE:
+                T[...] = bernstein_log(tt, n)
+            else:
+                T[:, 0] = 1.0
+                U[:, n] = 1.0
+            if n and n <= MAX_DIRECT_DEGREE:
                 u = 1.0 - tt
                 for j in range(1, n + 1):
                     np.multiply(T[:, j - 1], tt, out=T[:, j])
@@ -230,15 +253,15 @@ class GHTCurve:
         return np.linalg.norm(self.derivative(t, 1), axis=-1)
 
     def curvature(self, t: Any) -> np.ndarray:
-        r"""Curvature ``κ = |P' × P''| / |P'|^3`` (any dimension, via the Gram determinant)."""
-        d1 = self.derivative(t, 1)
-        d2 = self.derivative(t, 2)
-        a = np.sum(d1 * d1, axis=-1)
-        b = np.sum(d2 * d2, axis=-1)
-        c = np.sum(d1 * d2, axis=-1)
-        cross = np.sqrt(np.maximum(a * b - c * c, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return cross / a**1.5
+        r"""Curvature ``κ = |P' × P''| / |P'|^3`` in any dimension.
+
+        Computed as ``κ = |P'' - (P'·P''/|P'|²) P'| / |P'|²`` (the part of ``P''`` normal to the
+        tangent; equal to the formula above because ``|P' × P''| = |P'| · |P''_⊥|``). Unlike the
+        Gram determinant ``sqrt(|P'|²|P''|² - (P'·P'')²)``, whose cancellation leaves about
+        ``sqrt(1e-16)`` = 1e-8 of ``|P''|/|P'|²`` on a straight line, this is at round-off level
+        (``~1e-16 |P''|/|P'|²``): a straight line's curvature is 0 up to 1e-16.
+        """
+        return curvature_from_derivatives(self.derivative(t, 1), self.derivative(t, 2))
 
     def signed_curvature(self, t: Any) -> np.ndarray:
         """Signed curvature ``(x'y'' - y'x'') / |P'|^3`` of a planar (2-D) curve."""

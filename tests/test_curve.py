@@ -161,3 +161,64 @@ def test_with_shape_keeps_geometry_across_families() -> None:
     np.testing.assert_allclose(bern.evaluate(T), GHTCurve(pts, 0, 0, 0).evaluate(T), atol=1e-15)
     rev = GHTCurve(pts, 0.3, -0.2, 0.1).reversed().with_shape(gamma=0.2)
     assert rev.shape_parameters == (-0.2, 0.3, 0.2)
+
+
+@given(degrees, dims, params, params, params, seeds)
+def test_straight_line_curvature_is_zero_to_round_off(m, dim, mu, nu, gamma, seed) -> None:
+    """Control points on one line: the normal part of P'' that κ = |P''_⊥| / |P'|² measures is
+    round-off, |P''_⊥| ≤ 1e-14 (|P''| + m² |P|) (the Gram-determinant form left ~1e-8 |P''| there:
+    κ = 3.6e-9 for (0,0) (1,1) (2,2)). Same for :func:`ght_cad.analysis.curvature` (and the
+    composite curve's, which is the same function of the derivatives)."""
+    from ght_cad.analysis import curvature
+
+    rng = np.random.default_rng(seed)
+    a, d = rng.normal(size=dim), rng.normal(size=dim)
+    s = np.sort(rng.uniform(-2, 2, size=m + 1))
+    c = GHTCurve(a + s[:, None] * d, mu, nu, gamma)
+    size = np.abs(c.control_points).max()
+    d1, d2 = c.derivative(T, 1), c.derivative(T, 2)
+    for kappa in (c.curvature(T), curvature(c, T)):
+        normal = kappa * np.sum(d1 * d1, axis=1)
+        ok = np.isfinite(normal)  # P' = 0 at a stationary end (m = 2 at the corner μ = γ = -1)
+        assert np.all(normal[ok] <= 1e-14 * (np.linalg.norm(d2, axis=1)[ok] + (m + 1) ** 2 * size))
+
+
+def test_curvature_equals_closed_forms() -> None:
+    """The normal-part formula agrees with the closed forms: circle 1/r (γ = -1), parabola."""
+    quarter = GHTCurve([(3, 0), (3, 3), (0, 3)], gamma=-1)
+    np.testing.assert_allclose(quarter.curvature(T), 1 / 3, rtol=1e-14)
+    # P(t) = Bézier (0,0) (1,2) (2,0) with γ = 1: y = 4x(2-x)/4·..., κ = |x'y''| / |x'|³ (x' = 2, y'' = -8)
+    par = GHTCurve([(0, 0), (1, 2), (2, 0)], gamma=1)
+    d1 = par.derivative(T, 1)
+    np.testing.assert_allclose(par.curvature(T), 16.0 / np.sum(d1 * d1, axis=1) ** 1.5, rtol=1e-13)
+
+
+def test_degree_3000_evaluates_without_overflow() -> None:
+    """C(n, n/2) leaves the float range from n = 1030 on: the log-space Bernstein path keeps the
+    partition of unity (1e-11) and interpolation, and matches the direct path where both work."""
+    import importlib
+
+    B, C = importlib.import_module("ght_cad.basis"), importlib.import_module("ght_cad.curve")
+
+    n = 3000
+    x = np.linspace(0.0, 1.0, n)
+    line = GHTCurve(np.c_[x, 2 * x], 0.3, -0.2, 0.1)
+    assert line.degree == n - 1
+    tt = np.linspace(0, 1, 101)
+    np.testing.assert_allclose(line.basis(tt).sum(axis=1), 1.0, atol=1e-11)
+    np.testing.assert_allclose(line.evaluate([0.0, 1.0]), [[0, 0], [1, 2]], atol=1e-12)
+    assert abs(line.arc_length() - math.sqrt(5)) < 1e-9
+    assert np.all(np.isfinite(line.derivative(tt, 3)))
+    # degree 700 across the switch: log path against the direct product of powers
+    pts = np.random.default_rng(1).normal(size=(701, 2))
+    logp = GHTCurve(pts, 0.4, 0.1, -0.3)
+    a, da = logp.evaluate(tt), logp.derivative(tt, 2)
+    saved = B.MAX_DIRECT_DEGREE, C.MAX_DIRECT_DEGREE
+    try:
+        B.MAX_DIRECT_DEGREE = C.MAX_DIRECT_DEGREE = 10**9
+        direct = GHTCurve(pts, 0.4, 0.1, -0.3)
+        b, db = direct.evaluate(tt), direct.derivative(tt, 2)
+    finally:
+        B.MAX_DIRECT_DEGREE, C.MAX_DIRECT_DEGREE = saved
+    np.testing.assert_allclose(a, b, atol=1e-11 * np.abs(pts).max())
+    np.testing.assert_allclose(da, db, atol=1e-11 * np.abs(db).max())
