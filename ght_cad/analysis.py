@@ -27,7 +27,7 @@ from typing import Any, Union
 import numpy as np
 
 from .composite import CompositeCurve
-from .curve import GHTCurve
+from .curve import GHTCurve, curvature_from_derivatives
 from .errors import GHTError
 from .io import atomic_path
 
@@ -70,7 +70,10 @@ def _maybe_scalar(s: Any, arr: np.ndarray) -> Any:
 
 
 def curvature(curve: CurveLike, s: Any) -> np.ndarray:
-    r"""Curvature ``κ = sqrt(a b - c²) / a^{3/2}`` (``a = |X'|², b = |X''|², c = X'·X''``).
+    r"""Curvature ``κ = |X' × X''| / |X'|³ = |X'' - (X'·X''/|X'|²) X'| / |X'|²``.
+
+    The second form (:func:`ght_cad.curve.curvature_from_derivatives`) keeps a straight line's
+    curvature at round-off level (the Gram form ``sqrt(a b - c²)/a^{3/2}`` gave ~1e-8 there).
 
     Args:
         curve: a GHTCurve (s = t ∈ [0, 1]) or CompositeCurve (s ∈ [0, n_segments]).
@@ -80,11 +83,7 @@ def curvature(curve: CurveLike, s: Any) -> np.ndarray:
         κ >= 0 at each s (inf where the speed vanishes).
     """
     d1, d2 = _jets(_check_curve(curve), s, 2)
-    a = np.sum(d1 * d1, axis=1)
-    b = np.sum(d2 * d2, axis=1)
-    c = np.sum(d1 * d2, axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _maybe_scalar(s, np.sqrt(np.maximum(a * b - c * c, 0.0)) / a**1.5)
+    return _maybe_scalar(s, curvature_from_derivatives(d1, d2))
 
 
 def signed_curvature(curve: CurveLike, s: Any) -> np.ndarray:

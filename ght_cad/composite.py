@@ -32,7 +32,7 @@ import numpy as np
 from ._validate import as_parameter_array, check_points
 from .basis import _check_order
 from .continuity import Continuity, JointReport, join, measure_continuity, reverse_g_parameters
-from .curve import GHTCurve
+from .curve import GHTCurve, curvature_from_derivatives
 from .errors import GHTError, SingularJoinError
 from .seeds import make_seed, seed_names
 
@@ -64,6 +64,16 @@ def _float(name: str):
     return conv
 
 
+def _check_not_listed(segment: GHTCurve, index: int, others: Sequence[GHTCurve]) -> None:
+    """GHTError if ``segment`` is the very object of one of ``others`` (a chain lists each once)."""
+    for j, o in enumerate(others):
+        if o is segment:
+            raise GHTError(
+                f"segments[{index}] is the same GHTCurve object as segments[{j}]; allowed: each segment once "
+                "(to repeat a shape, pass a moved copy: curve.transformed(np.eye(dim), offset))"
+            )
+
+
 class CompositeCurve:
     r"""A chain of :class:`GHTCurve` segments with continuity C0..C3 / G0..G3 at every joint.
 
@@ -78,7 +88,8 @@ class CompositeCurve:
             at C joints they must be 1, 0, 0 when given per joint.
 
     Raises:
-        GHTError: empty chain, mixed dimensions, wrong list lengths, bad continuity.
+        GHTError: empty chain, a segment listed twice, mixed dimensions, wrong list lengths, bad
+            continuity.
         SingularJoinError: a joint cannot be imposed (see :func:`~ght_cad.continuity.join`), or a
             closed chain's last segment has too low a degree to carry both joints.
 
@@ -110,6 +121,7 @@ class CompositeCurve:
                     f"segments[{i}] has dimension {s.dim} but segments[0] has dimension {segs[0].dim}; "
                     "all segments must have the same dimension"
                 )
+            _check_not_listed(s, i, segs[:i])
         self._closed = bool(closed)
         nj = len(segs) if self._closed else len(segs) - 1
         self._continuity = _per_joint("continuity", continuity, nj, Continuity.parse)
@@ -262,6 +274,7 @@ class CompositeCurve:
             raise GHTError(f"segment must be a GHTCurve, got {type(segment).__name__}")
         if segment.dim != self.dim:
             raise GHTError(f"segment has dimension {segment.dim}; this chain has dimension {self.dim}")
+        _check_not_listed(segment, i, [s if j != i else None for j, s in enumerate(self._free)])
         self._replace(i, segment)
 
     def set_control_points(self, index: int, control_points: Any) -> None:
@@ -425,14 +438,9 @@ class CompositeCurve:
         return self._eval(s, _check_order(order))
 
     def curvature(self, s: Any) -> np.ndarray:
-        r"""Curvature ``κ = sqrt(|X'|²|X''|² - (X'·X'')²) / |X'|³`` at global parameters s."""
-        d1 = self.derivative(s, 1)
-        d2 = self.derivative(s, 2)
-        a = np.sum(d1 * d1, axis=-1)
-        b = np.sum(d2 * d2, axis=-1)
-        c = np.sum(d1 * d2, axis=-1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.sqrt(np.maximum(a * b - c * c, 0.0)) / a**1.5
+        r"""Curvature ``κ = |X' × X''| / |X'|³`` at global parameters s
+        (:func:`ght_cad.curve.curvature_from_derivatives`: 0 to round-off on straight segments)."""
+        return curvature_from_derivatives(self.derivative(s, 1), self.derivative(s, 2))
 
     def arc_length(self, *, rtol: float = 1e-13) -> float:
         """Total arc length ``Σ_j ∫_0^1 |P_j'(t)| dt`` (Gauss–Legendre per segment)."""
