@@ -431,18 +431,51 @@ def seed_names() -> list[str]:
     return sorted(_REGISTRY)
 
 
-def make_seed(seed: str | Seed = "ght", mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0) -> Seed:
-    """Return a :class:`Seed`: ``seed`` itself if it is one, else the registered family's instance."""
+#: the values a built-in family fixes (a parameter it does not use may be given only as this value)
+_FIXED = {"gbt": {"gamma": -1.0}, "bernstein": {"mu": 0.0, "nu": 0.0, "gamma": 1.0}}
+
+
+def make_seed(seed: str | Seed = "ght", mu: float | None = None, nu: float | None = None,
+              gamma: float | None = None) -> Seed:
+    """Return a :class:`Seed`: ``seed`` itself if it is one, else the registered family's instance.
+
+    A parameter left as None takes the family's default (0 for the GHT family, the fixed value
+    for GBT's γ = -1 and Bernstein's μ = ν = 0, γ = 1). A parameter the seed does not use is
+    refused rather than ignored: ``make_seed("gbt", gamma=0.5)`` (GBT is GHT at γ = -1),
+    ``make_seed("bernstein", mu=0.3)``, or a value given beside a :class:`Seed` instance that
+    differs from the instance's own.
+
+    Raises:
+        GHTError: unknown family name, a parameter the seed does not use, or (from the family)
+            a shape parameter outside [-1, 1].
+    """
+    given = {k: v for k, v in (("mu", mu), ("nu", nu), ("gamma", gamma)) if v is not None}
     if isinstance(seed, Seed):
+        for k, v in given.items():
+            own = getattr(seed, k, None)
+            if own is None or not _same(v, own):
+                raise GHTError(f"{k}={v!r} is given beside the seed object {seed!r}, which has {k}={own!r}; "
+                               f"allowed: the seed's own value, or a seed name (e.g. seed='ght') with {k}")
         return seed
     key = str(seed).lower()
     if key not in _REGISTRY:
         raise GHTError(f"seed={seed!r} is not registered; known seeds: {', '.join(seed_names())}")
-    if key == "gbt":
-        return _REGISTRY[key](mu=mu, nu=nu)
-    if key == "bernstein":
-        return _REGISTRY[key](mu=mu, nu=nu)
-    return _REGISTRY[key](mu=mu, nu=nu, gamma=gamma)
+    fixed = _FIXED.get(key)
+    if fixed is None:  # the GHT family or a registered one: every parameter is passed on
+        return _REGISTRY[key](**{"mu": 0.0, "nu": 0.0, "gamma": 0.0, **given})
+    for k, v in given.items():
+        if k in fixed and not _same(v, fixed[k]):
+            raise GHTError(f"{k}={v!r} is not used by the {key!r} seed (it is the GHT seed at "
+                           + ", ".join(f"{n}={x:g}" for n, x in fixed.items())
+                           + f"); allowed: leave {k} out, or seed='ght' to use {k}")
+    return _REGISTRY[key](**{k: v for k, v in given.items() if k not in fixed})
+
+
+def _same(a: Any, b: Any) -> bool:
+    try:
+        return float(a) == float(b)
+    except (TypeError, ValueError):
+        return False
 
 
 register_seed("ght", GHTSeed)

@@ -172,6 +172,15 @@ def test_errors_and_failed_edit_leaves_chain_unchanged():
     r = GHTCurve([(2, 0), (3, 1), (4, 0)], 0.0, 0.0, 0.0)
     with pytest.raises(GHTError, match="segments is empty"):
         CompositeCurve([])
+    # the same segment listed twice: refused naming both places (it used to be joined to itself)
+    with pytest.raises(GHTError, match=r"segments\[2\] is the same GHTCurve object as segments\[0\]"):
+        CompositeCurve([q, r, q], "G1")
+    chain = CompositeCurve([q, r], "G1")
+    with pytest.raises(GHTError, match=r"segments\[1\] is the same GHTCurve object as segments\[0\]"):
+        chain.set_segment(1, q)
+    chain.set_segment(0, q)  # replacing a segment by itself is no repetition
+    # a moved copy repeats the shape: allowed
+    CompositeCurve([q, q.transformed(np.eye(2), (2.0, 0.0))], "G1")
     with pytest.raises(GHTError, match="segments\\[1\\] has dimension 3"):
         CompositeCurve([q, GHTCurve(np.zeros((3, 3)))])
     with pytest.raises(GHTError, match="continuity has 2 entries but the chain has 1 joints"):

@@ -67,6 +67,29 @@ def test_bad_parameters_and_orders() -> None:
         GHTCurve([[0, 0], [1, 1], [2, 0]], seed="nope")
 
 
+def test_seed_parameters_it_does_not_use_are_refused() -> None:
+    """GBT is GHT at γ = -1 and Bernstein has no parameters: a value for them is an error, not ignored."""
+    from ght_cad.seeds import GHTSeed, make_seed
+
+    with pytest.raises(GHTError, match=r"gamma=0\.5 is not used by the 'gbt' seed \(it is the GHT seed at gamma=-1\)"):
+        make_seed("gbt", gamma=0.5)
+    with pytest.raises(GHTError, match=r"gamma=0\.0 is not used by the 'gbt' seed"):
+        GHTCurve([[0, 0], [1, 1], [2, 0]], gamma=0.0, seed="gbt")
+    for k in ("mu", "nu"):
+        with pytest.raises(GHTError, match=rf"{k}=0\.3 is not used by the 'bernstein' seed"):
+            make_seed("bernstein", **{k: 0.3})
+    with pytest.raises(GHTError, match=r"gamma=-1 is not used by the 'bernstein' seed"):
+        make_seed("bernstein", gamma=-1)
+    with pytest.raises(GHTError, match=r"mu=0\.2 is given beside the seed object .* which has mu=0\.5"):
+        GHTCurve([[0, 0], [1, 1], [2, 0]], 0.2, seed=GHTSeed(0.5, 0.0, 0.0))
+    # the values a seed fixes, or its own values, are accepted
+    assert make_seed("gbt", 0.3, -0.2, -1.0).gamma == -1.0 and make_seed("gbt", 0.3).mu == 0.3
+    assert make_seed("bernstein", 0.0, 0.0, 1.0).gamma == 1.0
+    c = GHTCurve([[0, 0], [1, 1], [2, 0]], 0.5, seed=GHTSeed(0.5, 0.0, 0.0))
+    assert (c.mu, c.nu, c.gamma) == (0.5, 0.0, 0.0)
+    assert GHTCurve([[0, 0], [1, 1], [2, 0]]).gamma == 0.0  # the GHT default
+
+
 def test_basis_outside_the_parameter_domain() -> None:
     """Outside [0, 1] the basis loses non-negativity: refused like GHTCurve.evaluate."""
     with pytest.raises(GHTError, match=r"t=1\.5 is outside the parameter domain \[0, 1\]"):

@@ -33,6 +33,9 @@ def joined_curves(obj: Any) -> list:
     for i, seg in enumerate(segs):
         if getattr(getattr(seg, "Proxy", None), "Type", "") != "GHT::Curve":
             raise ValueError(f"{obj.Label}.Segments[{i}] = {seg.Label} is not a GHT curve; link GHT curve features only")
+        if seg in segs[:i]:
+            raise ValueError(f"{obj.Label}.Segments[{i}] = {seg.Label} is already Segments[{segs.index(seg)}]; "
+                             "allowed: each curve once (copy the curve to repeat its shape)")
     n = len(segs) - 1
     conts = list(obj.Continuity)
     ks = [float(x) for x in obj.K] or [1.0] * n
