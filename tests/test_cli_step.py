@@ -66,7 +66,7 @@ def test_cylinder_step_is_r_theta_by_h(tmp_path: Path, capsys) -> None:
     write_step(_face(bd.Solid.make_cylinder(R, H, angle=arc), bd.GeomType.CYLINDER), step)
     rc, out, err = _run(["unroll", str(step), "--dxf", str(tmp_path / "c.dxf"), "--rulings", "5"], capsys)
     assert rc == EXIT_OK, err
-    assert out["units"] == "mm" and out["file_units"] == "millimetre" and out["panels"] == 1
+    assert out["units"] == "mm" and out["file_units"] == "mm" and out["panels"] == 1
     d = _dxf(tmp_path / "c.dxf")
     assert {"OUTLINE", "BEND", "LABELS", "MARKS"} <= d["layers"] and d["insunits"] == 4
     assert len(d["outlines"]) == 1 and len(d["bends"]) == 5 and "F1" in d["labels"]
@@ -85,7 +85,7 @@ def test_cone_step_is_annular_sector(r2: float, ratio: float, h: float, arc: flo
         step = Path(tmp) / "cone.stp"
         write_step(_face(bd.Solid.make_cone(r1, r2, h, angle=arc), bd.GeomType.CONE), step)
         res = unroll_step(step, units="cm", rulings=3)
-    assert res.units == "cm" and res.file_units == "millimetre"
+    assert res.units == "cm" and res.file_units == "mm"
     slant = math.hypot(r2 - r1, h)
     rho2, rho1 = r2 * slant / (r2 - r1), r1 * slant / (r2 - r1)
     angle = math.radians(arc) * r2 / rho2
@@ -103,10 +103,21 @@ def test_file_units_are_the_default(tmp_path: Path, capsys) -> None:
     write_step(_face(bd.Solid.make_cylinder(R / 1e3, H / 1e3, angle=arc), bd.GeomType.CYLINDER), step, units="m")
     rc, out, err = _run(["unroll", str(step), "--dxf", str(tmp_path / "m.dxf"), "--svg", str(tmp_path / "m.svg")], capsys)
     assert rc == EXIT_OK, err
-    assert out["file_units"] == "metre" and out["units"] == "m"
+    assert out["file_units"] == "m" and out["units"] == "m"
     np.testing.assert_allclose(out["area"], R * math.radians(arc) * H / 1e6, rtol=RTOL)
     assert _dxf(tmp_path / "m.dxf")["insunits"] == 6
     assert (tmp_path / "m.svg").read_text().lstrip().startswith("<")
+
+
+@pytest.mark.parametrize("units", ["in", "ft", "cm"])
+def test_file_units_one_spelling(tmp_path: Path, capsys, units: str) -> None:
+    """file_units is spelled like units (mm, cm, m, in, ft) whether the STEP file writes an SI unit
+    ('millimetre', .CENTI. 'METRE') or a conversion-based one ('INCH', 'FOOT')."""
+    step = tmp_path / f"cyl_{units}.step"
+    write_step(_face(bd.Solid.make_cylinder(3.0, 5.0, angle=90.0), bd.GeomType.CYLINDER), step, units=units)
+    rc, out, err = _run(["unroll", str(step)], capsys)
+    assert rc == EXIT_OK, err
+    assert out["file_units"] == units and out["units"] == units, out
 
 
 def test_project_face_and_two_strip_shell(tmp_path: Path, capsys) -> None:

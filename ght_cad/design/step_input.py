@@ -39,7 +39,9 @@ class StepUnroll:
     Attributes:
         pattern: one panel per selected face, labelled ``F<n>`` (``n`` = 1-based face number).
         units: length unit of the pattern (and of the face geometry as read).
-        file_units: the length unit the STEP file declares (OCCT name), or None.
+        file_units: the length unit the STEP file declares, in the spelling of ``units``
+            (mm, cm, m, in, ft, whatever the file writes: 'MM', 'millimetre', 'FOOT', ...); a unit
+            name not in that list as the file spells it, lower case; None if the file declares none.
         face_count: number of faces in the file.
         faces: per selected face: number, surface type, unroll method, 3-D and flat area,
             developability (θ_max, θ_rms, DD, R) when measured, max relative errors.
@@ -193,7 +195,8 @@ def unroll_step(
         report.append(row)
     mark_shared_edges(panels)
     layout_panels(panels)
-    return StepUnroll(FlatPattern(panels, units=unit), unit, file_unit, n, report, plate)
+    declared = _step_unit(file_unit) or (file_unit.strip().lower() if file_unit and file_unit.strip() else None)
+    return StepUnroll(FlatPattern(panels, units=unit), unit, declared, n, report, plate)
 
 
 def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any, k_factor: Any,
