@@ -19,12 +19,14 @@ and the pid in the name does not exist. :func:`sweep_dead` removes dead runs' fo
 pid-less ``.<name>.<random>.ght-cad-tmp`` and ``.ght-cad-export.<random>`` folders of earlier
 versions, which had no lock) and never touches a live one.
 
-**Manifests.** A folder holds one design's results: ``.ght-cad-manifest.json`` in it lists every
-file the last run wrote (``report.json`` lists the same under ``files``). :meth:`OutputFolder.commit`
-moves the new files in, then removes the files the previous manifest listed and this run did not
-write again; files a person put there are never listed, so they are kept. The manifest is first
-rewritten as the union of old and new names, so a run killed half-way through the moves leaves a
-manifest that still covers every file of ours in the folder, and the next run cleans up exactly.
+**Manifests.** A folder holds one design's results: the run's ``report.json`` lists every file
+the run wrote under ``files`` (a ght-cad report: it also has ``ght_definition`` or
+``"tool": "ght-cad"``); a run without such a report leaves ``.ght-cad-manifest.json`` instead.
+:meth:`OutputFolder.commit` moves the new files in, then removes the files the previous manifest
+listed and this run did not write again; files a person put there are never listed, so they are
+kept. During the moves ``.ght-cad-manifest.json`` holds the union of old and new names, so a run
+killed half-way leaves a manifest that still covers every file of ours in the folder, and the
+next run cleans up exactly.
 
 Typical use::
 
@@ -65,6 +67,7 @@ __all__ = [
     "OutputFolder",
     "StagedFiles",
     "MANIFEST_NAME",
+    "REPORT_NAME",
     "LOCK_SUFFIX",
     "STAGING_SUFFIX",
 ]
@@ -396,27 +399,42 @@ def _safe_names(names: Iterable[Any]) -> list[str]:
     return out
 
 
-def read_manifest(folder: str | os.PathLike) -> list[str]:
-    """The files the last run listed for ``folder`` ([] for a folder no ght-cad run wrote).
+#: the run's report, which lists the files of the run under ``files`` (the usual manifest)
+REPORT_NAME = "report.json"
 
-    Reads ``.ght-cad-manifest.json``; for folders written by earlier versions, which had none,
-    the ``files`` list of a ght-cad ``report.json`` (one with ``ght_definition`` and ``files``).
+
+def _report_files(path: Path) -> list[str] | None:
+    """The ``files`` list of a ght-cad report (one with ``files`` and ``ght_definition`` or
+    ``"tool": "ght-cad"``), None for anything else (a person's file of the same name)."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or not isinstance(data.get("files"), list):
+        return None
+    if "ght_definition" not in data and data.get("tool") != "ght-cad":
+        return None
+    return _safe_names(data["files"]) + [path.name]
+
+
+def read_manifest(folder: str | os.PathLike) -> list[str]:
+    """The files the last run wrote into ``folder`` ([] for a folder no ght-cad run wrote).
+
+    The union of ``report.json``'s ``files`` (a ght-cad report; the usual manifest) and
+    ``.ght-cad-manifest.json`` (written by runs without a report, and during a commit as the
+    union of the old and new names, so that a run killed half-way through still names every
+    file of ours).
     """
     folder = Path(folder)
-    for name, key in ((MANIFEST_NAME, "files"), ("report.json", "files")):
-        p = folder / name
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            continue
-        if not isinstance(data, dict) or not isinstance(data.get(key), list):
-            continue
-        if name == "report.json":
-            if "ght_definition" not in data:
-                continue  # not a ght-cad report: a person's file
-            return _safe_names(data[key]) + ["report.json"]
-        return _safe_names(data[key])
-    return []
+    names: list[str] = []
+    try:
+        data = json.loads((folder / MANIFEST_NAME).read_text(encoding="utf-8"))
+        if isinstance(data, dict) and isinstance(data.get("files"), list):
+            names += _safe_names(data["files"])
+    except (OSError, ValueError):
+        pass
+    names += _report_files(folder / REPORT_NAME) or []
+    return sorted(set(names))
 
 
 def write_manifest(folder: str | os.PathLike, files: Iterable[str], *, pending: bool = False) -> Path:
@@ -425,6 +443,12 @@ def write_manifest(folder: str | os.PathLike, files: Iterable[str], *, pending: 
 
     body = {"tool": "ght-cad", "files": sorted(set(_safe_names(files))), "pending": bool(pending)}
     return write_text_atomic(Path(folder) / MANIFEST_NAME, json.dumps(body, indent=1) + "\n")
+
+
+def _listed_by_report(folder: Path, names: Sequence[str]) -> bool:
+    """True if ``folder/report.json`` is a ght-cad report whose ``files`` list all of ``names``."""
+    listed = _report_files(folder / REPORT_NAME)
+    return listed is not None and set(names) <= set(listed)
 
 
 def _remove_part_leftovers(folder: Path) -> None:
@@ -511,10 +535,12 @@ class OutputFolder:
     def commit(self) -> list[str]:
         """Move the staged files into the output folder; returns their names (sorted).
 
-        A new folder appears by one rename. Into an existing folder: the manifest is first
-        rewritten as old ∪ new (pending), every new file replaces its target (``os.replace``),
-        the files of the previous manifest not written again are removed, and the manifest is
-        rewritten as the new names. Files not in the previous manifest (a person's) are kept.
+        A new folder appears by one rename. Into an existing folder: ``.ght-cad-manifest.json``
+        is first written as old ∪ new (pending), every new file replaces its target
+        (``os.replace``), the files of the previous manifest not written again are removed, and
+        the hidden manifest is removed again if the new ``report.json`` lists every new file
+        (else rewritten as the new names). Files not in the previous manifest (a person's) are
+        kept.
 
         Raises:
             GHTError: a staged name is a folder in the output folder (checked before any move).
@@ -523,8 +549,10 @@ class OutputFolder:
             raise RuntimeError("OutputFolder is not open")
         out = self.out
         names = self.stage.files()
+        by_report = _listed_by_report(self.stage.path, names)  # report.json is the manifest
         if not out.exists():
-            write_manifest(self.stage.path, names)
+            if not by_report:
+                write_manifest(self.stage.path, names)
             self.stage.drop_lock_file()
             try:
                 os.replace(self.stage.path, out)  # one atomic rename: the folder appears complete
@@ -537,7 +565,8 @@ class OutputFolder:
                 if not out.is_dir():
                     raise
                 # a folder appeared meanwhile (made by hand): fall through to the file moves
-                os.unlink(self.stage.path / MANIFEST_NAME)
+                if not by_report:
+                    os.unlink(self.stage.path / MANIFEST_NAME)
         if not out.is_dir():
             raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
         for n in names:  # checked before the first move: a failure must not leave a mixed folder
@@ -555,7 +584,10 @@ class OutputFolder:
                     p.unlink()
             except OSError:
                 pass
-        write_manifest(out, names)
+        if by_report:
+            os.unlink(out / MANIFEST_NAME)  # the new report.json lists every file
+        else:
+            write_manifest(out, names)
         self.stage.remove()
         self.stage = None
         self.made_parents = []

@@ -239,7 +239,7 @@ def test_failure_leaves_folder_and_parents_as_they_were(tmp_path: Path) -> None:
 
 
 KILL_IN_COMMIT = """
-import os, signal, sys
+import json, os, signal, sys
 from ght_cad import outdir
 out, k, design = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 names = {"A": ["basis.png", "model.step", "report.json", "surface.png"], "B": ["model.step", "report.json", "curve.png"]}[design]
@@ -252,8 +252,8 @@ def replace(a, b):
     real_replace(a, b)
 os.replace = replace
 with outdir.OutputFolder(out) as f:
-    for n in names:
-        f.path(n).write_text(design + " " + n)
+    for n in names:  # report.json lists the run's files: it is the manifest
+        f.path(n).write_text(json.dumps({"tool": "ght-cad", "files": names}) if n == "report.json" else design + " " + n)
     f.commit()
 """
 
@@ -267,8 +267,10 @@ def test_kill_inside_commit_then_one_run_gives_exactly_its_files(tmp_path: Path,
     proc = _python(KILL_IN_COMMIT, str(out), str(k), "B")
     assert proc.wait() in (-signal.SIGKILL, 0)
     assert _python(KILL_IN_COMMIT, str(out), "99", "B").wait() == 0
-    assert sorted(p.name for p in out.iterdir()) == sorted(["model.step", "report.json", "curve.png", "mine.txt", MANIFEST_NAME])
-    assert all((out / n).read_text() == "B " + n for n in ("model.step", "report.json", "curve.png"))
+    # exactly B's files and the person's: no hidden manifest either (B's report.json lists its files)
+    assert sorted(p.name for p in out.iterdir()) == sorted(["model.step", "report.json", "curve.png", "mine.txt"])
+    assert all((out / n).read_text() == "B " + n for n in ("model.step", "curve.png"))
+    assert read_manifest(out) == ["curve.png", "model.step", "report.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder, no lock file
 
 
