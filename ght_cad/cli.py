@@ -319,7 +319,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     """``ght-cad demo``: :func:`ght_cad.demo.run_demo` into ``--out``."""
     from .demo import run_demo
 
-    report = run_demo(args.out, progress=not args.no_progress, quick=args.quick)
+    report = run_demo(args.out, progress=not args.no_progress, quick=args.quick, **_wait_args(args))
     _emit(args, {"command": "demo", **report}, _report_text)
     return EXIT_OK
 
@@ -330,9 +330,26 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     design = load_design(args.design)
     out = args.out if args.out is not None else Path(args.design).with_suffix("").name + "-out"
-    report = run_design(design, out, progress=not args.no_progress)
+    report = run_design(design, out, progress=not args.no_progress, **_wait_args(args))
     _emit(args, {"command": "run", **report}, _report_text)
     return EXIT_OK
+
+
+def _wait_args(args: argparse.Namespace) -> dict[str, Any]:
+    """``wait``/``timeout`` for :func:`ght_cad.design.run_design` from ``--wait``/``--wait-timeout``."""
+    timeout = getattr(args, "wait_timeout", None)
+    if timeout is not None and not (math.isfinite(timeout) and timeout >= 0):
+        raise UsageError(f"--wait-timeout {timeout:g} is not allowed; allowed: a number of seconds >= 0")
+    return {"wait": bool(getattr(args, "wait", False) or timeout is not None), "timeout": timeout}
+
+
+def add_wait_options(sp: argparse.ArgumentParser) -> None:
+    """``--wait`` and ``--wait-timeout`` of the commands that write an output folder (run, demo, batch)."""
+    sp.add_argument("--wait", action="store_true",
+                    help="if another ght-cad process writes the output folder, wait until it has finished "
+                    "(default: refuse with exit code 2, naming the folder and the other process)")
+    sp.add_argument("--wait-timeout", type=float, metavar="SECONDS",
+                    help="wait at most this long for the output folder (implies --wait); then exit code 2")
 
 
 def _report_text(r: dict[str, Any]) -> str:
@@ -636,6 +653,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, metavar="DIR", help="output folder (created; files are replaced atomically)")
     sp.add_argument("--quick", action="store_true", help="fewer optimizer iterations (for smoke tests)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    add_wait_options(sp)
     common(sp)
     sp.set_defaults(func=cmd_demo)
 
@@ -645,12 +663,15 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run the whole pipeline on DESIGN.toml. The file is validated first; an invalid "
         "file gives one line on stderr naming the file, the key and the allowed values (exit 2). "
         "Results are computed into a temporary folder beside --out and moved in only when "
-        "everything succeeded, so a failure leaves --out untouched.",
+        "everything succeeded, so a failure leaves --out untouched. --out holds one design: files "
+        "an earlier run wrote and this one does not are removed, files you put there are kept. "
+        "A second run on an --out in use is refused (exit 2) unless --wait is given.",
         epilog=_EPILOG,
     )
     design_arg(sp)
     sp.add_argument("--out", metavar="DIR", help="output folder (default: <DESIGN file name without .toml>-out in the current folder)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    add_wait_options(sp)
     common(sp)
     sp.set_defaults(func=cmd_run)
 

@@ -21,13 +21,16 @@ def default_design_text() -> str:
     return resources.files("ght_cad").joinpath("data", DEFAULT_DESIGN).read_text(encoding="utf-8")
 
 
-def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool = False) -> dict[str, Any]:
+def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool = False, wait: bool = False,
+             timeout: float | None = None) -> dict[str, Any]:
     """Run the embedded default design into ``out_dir`` and return the report dictionary.
 
     Args:
         out_dir: output folder (created if missing; files in it are replaced atomically).
         progress: draw progress on stderr when it is a terminal.
         quick: fewer optimizer iterations (smoke tests).
+        wait, timeout: wait (at most ``timeout`` s) while another process writes ``out_dir``
+            instead of refusing (see :func:`ght_cad.design.run_design`).
 
     Returns:
         The report (also written as ``report.json`` and ``report.md``).
@@ -40,4 +43,4 @@ def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool =
     design = parse_design_text(default_design_text(), source=f"<embedded {DEFAULT_DESIGN}>")
     if quick and design.optimize is not None:
         design.optimize.iterations = min(design.optimize.iterations, 10)
-    return run_design(design, out_dir, progress=progress)
+    return run_design(design, out_dir, progress=progress, wait=wait, timeout=timeout)

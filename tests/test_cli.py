@@ -466,3 +466,17 @@ def test_curve_whose_control_points_coincide(tmp_path: Path, capsys) -> None:
     rc, res, err = run_json(["curve", "--points", "2,3 2,3 2,3", "--step", str(tmp_path / "c.step")], capsys)
     assert rc == EXIT_USAGE and "coincide" in res["error"] and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "c.step").exists()
+
+
+def test_curve_of_3000_control_points_and_a_straight_line(capsys) -> None:
+    """Degree 2999 (C(n, n/2) overflows a float from n = 1030 on; it was exit 1, OverflowError):
+    exit 0 with the right arc length; a straight line's curvature_max is round-off (degree 2: was 3.6e-9)."""
+    x = [3.0 * i / 2999 for i in range(3000)]
+    pts = " ".join(f"{a!r},{4 * a / 3!r}" for a in x)  # on the line y = 4x/3: length 5
+    rc, res, err = run_json(["curve", "--points", pts, "--gamma", "0.4"], capsys)
+    assert rc == EXIT_OK, err
+    assert res["degree"] == 2999 and abs(res["arc_length"] - 5.0) < 1e-9, res["arc_length"]
+    # round-off of P''_⊥ grows like m² 1e-16 |P| / |P'|² = 9e6 · 1e-16 · 5 / 25 ≈ 2e-10 at this degree
+    assert res["curvature_max"] < 1e-9, res["curvature_max"]
+    rc, res, err = run_json(["curve", "--points", "0,0 1,1 2,2"], capsys)
+    assert rc == EXIT_OK and res["curvature_max"] < 1e-15, res["curvature_max"]

@@ -115,7 +115,6 @@ from .outputs import (  # noqa: F401
     shared_edge_count,
     unroll_surface,
     plate_solids,
-    _FileStage,
     _export_one,
     _jsonable,
     _ruled_face,
@@ -126,7 +125,6 @@ from .report import (  # noqa: F401
 )
 from .run import (  # noqa: F401
     run_design,
-    _Stage,
     _curves_report,
     _versions,
 )

@@ -6,14 +6,11 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
-import tempfile
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable
 
 import numpy as np
 
-from ..errors import GHTError
 from .build import BuiltSurface, _is_composite, build_curves, build_surface, surface_summary, surface_view
 from .schema import Design, DesignError
 
@@ -180,7 +177,8 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
     surface summary, curves and (with a surface) the ``flat_pattern`` entry of :func:`pattern_report`;
     ``.png``: rendered surface (or the curves when the design has no surface).
 
-    All or nothing: every file is first written into a temporary folder beside its target
+    All or nothing (:class:`ght_cad.outdir.StagedFiles`): every target is locked against other
+    ght-cad processes, every file is first written into a staging folder beside its target
     (which also proves the target's folder is writable) and the files are moved into place only
     when every one was written; a failure leaves every target as it was (existing files
     untouched, no new file).
@@ -190,8 +188,9 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
         files: output paths; the suffix selects the content.
 
     Raises:
-        DesignError: a suffix that is not allowed, a surface output without [surface], or a
-            target whose folder cannot be written (the message names the target).
+        DesignError: a suffix that is not allowed, a surface output without [surface].
+        GHTError: a target whose folder cannot be written (the message names the target).
+        FolderBusy: another process writes one of the targets.
 
     Returns:
         ``{kind: path}`` for each written file (``kind`` = suffix without dot, ``_<n>`` appended
@@ -208,8 +207,9 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
         for f in files:
             if f.suffix.lower() in (".dxf", ".svg"):
                 raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
-    stage = _FileStage(files)
-    try:
+    from ..outdir import StagedFiles
+
+    with StagedFiles(files) as stage:  # locked targets, staging folders with pid + lock
         out: dict[str, str] = {}
         pattern = None
         for f in files:
@@ -217,8 +217,6 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
             suf = f.suffix.lower().lstrip(".")
             out[suf + (f"_{len(out)}" if suf in out else "")] = str(f)
         stage.commit()
-    finally:
-        stage.cleanup()
     return out
 
 
@@ -256,73 +254,6 @@ def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | No
         else:
             plot_curve(list(curves.values()), tmp)
     return pattern
-
-
-class _FileStage:
-    """One temporary folder beside each target's folder; :meth:`commit` moves all files into place.
-
-    Creating the temporary folders up front checks that every target folder is writable before
-    anything is computed or written. Folders created for missing parents are removed again on
-    failure.
-    """
-
-    def __init__(self, targets: Sequence[Path]) -> None:
-        self.dirs: dict[Path, Path] = {}
-        self.made: list[Path] = []
-        self.map: dict[Path, Path] = {}
-        try:
-            for t in targets:
-                parent = t.parent.absolute()
-                if t.exists() and t.is_dir():
-                    raise DesignError(f"cannot write {t}: it is a folder; allowed: a file path")
-                if parent not in self.dirs:
-                    self._mkdirs(parent, t)
-                    try:
-                        self.dirs[parent] = Path(tempfile.mkdtemp(prefix=".ght-cad-export.", dir=parent))
-                    except OSError as exc:
-                        raise DesignError(
-                            f"cannot write {t}: folder {parent} is not writable ({exc.strerror or exc})"
-                        ) from None
-                # a numbered name keeps repeated or equal base names apart; the suffix is kept for writers
-                self.map[t] = self.dirs[parent] / f"{len(self.map)}{t.suffix}"
-        except BaseException:
-            self.cleanup()
-            raise
-
-    def _mkdirs(self, parent: Path, target: Path) -> None:
-        missing = []
-        p = parent
-        while not p.exists() and p != p.parent:
-            missing.append(p)
-            p = p.parent
-        for d in reversed(missing):
-            try:
-                d.mkdir()
-            except OSError as exc:
-                raise DesignError(f"cannot write {target}: cannot create folder {d} ({exc.strerror or exc})") from None
-            self.made.append(d)
-
-    def path(self, target: Path) -> Path:
-        return self.map[target]
-
-    def commit(self) -> None:
-        """Move every staged file onto its target (same file system: ``os.replace`` each)."""
-        for t, tmp in self.map.items():
-            if not tmp.is_file():
-                raise GHTError(f"writing {t} produced no file")
-        for t, tmp in self.map.items():
-            os.replace(tmp, t)
-        self.made = []  # the folders now hold results
-
-    def cleanup(self) -> None:
-        for d in self.dirs.values():
-            shutil.rmtree(d, ignore_errors=True)
-        for d in reversed(self.made):
-            try:
-                d.rmdir()
-            except OSError:
-                pass
-        self.made = []
 
 
 def _jsonable(o: Any) -> Any:

@@ -1,15 +1,15 @@
 r"""The pipeline behind ``ght-cad run``/``demo``: :func:`run_design`.
 
 curves → surface → optimization → measures → B-rep + STEP → flat pattern → figures → report,
-computed into a temporary folder beside the output folder and moved in only when every step
-succeeded, so a failure leaves the output folder untouched.
+computed into a staging folder beside the output folder and moved in only when every step
+succeeded, so a failure leaves the output folder untouched. The folder handling (lock, staging
+folders a later run can tell from a live one's, the manifest of one design per folder) is
+:class:`ght_cad.outdir.OutputFolder`.
 """
 
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -24,60 +24,6 @@ from .outputs import (_jsonable, brep_shape, curve_edges, pattern_report, plate_
                       unroll_surface)
 from .report import report_markdown
 from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
-
-
-class _Stage:
-    """A temporary folder beside ``out_dir``; :meth:`commit` moves its files into ``out_dir``."""
-
-    def __init__(self, out_dir: Path) -> None:
-        self.out = out_dir
-        parent = out_dir.parent
-        # folders created for out_dir's parent: removed again by cleanup() after a failed run
-        self.made_parents = [d for d in (parent, *parent.parents) if not d.exists()][::-1]
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-            self.tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".ght-cad-tmp", dir=parent))
-        except OSError as exc:  # e.g. a part of the path is a regular file, or a read-only folder
-            self._remove_made_parents()
-            raise GHTError(
-                f"cannot create the output folder {out_dir}: {exc.strerror or exc}"
-                f"{f' ({exc.filename})' if exc.filename else ''}; allowed: a folder or a new path "
-                "whose parent folders can be created"
-            ) from None
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self.tmp, 0o777 & ~umask)  # mkdtemp makes 0700; the result is an ordinary folder
-
-    def path(self, name: str) -> Path:
-        return self.tmp / name
-
-    def commit(self) -> list[str]:
-        names = sorted(p.name for p in self.tmp.iterdir() if p.is_file() and not p.name.endswith(".part"))
-        if not self.out.exists():
-            os.replace(self.tmp, self.out)  # one atomic rename: the folder appears complete
-            return names
-        if not self.out.is_dir():
-            raise GHTError(f"{self.out} exists and is not a folder; allowed: a folder or a new path")
-        for n in names:  # checked before the first move: a failure must not leave a mixed folder
-            if (self.out / n).is_dir():
-                raise GHTError(f"cannot write {self.out / n}: it is a folder; allowed: a file path "
-                               "(remove or rename the folder)")
-        for n in names:
-            os.replace(self.tmp / n, self.out / n)
-        shutil.rmtree(self.tmp, ignore_errors=True)
-        return names
-
-    def cleanup(self) -> None:
-        """Remove the temporary folder and the parent folders created for it (after a failure)."""
-        shutil.rmtree(self.tmp, ignore_errors=True)
-        self._remove_made_parents()
-
-    def _remove_made_parents(self) -> None:
-        for d in reversed(self.made_parents):
-            try:
-                d.rmdir()  # only if still empty
-            except OSError:
-                pass
 
 
 def _versions() -> dict[str, str]:
@@ -113,7 +59,8 @@ def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
     ]
 
 
-def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True) -> dict[str, Any]:
+def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True, wait: bool = False,
+               timeout: float | None = None) -> dict[str, Any]:
     """Run the whole pipeline of a design and write its outputs into ``out_dir``.
 
     Steps: GHT curves (+ joins, measured) → surface (developable from control planes, or a ruled
@@ -123,29 +70,35 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     ``report.md``. File names: ``model.step``, ``flat_pattern.dxf``, ``flat_pattern.svg``,
     ``report.json``, ``report.md``, ``<figure>.png``.
 
-    Everything is computed into a temporary folder beside ``out_dir``; only when every step has
-    succeeded are the files moved in (a new ``out_dir`` appears by one rename). On any error the
-    temporary folder is removed and ``out_dir`` is untouched.
+    The output folder holds one design (:class:`ght_cad.outdir.OutputFolder`): it is locked for
+    the whole run (a second run on it waits with ``wait`` or is refused), everything is computed
+    into a staging folder beside ``out_dir`` and moved in only when every step has succeeded (a
+    new ``out_dir`` appears by one rename); then the files the previous run listed in its
+    manifest and this run did not write again are removed, files a person put there are kept.
+    ``report["files"]`` (and ``.ght-cad-manifest.json``) list every file this run wrote. On any
+    error the staging folder is removed and ``out_dir`` is untouched.
 
     Args:
         design: a validated :class:`Design`.
         out_dir: output folder.
-        progress: progress bar on stderr when it is a terminal.
+        progress: progress bar on stderr when it is a terminal (and a line when it has to wait).
+        wait: wait while another process writes ``out_dir`` instead of refusing.
+        timeout: with ``wait``, give up after this many seconds (None: no limit).
 
     Returns:
         The report dictionary (the content of ``report.json``).
 
     Raises:
+        FolderBusy: ``out_dir`` is in use by another live process (message: folder and pid).
         GHTError: degenerate geometry, non-developable surface, ...; nothing is written.
     """
     import sys
 
+    from ..outdir import OutputFolder
     from ..progress import progress_enabled
 
     t_start = time.perf_counter()
     out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
     want_files = set(design.outputs.files)
     want_figs = set(design.outputs.figures)
     steps = ["curves", "surface", "optimize", "measure", "B-rep + STEP", "flat pattern", "figures", "report"]
@@ -164,8 +117,12 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             sys.stderr.write(f"[{i}/{len(steps)}] {design.name}: {name} ({time.perf_counter() - t_start:.1f} s)\n")
             sys.stderr.flush()
 
-    stage = _Stage(out)
-    try:
+    def waiting(busy: Any) -> None:  # one line on stderr when the run has to wait for another
+        who = f"pid {busy.pid}" + (f" ({busy.owner})" if busy.owner else "") if busy.pid is not None else "another process"
+        sys.stderr.write(f"ght-cad: waiting for {who}, which writes {busy.path}\n")
+        sys.stderr.flush()
+
+    with OutputFolder(out, wait=wait, timeout=timeout, on_wait=waiting) as stage:
         # 1. curves
         step("curves")
         curves, joins = build_curves(design)
@@ -289,7 +246,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
 
         # 8. report
         step("report")
-        files = sorted(p.name for p in stage.tmp.iterdir() if p.is_file())
+        files = stage.files()
         if "json" in want_files:
             files.append(FILE_NAMES["json"])
         if "md" in want_files:
@@ -307,7 +264,4 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         if "md" in want_files:
             write_text_atomic(stage.path(FILE_NAMES["md"]), report_markdown(report))
         stage.commit()
-    except BaseException:
-        stage.cleanup()
-        raise
     return report
