@@ -75,7 +75,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     into a staging folder beside ``out_dir`` and moved in only when every step has succeeded (a
     new ``out_dir`` appears by one rename); then the files the previous run listed in its
     manifest and this run did not write again are removed, files a person put there are kept.
-    ``report["files"]`` (and ``.ght-cad-manifest.json``) list every file this run wrote. On any
+    ``report["files"]`` lists every file this run wrote (the manifest). On any
     error the staging folder is removed and ``out_dir`` is untouched.
 
     Args:
