@@ -5,8 +5,8 @@ Every design goes through exactly the pipeline of ``ght-cad run``
 :class:`concurrent.futures.ProcessPoolExecutor`, or a ``dask.distributed`` worker on any machine)
 runs it into a private temporary folder and sends back the report and the bytes of every file;
 the calling process then writes them into ``DIR/<name>/`` through run's own staging
-(:class:`ght_cad.design._Stage`: a temporary folder beside the target, moved in only when
-complete), so local and remote runs write the same files in the same way and a worker that dies
+(:class:`ght_cad.outdir.OutputFolder`: a locked target, a temporary folder beside it, moved in
+only when complete), so local and remote runs write the same files in the same way and a worker that dies
 leaves nothing in ``DIR``. ``report.json`` and ``report.md`` are rewritten with ``out_dir`` naming
 the local folder. ``DIR/batch.json`` and ``DIR/batch.md`` (plus one ``sweep-<name>.png`` per
 sweep, :mod:`ght_cad.sweep`) hold one row per design:
@@ -223,12 +223,12 @@ def _commit(target: Path, result: dict[str, Any]) -> None:
     """Write a worker's files into ``target`` through run's staging (all files or none)."""
     import json
 
-    from .design import FILE_NAMES, _Stage, report_markdown
+    from .design import FILE_NAMES, report_markdown
+    from .outdir import OutputFolder
 
     report = dict(result["report"] or {})
     report["out_dir"] = str(target)
-    stage = _Stage(target)
-    try:
+    with OutputFolder(target) as stage:  # run's folder handling: lock, staging, manifest
         for name, data in result["files"].items():
             if name == FILE_NAMES["json"]:
                 data = (json.dumps(report, indent=2) + "\n").encode("utf-8")
@@ -236,9 +236,6 @@ def _commit(target: Path, result: dict[str, Any]) -> None:
                 data = report_markdown(report).encode("utf-8")
             stage.path(name).write_bytes(data)
         stage.commit()
-    except BaseException:
-        stage.cleanup()
-        raise
 
 
 def _figures(report: dict[str, Any] | None) -> dict[str, Any]:
@@ -383,7 +380,7 @@ def run_batch(
     Raises:
         GHTError: no designs, ``jobs < 1``, ``out_dir`` is not a folder, an unreachable scheduler.
     """
-    from .design import _FileStage
+    from .outdir import StagedFiles
     from .progress import Progress
 
     t0 = time.perf_counter()
@@ -429,7 +426,7 @@ def run_batch(
     executor = f"dask {scheduler}" if scheduler else f"local processes ({min(jobs, max(len(todo), 1))} jobs)"
     result = BatchResult(out, [rows[j.index] for j in job_list], sweeps, executor)
     result.elapsed_s = time.perf_counter() - t0
-    _write_summary(result, _FileStage)
+    _write_summary(result, StagedFiles)
     return result
 
 
