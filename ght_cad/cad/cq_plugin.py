@@ -1,11 +1,15 @@
 r"""cadquery Workplane plugin: GHT-Bézier curves as pending edges.
 
-Importing this module registers two Workplane methods, following cadquery's plugin convention
+Importing this module registers three Workplane methods, following cadquery's plugin convention
 (a function taking ``self``, attached to ``cq.Workplane``, that returns ``self.newObject(...)``):
 
 - ``Workplane.ghtBezier(control_points, mu=0, nu=0, gamma=0, *, tol=None, degree=5,
   forConstruction=False, includeCurrent=False, makeWire=False)``
 - ``Workplane.ghtCurve(curve_or_composite, *, tol=None, degree=5, forConstruction=False)``
+- ``Workplane.developableLoft(rail_a=None, rail_b=None, **options)``: the exact developable loft
+  between two rails (spec 5.7) as a ``cq.Shell``/``cq.Face`` on the stack; without arguments the
+  rails are the two edges (or wires) on the stack. The plain function :func:`developable_loft_cq`
+  returns the shape itself.
 
 Control points are in the workplane's local coordinates (2-D or 3-D); they are mapped to world
 coordinates point by point, which is exact because a GHT-Bézier curve is affinely invariant
@@ -33,7 +37,7 @@ from ..curve import GHTCurve
 from ..errors import GHTError
 from .curves import ght_edge, segments_of
 
-__all__ = ["ghtBezier", "ghtCurve", "register"]
+__all__ = ["ghtBezier", "ghtCurve", "developableLoft", "developable_loft_cq", "register"]
 
 
 def _to_world(wp: "cq.Workplane", points: np.ndarray) -> np.ndarray:
@@ -145,10 +149,65 @@ def ghtCurve(
     return _add_edges(self, edges, forConstruction, makeWire)
 
 
+def developable_loft_cq(rail_a: Any, rail_b: Any, **options: Any) -> Any:
+    r"""The exact developable loft between two rails as a cadquery ``Shell`` (or ``Face``).
+
+    Rulings ``a(t)–b(σ(t))`` with ``det(a', b', b - a) = 0`` to round-off, fans at the rail ends
+    (spec 5.7); the same B-rep as :func:`ght_cad.cad.loft.developable_loft` (one B-spline face per
+    segment, degree 1 across the rulings, sewn), wrapping the same OCP shape.
+
+    Args:
+        rail_a, rail_b: cadquery/build123d ``Edge``/``Wire``, OCP edges/wires or 3-D GHTCurves.
+        **options: ``tol``, ``degree``, ``sew_tol`` and the core options of
+            :func:`ght_cad.loft.developable_loft` (``orientation``, ``branch``, ...).
+
+    Returns:
+        ``cq.Shell`` or ``cq.Face`` with ``.ght_loft`` (the core loft: report, ``unroll``).
+
+    Raises:
+        NotDevelopableError: no developable joins the rails; GHTError: bad rails or options.
+    """
+    from build123d import Mode
+
+    from .loft import developable_loft
+
+    shape = developable_loft(rail_a, rail_b, mode=Mode.PRIVATE, **options)
+    out = cq.Shell(shape.wrapped) if shape.wrapped.ShapeType().name == "TopAbs_SHELL" else cq.Face(shape.wrapped)
+    out.ght_loft = shape.ght_loft
+    out.ght_bspline = shape.ght_bspline
+    out.ght_max_deviation = shape.ght_max_deviation
+    return out
+
+
+def developableLoft(self: "cq.Workplane", rail_a: Any = None, rail_b: Any = None, **options: Any) -> "cq.Workplane":
+    r"""Workplane method: the exact developable loft between two rails, pushed on the stack.
+
+    Args:
+        rail_a, rail_b: the rails (see :func:`developable_loft_cq`); both None: the two edges or
+            wires on the stack, in stack order (``cq.Workplane().add(e1).add(e2).developableLoft()``).
+        **options: as in :func:`developable_loft_cq`.
+
+    Returns:
+        A new Workplane whose stack holds the ``Shell``/``Face``.
+
+    Raises:
+        GHTError: only one rail given, or not exactly two edges/wires on the stack.
+    """
+    if (rail_a is None) != (rail_b is None):
+        raise GHTError("developableLoft needs two rails: give rail_a and rail_b, or neither (the two edges on the stack)")
+    if rail_a is None:
+        rails = [o for o in self.vals() if isinstance(o, (cq.Edge, cq.Wire))]
+        if len(rails) != 2:
+            raise GHTError(f"developableLoft without rails needs exactly two edges or wires on the stack; found {len(rails)}")
+        rail_a, rail_b = rails
+    return self.newObject([developable_loft_cq(rail_a, rail_b, **options)])
+
+
 def register() -> None:
-    """Attach :func:`ghtBezier` and :func:`ghtCurve` to ``cadquery.Workplane`` (idempotent)."""
+    """Attach :func:`ghtBezier`, :func:`ghtCurve` and :func:`developableLoft` to ``cadquery.Workplane`` (idempotent)."""
     cq.Workplane.ghtBezier = ghtBezier  # type: ignore[attr-defined]
     cq.Workplane.ghtCurve = ghtCurve  # type: ignore[attr-defined]
+    cq.Workplane.developableLoft = developableLoft  # type: ignore[attr-defined]
 
 
 register()

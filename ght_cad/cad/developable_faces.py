@@ -47,6 +47,7 @@ __all__ = [
     "face_developability",
     "joint_normal_deviation",
     "shell_faces",
+    "sew_shell",
 ]
 
 
@@ -126,7 +127,19 @@ def composite_shell(composite: Any, *, tol: float | None = None, degree: int = 5
     if len(faces) == 1:
         return Shell([faces[0]])
     size = max(_size(s) for s in segs)
-    sewing = BRepBuilderAPI_Sewing(float(sew_tol if sew_tol is not None else 1e-6 * size))
+    return sew_shell(faces, float(sew_tol if sew_tol is not None else 1e-6 * size), len(faces) - 1)
+
+
+def sew_shell(faces: list, sew_tol: float, shared_edges: int) -> Any:
+    """A build123d ``Shell`` of ``faces`` sewn with ``BRepBuilderAPI_Sewing(sew_tol)``.
+
+    Raises:
+        ConversionError: sewing gave no or several shells, a number of shared edges other than
+            ``shared_edges`` (the joint rulings), or a shell that fails ``BRepCheck_Analyzer``.
+    """
+    from build123d import Shell
+
+    sewing = BRepBuilderAPI_Sewing(float(sew_tol))
     for f in faces:
         sewing.Add(unwrap(f))
     sewing.Perform()
@@ -140,8 +153,8 @@ def composite_shell(composite: Any, *, tol: float | None = None, degree: int = 5
         raise ConversionError(f"sewing the {len(faces)} developable faces gave {len(shells)} shells; expected one")
     shell = Shell(shells[0])
     shared = len(_internal_edges(shells[0]))
-    if shared != len(faces) - 1:
-        raise ConversionError(f"the sewn shell has {shared} shared edges; {len(faces) - 1} joint rulings expected")
+    if shared != shared_edges:
+        raise ConversionError(f"the sewn shell has {shared} shared edges; {shared_edges} joint rulings expected")
     if not is_valid(shell):
         raise ConversionError("the sewn shell is not a valid B-rep (BRepCheck_Analyzer)")
     return shell
@@ -185,20 +198,24 @@ def _normal(adaptor: BRepAdaptor_Surface, u: float, v: float, reversed_: bool) -
     return -vec if reversed_ else vec
 
 
-def _ruling_end_normal(ad: BRepAdaptor_Surface, s: float, w_end: float, w_other: float, rev: bool, across_u: bool) -> np.ndarray:
-    """OCCT normal at the end ``w_end`` of the ruling at ``s``; at a cone apex (a collapsed edge,
-    e.g. a loft's fan, where the normal is undefined) the normal 1e-6 of the ruling inside, which on
-    a developable is the same (the tangent plane is constant along a ruling)."""
-    def at(frac: float) -> np.ndarray:
-        w = w_end + frac * (w_other - w_end)
-        return _normal(ad, w, s, rev) if across_u else _normal(ad, s, w, rev)
+def _ruling_end_normal(ad: BRepAdaptor_Surface, s: float, w: float, w_other: float, rev: bool, across_u: bool) -> np.ndarray:
+    """Normal at the end ``w`` of the ruling at ``s``. Where the boundary curve there is collapsed
+    (the apex of a cone-like fan: the derivative across the ruling is below 1e-9 of the one along
+    it) the normal is taken ``1e-6`` of the ruling inward: a developable's tangent plane is
+    constant along the ruling, so that is the limit normal (OCCT's normal at the singular point
+    itself can point anywhere: 70° off on a fan face, so a merely defined normal is not enough)."""
+    from OCP.gp import gp_Pnt, gp_Vec
 
+    x = w
     for frac in (0.0, 1e-6):
-        try:
-            return at(frac)
-        except GHTError:
-            pass
-    return at(1e-4)
+        x = w + frac * (w_other - w)
+        uv = (x, s) if across_u else (s, x)
+        p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+        ad.D1(uv[0], uv[1], p, du, dv)
+        along, across = (du, dv) if across_u else (dv, du)
+        if across.Magnitude() > 1e-9 * along.Magnitude():
+            break
+    return _normal(ad, *((x, s) if across_u else (s, x)), rev)
 
 
 def face_developability(face: Any, rulings: int = 129) -> FaceDevelopability:
@@ -206,7 +223,9 @@ def face_developability(face: Any, rulings: int = 129) -> FaceDevelopability:
 
     The ruling direction is the parameter direction of degree 1 of the face's B-spline surface
     (``BRep_Tool.Surface``); for every sampled parameter ``s`` of the other direction the normals
-    ``n(s, w_min)`` and ``n(s, w_max)`` (``BRepLProp_SLProps``) give ``θ(s) = angle``.
+    ``n(s, w_min)`` and ``n(s, w_max)`` (``BRepLProp_SLProps``) give ``θ(s) = angle``; at an end
+    where the boundary is collapsed (the apex of a cone-like fan) the normal ``1e-6`` of the ruling
+    inward is used (:func:`_ruling_end_normal`).
 
     Raises:
         GHTError: a shape without a face, or a surface of degree > 1 in both directions.
