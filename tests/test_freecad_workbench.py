@@ -151,6 +151,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     expected = {
         "GHT_Curve", "GHT_CompositeCurve", "GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern",
         "GHT_Optimization", "GHT_RunOptimization", "GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG",
+        "GHT_DevelopableLoft",
     }
     assert expected <= set(res["commands"]), res["commands"]
     assert all(res["commands"].values()), res["commands"]
@@ -193,6 +194,10 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
         panel = "ShapeParameterPanel" if kind == "GHT::JoinedDevelopable" else "MessagePanel"
         assert info["handled"] and info["dialog"] and info["panel"] == panel, (kind, info)
         assert prop in info["message"] and "link" in info["message"], (kind, info)
+    lf = steps["GHT_DevelopableLoft"]["value"]  # two selected sketch edges (circles of a cone)
+    assert lf["segments"] == ["main"] and lf["faces"] == 1 and lf["icon"], lf
+    assert "RailA = RimA.Edge1" in lf["report"] and "fan share 0" in lf["report"], lf
+    assert "RailB is not linked" in lf["unset"] and "Traceback" not in lf["unset"], lf
     r = steps["reopen"]["value"]
     assert r["objects"] == 9 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]

@@ -56,7 +56,11 @@ class OCPCurveRail:
 
     ``r(t) = C(p(t))``, ``p(t) = p_0 + t (p_1 - p_0)`` on the edge's parameter range (reversed
     edges run from ``p_1`` to ``p_0``), derivatives ``r^(k)(t) = (dp/dt)^k C^(k)(p(t))`` for
-    k = 1..3 from ``BRepAdaptor_Curve.DN`` (exact, the edge's location included). A wire of
+    k = 1..3, the edge's location included. Lines, circles, ellipses, Bézier and (rational)
+    B-spline curves are evaluated in closed form with numpy on the adaptor's placed geometry
+    (``O + R(cos p X + sin p Y)``, ``C = A/w`` with ``C^(k) = (A^(k) - Σ_j binom(k,j) w^(j)
+    C^(k-j)) / w``; the core evaluates millions of points); other curve types call OCCT's
+    ``BRepAdaptor_Curve.DN`` point by point. A wire of
     several edges is one curve through ``BRepAdaptor_CompCurve`` (its parameter is the sum of the
     edges' ranges; the edges should meet G1, else the loft finds no smooth branch across a kink).
 
@@ -99,6 +103,71 @@ class OCPCurveRail:
         if not (math.isfinite(p0) and math.isfinite(p1) and p1 > p0):
             raise GHTError(f"{name} has the parameter range [{p0:g}, {p1:g}]; a rail needs a bounded edge")
         self.p_range = (p0, p1)
+        self._exact = self._closed_form()
+
+    def _closed_form(self) -> Any:
+        """``f(p, k) -> C^(k)(p)`` (vectorized numpy, exact) for lines, circles, ellipses, Bézier
+        and B-spline curves (rational too) in the edge's own parameter; None for other types
+        (then OCCT's ``DN`` is called point by point)."""
+        from OCP.GeomAbs import GeomAbs_BezierCurve, GeomAbs_BSplineCurve, GeomAbs_Circle, GeomAbs_Ellipse, GeomAbs_Line
+
+        c = self._curve
+        kind = c.GetType()
+
+        def xyz(v: Any) -> np.ndarray:
+            return np.array([v.X(), v.Y(), v.Z()])
+
+        if kind == GeomAbs_Line:
+            ln = c.Line()
+            o, d = xyz(ln.Location()), xyz(ln.Direction())
+            return lambda p, k: o + p[:, None] * d if k == 0 else (np.tile(d, (p.size, 1)) if k == 1 else np.zeros((p.size, 3)))
+        if kind in (GeomAbs_Circle, GeomAbs_Ellipse):
+            if kind == GeomAbs_Circle:
+                g = c.Circle()
+                ra = rb = g.Radius()
+            else:
+                g = c.Ellipse()
+                ra, rb = g.MajorRadius(), g.MinorRadius()
+            ax = g.Position()
+            o, x, y = xyz(ax.Location()), ra * xyz(ax.XDirection()), rb * xyz(ax.YDirection())
+            # d^k/dp^k (cos p, sin p) = (cos(p + kπ/2), sin(p + kπ/2))
+            return lambda p, k: (o if k == 0 else 0.0) + np.cos(p + k * np.pi / 2)[:, None] * x + np.sin(p + k * np.pi / 2)[:, None] * y
+        if kind not in (GeomAbs_BSplineCurve, GeomAbs_BezierCurve):
+            return None
+        from scipy.interpolate import BSpline
+
+        g = c.BSpline() if kind == GeomAbs_BSplineCurve else c.Bezier()
+        if kind == GeomAbs_BSplineCurve and g.IsPeriodic():
+            g = g.Copy()  # OCP hands back the Geom_BSplineCurve; never modify the edge's own curve
+            g.SetNotPeriodic()
+        n = g.NbPoles()
+        poles = np.array([xyz(g.Pole(i)) for i in range(1, n + 1)])
+        w = np.array([g.Weight(i) for i in range(1, n + 1)]) if g.IsRational() else np.ones(n)
+        if kind == GeomAbs_BSplineCurve:
+            knots = np.array([g.KnotSequence().Value(i) for i in range(1, g.KnotSequence().Length() + 1)])
+        else:
+            knots = np.r_[np.zeros(n), np.ones(n)]
+        deg = g.Degree()
+        lo, hi = knots[deg], knots[-deg - 1]
+        p0, p1 = self.p_range
+        if p0 < lo - 1e-12 * (hi - lo) or p1 > hi + 1e-12 * (hi - lo):
+            return None
+        sp = BSpline(knots, np.column_stack([poles * w[:, None], w]), deg, extrapolate=False)
+
+        def f(p: np.ndarray, k: int) -> np.ndarray:
+            # C = A / w: C^(k) = (A^(k) - Σ_{j=1..k} binom(k, j) w^(j) C^(k-j)) / w
+            q = np.clip(p, lo, hi)
+            H = [sp(q, j) for j in range(k + 1)]
+            W = [h[:, 3:] for h in H]
+            C: list[np.ndarray] = []
+            for r in range(k + 1):
+                acc = H[r][:, :3].copy()
+                for j in range(1, r + 1):
+                    acc -= math.comb(r, j) * W[j] * C[r - j]
+                C.append(acc / W[0])
+            return C[k]
+
+        return f
 
     def _param(self, t: np.ndarray) -> tuple[np.ndarray, float]:
         p0, p1 = self.p_range
@@ -116,6 +185,8 @@ class OCPCurveRail:
             raise GHTError(f"order={order!r} is not allowed; an edge rail gives derivatives of order 0..3")
         tt, _ = as_parameter_array(t, "t")
         p, dp = self._param(tt)
+        if self._exact is not None:
+            return self._exact(p, order) * dp**order
         c = self._curve
         out = np.empty((tt.size, 3))
         if order == 0:

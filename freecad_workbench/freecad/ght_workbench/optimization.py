@@ -9,6 +9,10 @@ Problems (``ght_cad.optimize.problems``), chosen by ``Problem`` and the ``Target
   measures of the dual curve of the (normalized) control planes.
 * ``Developability``, two GHT curve targets: :class:`StripProblem`, ``R = ∫(1 - n_a·n_b) du`` of the
   ruled strip between them (parameters ``a.mu ... b.gamma``).
+* ``Loft``, one *Developable loft* target whose two rails are GHT curves:
+  :class:`ght_cad.loft.LoftProblem` over the rails' ``a.mu ... b.gamma``, objective
+  ``WeightFanShare · fan share + WeightRulingFairness · ∫|d'|² + WeightRegression · (edge of
+  regression penalty)`` of the exact developable loft (+inf where none exists).
 
 Recomputing the feature only evaluates the objective at the targets' current parameters
 (``CurrentValue``); :meth:`OptimizationFeature.run` (command *Run optimization*) runs PSO / GWO /
@@ -26,7 +30,9 @@ from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_
 
 __all__ = ["OptimizationFeature", "make_optimization", "run_optimization", "PROBLEMS", "METHODS"]
 
-PROBLEMS = ["Fairness", "Developability"]
+PROBLEMS = ["Fairness", "Developability", "Loft"]
+#: Loft objective weights: property -> LoftProblem objective name
+LOFT_WEIGHTS = {"WeightFanShare": "fan_share", "WeightRulingFairness": "fairness", "WeightRegression": "regression"}
 METHODS = ["hybrid", "igwo", "pso", "gwo", "de"]
 _OUT = ("InitialValue", "BestValue", "CurrentValue", "Evaluations", "Status", "BestParameters")
 
@@ -42,13 +48,14 @@ class OptimizationFeature(FeatureProxy):
 
     def setup(self, obj: Any) -> None:
         obj.addProperty("App::PropertyLinkList", "Targets", "Problem", "Driven features: one GHT curve or developable (Fairness), two GHT curves (Developability)")
-        obj.addProperty("App::PropertyEnumeration", "Problem", "Problem", "Fairness (AL/En/CVEn) or Developability (R of the strip between two curves)")
+        obj.addProperty("App::PropertyEnumeration", "Problem", "Problem", "Fairness (AL/En/CVEn), Developability (R of the strip between two curves) or Loft (a developable loft's fan share, ruling fairness, edge of regression)")
         obj.Problem = PROBLEMS
         obj.addProperty("App::PropertyStringList", "Free", "Problem", "Free parameter names (empty: all), e.g. mu, gamma or a.mu, b.nu")
         obj.addProperty("App::PropertyFloat", "WeightAL", "Problem", "Weight of the arc length AL = ∫|X'| (Fairness)")
         obj.addProperty("App::PropertyFloat", "WeightEn", "Problem", "Weight of the bending energy En = ∫|X''|² (Fairness)")
         obj.addProperty("App::PropertyFloat", "WeightCVEn", "Problem", "Weight of the curvature variation CVEn = ∫|X'''|² (Fairness)")
         obj.WeightEn = 1.0
+        self.add_loft_weights(obj)
         obj.addProperty("App::PropertyEnumeration", "Method", "Optimizer", "hybrid (Sobol starts + L-BFGS-B, default), igwo, pso, gwo or de (scipy differential evolution)")
         obj.Method = METHODS
         obj.addProperty("App::PropertyInteger", "PopulationSize", "Optimizer", "Population size")
@@ -67,6 +74,24 @@ class OptimizationFeature(FeatureProxy):
 
     def restored(self, obj: Any) -> None:
         set_read_only(obj, _OUT)
+        self.add_loft_weights(obj)  # files saved before the Loft problem existed
+        if "Loft" not in obj.getEnumerationsOfProperty("Problem"):
+            current = obj.Problem
+            obj.Problem = PROBLEMS
+            obj.Problem = current
+
+    @staticmethod
+    def add_loft_weights(obj: Any) -> None:
+        """Add the Loft objective weights (fan share 1, the others 0) if missing."""
+        tips = {
+            "WeightFanShare": "Weight of the fan share of the loft's area (Loft: 0 = rulings end to end)",
+            "WeightRulingFairness": "Weight of the ruling field's fairness ∫|d'|² (Loft)",
+            "WeightRegression": "Weight of the edge-of-regression penalty (Loft: keeps it away from the rails)",
+        }
+        for prop, tip in tips.items():
+            if prop not in obj.PropertiesList:
+                obj.addProperty("App::PropertyFloat", prop, "Problem", tip)
+                setattr(obj, prop, 1.0 if prop == "WeightFanShare" else 0.0)
 
     # -- problem ------------------------------------------------------------------------
     def problem(self, obj: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
@@ -83,6 +108,8 @@ class OptimizationFeature(FeatureProxy):
             prob = StripProblem(core_curve(targets[0], placed=True), core_curve(targets[1], placed=True), free=free)
             mapping = [(targets[i], p, f"{s}.{p.lower()}") for i, s in enumerate("ab") for p in ("Mu", "Nu", "Gamma")]
             return prob, mapping
+        if obj.Problem == "Loft":
+            return self.loft_problem(obj, targets, free)
         if len(targets) != 1:
             raise ValueError(f"{obj.Label}: Fairness needs exactly one target (a GHT curve or a developable), got {len(targets)}")
         weights = {"AL": float(obj.WeightAL), "En": float(obj.WeightEn), "CVEn": float(obj.WeightCVEn)}
@@ -95,6 +122,28 @@ class OptimizationFeature(FeatureProxy):
         else:
             raise ValueError(f"{t.Label} is a {_kind(t) or t.TypeId}; Fairness drives a GHT curve or a developable from planes")
         return prob, [(t, p, p.lower()) for p in ("Mu", "Nu", "Gamma")]
+
+    def loft_problem(self, obj: Any, targets: list, free: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
+        """(:class:`ght_cad.loft.LoftProblem`, mapping to the rails' Mu/Nu/Gamma) of one loft target."""
+        from ght_cad.loft import LoftProblem
+
+        from .ght_curve import core_curve
+
+        if len(targets) != 1 or _kind(targets[0]) != "GHT::DevelopableLoft":
+            raise ValueError(f"{obj.Label}: Loft needs exactly one Developable loft target, got {[t.Label for t in targets]}")
+        loft = targets[0]
+        rails = [getattr(loft, n)[0] if getattr(loft, n) else None for n in ("RailA", "RailB")]
+        for n, r in zip(("RailA", "RailB"), rails):
+            if r is None or _kind(r) != "GHT::Curve":
+                raise ValueError(
+                    f"{obj.Label}: {loft.Label}.{n} is {'not linked' if r is None else r.Label + ', not a GHT curve'}; "
+                    "Loft optimizes the shape parameters of GHT curve rails"
+                )
+        weights = {name: float(getattr(obj, prop)) for prop, name in LOFT_WEIGHTS.items() if float(getattr(obj, prop)) != 0.0}
+        opts = {"orientation": str(loft.Orientation), "samples": 33}
+        prob = LoftProblem(core_curve(rails[0], placed=True), core_curve(rails[1], placed=True), objective=weights, free=free, loft_options=opts)
+        mapping = [(rails[i], p, f"{s}.{p.lower()}") for i, s in enumerate("ab") for p in ("Mu", "Nu", "Gamma")]
+        return prob, mapping
 
     def check_settings(self, obj: Any) -> None:
         """Refuse optimizer settings the core would refuse, naming the property.
@@ -212,7 +261,8 @@ class CommandOptimization(BaseCommand):
     tooltip = (
         "Create an optimization of the selected features' shape parameters: one GHT curve or "
         "developable -> fairness (AL/En/CVEn weights); two GHT curves -> developability R of the "
-        "strip between them. Run it with 'Run optimization'."
+        "strip between them; a developable loft on GHT curve rails -> fan share / ruling fairness / edge of "
+        "regression of the loft. Run it with 'Run optimization'."
     )
 
     def IsActive(self) -> bool:
@@ -223,11 +273,14 @@ class CommandOptimization(BaseCommand):
     def Activated(self) -> None:
         import FreeCADGui as Gui
 
-        sel = [o for o in Gui.Selection.getSelection() if _kind(o) in ("GHT::Curve", "GHT::Developable")]
+        sel = [o for o in Gui.Selection.getSelection() if _kind(o) in ("GHT::Curve", "GHT::Developable", "GHT::DevelopableLoft")]
         if not sel:
-            App.Console.PrintError("GHT optimization: select one or two GHT curves or a developable\n")
+            App.Console.PrintError("GHT optimization: select one or two GHT curves, a developable or a developable loft\n")
             return
-        problem = "Developability" if len(sel) == 2 and all(_kind(o) == "GHT::Curve" for o in sel) else "Fairness"
+        if _kind(sel[0]) == "GHT::DevelopableLoft":
+            problem = "Loft"
+        else:
+            problem = "Developability" if len(sel) == 2 and all(_kind(o) == "GHT::Curve" for o in sel) else "Fairness"
         doc = App.ActiveDocument
         doc.openTransaction("Optimization")
         obj = make_optimization(sel if problem == "Developability" else sel[:1], problem, doc=doc)

@@ -267,6 +267,47 @@ def main():
         step("GHT_Developable", generic("GHT_Developable", None, "GHT::Developable", "developable"))
     if "GHT_SpineDevelopable" in _base.COMMANDS:
         step("GHT_SpineDevelopable", generic("GHT_SpineDevelopable", "curve", "GHT::SpineDevelopable", "spine"))
+    if "GHT_DevelopableLoft" in _base.COMMANDS:
+        def loft():
+            # two sketch edges selected as a user would, in their own document (the main check's
+            # object count stays), then double-click: the panel shows the report; unset: a message
+            import Part
+
+            ldoc = App.newDocument("LoftCheck")
+            sketches = []
+            for name, r, z in (("RimA", 5.0, 0.0), ("RimB", 2.0, 6.0)):
+                sk = ldoc.addObject("Sketcher::SketchObject", name)
+                sk.Placement = App.Placement(App.Vector(0, 0, z), App.Rotation())
+                sk.addGeometry(Part.Circle(App.Vector(0, 0, 0), App.Vector(0, 0, 1), r), False)
+                sketches.append(sk)
+            ldoc.recompute()
+            try:
+                Gui.Selection.clearSelection()
+                for sk in sketches:  # the edges themselves, as a click in the 3-D view selects them
+                    Gui.Selection.addSelection(sk, "Edge1")
+                before = {o.Name for o in ldoc.Objects}
+                Gui.runCommand("GHT_DevelopableLoft", 0)
+                ldoc.recompute()
+                created = new_objects(ldoc, before)
+                ok = all(o.Shape.isValid() for o in created)
+                lf = [o for o in created if o.Proxy.Type == "GHT::DevelopableLoft"][0]
+                Gui.ActiveDocument.setEdit(lf.Name, 0)
+                from freecad.ght_workbench.developable_loft import LoftPanel
+
+                report = LoftPanel.last.message if Gui.Control.activeDialog() else ""
+                Gui.Control.closeDialog()
+                Gui.ActiveDocument.resetEdit()
+                lf.RailB = None  # unset link: a message, not a traceback (the recompute is not run)
+                Gui.ActiveDocument.setEdit(lf.Name, 0)
+                unset = LoftPanel.last.message if Gui.Control.activeDialog() else ""
+                return {"created": len(created), "valid": ok, "segments": list(lf.Segments), "faces": len(lf.Shape.Faces),
+                        "report": report, "unset": unset, "icon": os.path.isfile(lf.ViewObject.Proxy.getIcon())}
+            finally:
+                if Gui.Control.activeDialog():
+                    Gui.Control.closeDialog()
+                App.closeDocument(ldoc.Name)
+                App.setActiveDocument(doc.Name)
+        step("GHT_DevelopableLoft", loft)
     if "GHT_FlatPattern" in _base.COMMANDS and "developable" in ctx:
         step("GHT_FlatPattern", generic("GHT_FlatPattern", "developable", "GHT::FlatPattern", "flat"))
     if "GHT_Optimization" in _base.COMMANDS and "developable" in ctx:
