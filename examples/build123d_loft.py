@@ -1,12 +1,15 @@
 r"""build123d: a round-to-oval duct transition as the exact developable loft between two edges.
 
 The inlet is a circle of radius 100 (z = 0), the outlet an ellipse 160 × 60 at z = 250, shifted by
-40 in x. Both rails are plain build123d edges (a circle and an ellipse). The rulings pair points
+40 in x. The duct is made of two mirror-image halves (a seam on each side, as sheet-metal
+transitions are); one half is lofted between two plain build123d edges: the half circle and the
+half ellipse. The rulings pair points
 where the two tangents are parallel (the tangent-plane condition ``det(a', b', b - a) = 0`` of spec
 5.7 for rails in parallel planes), so the transition is developable and unrolls into ONE flat
 panel with no stretch: the sheet-metal blank, written as DXF/SVG/PNG with bend lines along the
-rulings. Algebra mode gives the surface (one B-spline face, closed by a seam); builder mode
-thickens it into a 2 mm sheet solid.
+rulings. Algebra mode gives the surface (one B-spline face); builder mode thickens it into a 2 mm
+sheet solid. (A loft of the full closed rails is one face closed by a seam; OCCT's thickening of
+such a seam face gives a wrong volume, so sheets are made from the halves.)
 
 Checks (returned by :func:`main`): θ of the core loft and of the STEP face, the flat area against
 the STEP face area, the rails covered by the face's edges.
@@ -34,8 +37,8 @@ def main(out_dir: str | Path) -> dict[str, Any]:
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    inlet = Edge.make_circle(R_IN)
-    outlet = Edge.make_ellipse(A_OUT, B_OUT, Plane.XY.offset(H).shift_origin((SHIFT, 0, H)))
+    inlet = Edge.make_circle(R_IN, start_angle=0, end_angle=180)
+    outlet = Edge.make_ellipse(A_OUT, B_OUT, Plane.XY.offset(H).shift_origin((SHIFT, 0, H)), start_angle=0, end_angle=180)
 
     # algebra mode: the surface itself
     duct = developable_loft(inlet, outlet)

@@ -320,18 +320,19 @@ def test_builder_mode_adds_pending_faces(cone_pair) -> None:
             developable_loft(ea, eb)
 
 
-def test_builder_thicken_gives_a_valid_solid(cone_pair) -> None:
-    """A loft's faces in BuildPart thicken into a sheet of the stated thickness (a frustum wall)."""
+def test_builder_thicken_gives_a_valid_solid() -> None:
+    """A half cone's loft faces in BuildPart thicken into a sheet: |V - T A| <= T A · T max|H|
+    (offset volume T A + T² ∫H dA; mean curvature H = 1/(2 r) <= 1/4 for radii r >= 2)."""
     from build123d import thicken
 
-    ea, eb = cone_pair
+    ea = Edge.make_circle(5.0, start_angle=0, end_angle=180)
+    eb = Edge.make_circle(2.0, Plane.XY.offset(6.0), start_angle=0, end_angle=180)
     with BuildPart() as part:
-        developable_loft(ea, eb)
+        shape = developable_loft(ea, eb)
         thicken(amount=0.2)
     assert part.part.is_valid
-    # wall of a frustum: volume ≈ lateral area × thickness (to O(thickness × curvature))
-    area = ght_cad.unroll(developable_loft(ea, eb).ght_loft).area
-    assert abs(part.part.volume - 0.2 * area) <= 0.05 * 0.2 * area
+    area = ght_cad.unroll(shape.ght_loft).area
+    assert abs(part.part.volume - 0.2 * area) <= (0.2 * 0.25) * 0.2 * area
 
 
 # -- cadquery -----------------------------------------------------------------------------------
@@ -377,7 +378,7 @@ def test_example_build123d_loft(tmp_path) -> None:
     assert res["valid"] and res["sheet_valid"]
     assert res["theta_core_deg"] <= 1e-8 and res["theta_step_deg"] <= THETA_STEP_DEG
     assert res["area_rel_error"] <= AREA_REL
-    # the 2 mm sheet: volume = T × area to O(T × curvature) (radii >= 22 here)
-    assert abs(res["sheet_volume"] - mod.T * res["flat_area"]) <= 0.1 * mod.T * res["flat_area"]
+    # the 2 mm sheet: volume = T × area to O(T / radius) (radii >= 22 here: within 2%)
+    assert abs(res["sheet_volume"] - mod.T * res["flat_area"]) <= 0.02 * mod.T * res["flat_area"]
     ezdxf.readfile(res["dxf"])
     assert Path(res["svg"]).stat().st_size > 0 and Path(res["png"]).stat().st_size > 0
