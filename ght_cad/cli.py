@@ -453,11 +453,14 @@ def cmd_unroll(args: argparse.Namespace) -> int:
         if val is not None:
             raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file: give the sheet "
                              "in its [sheet] table); allowed for design files: --dxf, --svg, --png, --forming-png, --json")
-    from .design import build_surface, unroll_surface
+    from .design import build_surfaces, unroll_surfaces
 
     design = _load(args)
-    built = build_surface(design)
-    pattern = unroll_surface(built)
+    if not design.surfaces:
+        from .design import build_surface
+
+        build_surface(design)  # the error naming the missing [surface]
+    pattern = unroll_surfaces(build_surfaces(design))
     result: dict[str, Any] = {"command": "unroll", "name": design.name, "errors": _errors_dict(pattern), "outputs": {}}
     _sheet_result(result, pattern)
     result["outputs"] = _write_pattern(args, pattern, design.name)

@@ -137,12 +137,12 @@ def test_export_unknown_suffix(cone: Path, tmp_path: Path, capsys) -> None:
 
 
 def test_optimize_command(tmp_path: Path, capsys) -> None:
-    rc, res, _ = run_json(["optimize", str(EXAMPLES / "design_hull_plate.toml"), "--iterations", "4",
+    rc, res, _ = run_json(["optimize", str(EXAMPLES / "design_hull_plate_quasi.toml"), "--iterations", "4",
                            "--population", "8", "--method", "gwo", "--plot", str(tmp_path / "cv.png")], capsys)
     assert rc == 0 and res["method"] == "gwo" and res["objective"] == "R"
     assert res["best_value"] <= res["initial_value"]
     assert len(res["history"]) == 5 and (tmp_path / "cv.png").exists()
-    rc, res, err = run_json(["optimize", str(EXAMPLES / "design_hull_plate.toml"), "--objective", "AL"], capsys)
+    rc, res, err = run_json(["optimize", str(EXAMPLES / "design_hull_plate_quasi.toml"), "--objective", "AL"], capsys)
     assert rc == EXIT_USAGE and "'optimize.objective'" in err and "allowed: R" in err
 
 

@@ -204,10 +204,12 @@ def test_optimize_block_validation() -> None:
             parse_design({**base, "optimize": bad}, "f.toml")
 
 
-@pytest.mark.parametrize("name", ["design_duct.toml", "design_hull_plate.toml", "design_duct_two_strips.toml"])
+@pytest.mark.parametrize("name", ["design_duct.toml", "design_hull_plate.toml", "design_hull_plate_quasi.toml",
+                                  "design_duct_two_strips.toml", "design_dory_multichine.toml",
+                                  "design_hopper_transition.toml"])
 def test_example_designs_validate(name: str) -> None:
     d = load_design(Path(__file__).parent.parent / "examples" / name)
-    assert d.surface is not None
+    assert d.surfaces and (d.surface is not None) == (len(d.surfaces) == 1)
 
 
 def test_embedded_default_design_validates() -> None:
@@ -381,7 +383,7 @@ def test_step_declares_the_design_units(tmp_path) -> None:
 
 def test_hull_plate_header_describes_its_join() -> None:
     """The example's comment header names the join the file really has (sheer -> stem, G1)."""
-    path = Path(__file__).resolve().parent.parent / "examples" / "design_hull_plate.toml"
+    path = Path(__file__).resolve().parent.parent / "examples" / "design_hull_plate_quasi.toml"
     header = " ".join(ln.lstrip("# ").strip() for ln in path.read_text().splitlines() if ln.startswith("#"))
     d = load_design(path)
     assert [(j.first, j.second, j.continuity, j.k) for j in d.joins] == [("sheer", "stem", "G1", 0.8)]
@@ -421,7 +423,7 @@ def test_optimized_curve_strip_exports_the_optimized_curves(tmp_path: Path) -> N
     from ght_cad.cad.occ import read_step
     from ght_cad.design import build_curves, build_surface
 
-    text = (EXAMPLES / "design_hull_plate.toml").read_text()
+    text = (EXAMPLES / "design_hull_plate_quasi.toml").read_text()
     text = text.replace('continuity = "G1"\nk = 0.8', 'continuity = "G2"\nk = 0.8')
     text = text.replace("population = 16\niterations = 25", "population = 8\niterations = 6")
     text = text.replace('files = ["step", "dxf", "svg", "json", "md"]', 'files = ["step", "json"]')
@@ -473,7 +475,7 @@ def test_boundary_curve_that_is_a_join_second_is_rejoined_per_candidate() -> Non
     is R of the strip rebuilt from build_curves(design, shape), and the join stays G2."""
     from ght_cad.design import build_curves, build_surface, optimize_design
 
-    text = (EXAMPLES / "design_hull_plate.toml").read_text()
+    text = (EXAMPLES / "design_hull_plate_quasi.toml").read_text()
     text = text.replace('first = "sheer"\nsecond = "stem"\ncontinuity = "G1"', 'first = "stem"\nsecond = "sheer"\ncontinuity = "G2"')
     text = text.replace("[[4500, -1100, 1300], [5200, -800, 1450], [5800, -200, 1600]]",
                         "[[-1500, -700, 1000], [-800, -850, 1150], [0, -900, 1200]]")

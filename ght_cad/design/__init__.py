@@ -1,8 +1,9 @@
 r"""Design files (TOML): schema, validation and the pipeline runner behind ``ght-cad run``/``demo``.
 
 A design file describes GHT-Bézier curves (control points and shape parameters, optional joins),
-one surface (an enveloping developable from control planes, spec 5.2, a ruled strip between two
-curves, or a composite of developable strips joined G1/G2/G3, spec 5.6), an optional
+one surface or several named ones (an enveloping developable from control planes, spec 5.2, a
+ruled strip between two curves, the exact developable loft between two rails, spec 5.7, or a
+composite of developable strips joined G1/G2/G3, spec 5.6), an optional
 shape-parameter optimization (of one strip, or of every strip of a composite with its joints kept) and the
 outputs to write. The schema is
 documented in ``docs/design-files.md``; :func:`parse_design` validates a parsed file completely
@@ -22,7 +23,7 @@ functions that need them.
 The package follows the pipeline, one module per stage:
 
 * :mod:`~ght_cad.design.schema`: the dataclasses and :func:`parse_design` / :func:`load_design`;
-* :mod:`~ght_cad.design.build`: curves (joins applied and measured) and the surface;
+* :mod:`~ght_cad.design.build`: curves (joins applied and measured) and the surface(s);
 * :mod:`~ght_cad.design.objectives` and :mod:`~ght_cad.design.optimize`: fairness / developability
   objectives and :func:`optimize_design`;
 * :mod:`~ght_cad.design.outputs`: B-rep, STEP, flat pattern and :func:`export_files`;
@@ -49,6 +50,8 @@ from .schema import (  # noqa: F401
     OptimizeSpec,
     OutputSpec,
     PLANE_OBJECTIVES,
+    RAILS_OBJECTIVES,
+    RAIL_ORIENTATIONS,
     SHAPE_NAMES,
     STRIP_JOINS,
     STRIP_OBJECTIVES,
@@ -57,6 +60,7 @@ from .schema import (  # noqa: F401
     SurfaceSpec,
     UNITS,
     UnrollSpec,
+    default_objective,
     load_design,
     parse_design,
     parse_design_text,
@@ -66,10 +70,13 @@ from .schema import (  # noqa: F401
     _composite_parameters,
     _objectives_for,
     _parse_composite,
+    _parse_surface,
+    _parse_surfaces,
     _range_text,
     _shape_names,
     _short,
     _tname,
+    _weight_names,
 )
 from .objectives import (  # noqa: F401
     composite_dual_objectives,
@@ -82,19 +89,27 @@ from .build import (  # noqa: F401
     GHT_DEFINITION,
     build_curves,
     build_surface,
+    build_surfaces,
+    make_loft,
     ruled_area,
+    surface_area,
+    surface_designs,
     surface_summary,
     surface_view,
+    surfaces_summary,
     _CompositeView,
     _composite_summary,
     _developability_dict,
     _initial_shape,
     _is_composite,
+    _is_loft,
     _joined_curves,
     _make_composite,
     _make_surface,
+    _worst,
 )
 from .optimize import (  # noqa: F401
+    CANDIDATE_LOFT_SAMPLES,
     OptimizationOutcome,
     composite_objective,
     optimize_design,
@@ -102,19 +117,23 @@ from .optimize import (  # noqa: F401
     _composite_candidate,
     _composite_joint_rows,
     _objective_fn,
+    _rails_objective_fn,
 )
 from .outputs import (  # noqa: F401
     brep_face,
     brep_shape,
+    brep_shapes,
     curve_edges,
     export_files,
     export_step,
     pattern_errors,
     pattern_report,
     plot_pattern,
+    sew_shell,
     shared_edge_count,
     unroll_surface,
     plate_solids,
+    unroll_surfaces,
     _export_one,
     _jsonable,
     _ruled_face,
@@ -122,6 +141,8 @@ from .outputs import (  # noqa: F401
 from .report import (  # noqa: F401
     report_markdown,
     _f,
+    _strips_section,
+    _surface_section,
 )
 from .run import (  # noqa: F401
     run_design,
@@ -156,8 +177,14 @@ __all__ = [
     "parse_design_text",
     "build_curves",
     "build_surface",
+    "build_surfaces",
+    "surface_designs",
+    "surfaces_summary",
+    "make_loft",
     "BuiltSurface",
     "brep_shape",
+    "brep_shapes",
+    "sew_shell",
     "shared_edge_count",
     "surface_view",
     "unroll_step",
@@ -167,6 +194,7 @@ __all__ = [
     "optimize_design",
     "unroll_surface",
     "plate_solids",
+    "unroll_surfaces",
     "pattern_errors",
     "export_step",
     "export_files",

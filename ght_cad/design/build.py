@@ -4,14 +4,14 @@ r"""Building a validated design: its GHT curves (joins applied and measured) and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, Sequence
 
 import numpy as np
 
 from ..errors import GHTError
 from .objectives import dual_curve_objectives
-from .schema import SHAPE_NAMES, Design, DesignError
+from .schema import SHAPE_NAMES, Design, DesignError, SurfaceSpec
 
 
 GHT_DEFINITION = (
@@ -30,7 +30,7 @@ def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple
 
     Args:
         design: a validated design.
-        shape: for a ``curves`` surface, strip shape parameters ``{"a.mu", ..., "b.gamma"}`` (any
+        shape: for a ``curves`` or ``rails`` surface, strip shape parameters ``{"a.mu", ..., "b.gamma"}`` (any
             subset) that replace the file's ``mu, nu, gamma`` of ``curve_a`` / ``curve_b``
             *before* the joins, so that joined curves follow them (as after an optimization).
 
@@ -45,7 +45,7 @@ def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: b
     from ..curve import GHTCurve
 
     side_of: dict[str, str] = {}
-    if shape and design.surface is not None and design.surface.type == "curves":
+    if shape and design.surface is not None and design.surface.type in ("curves", "rails"):
         side_of = {str(design.surface.curve_a): "a", str(design.surface.curve_b): "b"}
     curves: dict[str, Any] = {}
     for c in design.curves:
@@ -126,11 +126,26 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
         )
     if spec.type == "composite":
         return _make_composite(design, shape)
-    from ..ruled import CurvePairRuledSurface
-
     ca = curves[spec.curve_a].with_shape(shape["a.mu"], shape["a.nu"], shape["a.gamma"])
     cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
+    if spec.type == "rails":
+        return make_loft(spec, ca, cb)
+    from ..ruled import CurvePairRuledSurface
+
     return CurvePairRuledSurface(ca, cb)
+
+
+def make_loft(spec: SurfaceSpec, rail_a: Any, rail_b: Any, **options: Any) -> Any:
+    r"""The exact developable loft of a ``rails`` surface (:func:`ght_cad.developable_loft`, spec 5.7):
+    the rulings ``a(t)–b(σ(t))`` solve ``det(a'(t), b'(s), b(s) - a(t)) = 0``, fans at the rail ends.
+
+    Raises:
+        NotDevelopableError: no developable joins the rails over their whole length (the loft
+            core's message).
+    """
+    from ..loft import developable_loft
+
+    return developable_loft(rail_a, rail_b, orientation=spec.orientation, **options)
 
 
 def _make_composite(design: Design, shape: dict[str, float]) -> Any:
@@ -162,11 +177,11 @@ def _make_composite(design: Design, shape: dict[str, float]) -> Any:
                 segs.append(join_developable(segs[-1], g.continuity or "G1", P, mu=sh["mu"], nu=sh["nu"],
                                              gamma=sh["gamma"], k=g.k, beta2=g.beta2, beta3=g.beta3))
         except GHTError as exc:
-            raise type(exc)(f"{design.source}: key 'surface.segments[{i}]' ({g.name}): {' '.join(str(exc).split())}") from None
+            raise type(exc)(f"{design.source}: key '{spec.key}.segments[{i}]' ({g.name}): {' '.join(str(exc).split())}") from None
     try:
         comp = CompositeDevelopable(segs)
     except GHTError as exc:
-        raise type(exc)(f"{design.source}: key 'surface.segments': {' '.join(str(exc).split())}") from None
+        raise type(exc)(f"{design.source}: key '{spec.key}.segments': {' '.join(str(exc).split())}") from None
     return comp
 
 
@@ -179,21 +194,14 @@ def _developability_dict(surface: Any) -> dict[str, float]:
     (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed)."""
     if not _is_composite(surface):
         return surface.developability().as_dict()
-    ds = [d.as_dict() for d in surface.developability()]
-    return {
-        "theta_max": max(d["theta_max"] for d in ds),
-        "theta_rms": float(math.sqrt(sum(d["theta_rms"] ** 2 for d in ds) / len(ds))),
-        "dd": min(d["dd"] for d in ds),
-        "R": float(sum(d["R"] for d in ds)),
-        "residual_max": max(d["residual_max"] for d in ds),
-    }
+    return _worst([d.as_dict() for d in surface.developability()])
 
 
 class _CompositeView:
     """A composite surface seen as one ruled strip for plots: ``grid`` and ``theta`` by strip."""
 
     def __init__(self, composite: Any) -> None:
-        self.segments = list(composite.segments)
+        self.segments = list(getattr(composite, "segments", composite))
 
     def _split(self, n: int) -> list[int]:
         k = len(self.segments)
@@ -208,8 +216,39 @@ class _CompositeView:
                                for s, m in zip(self.segments, self._split(n))])
 
 
-def surface_view(built: "BuiltSurface") -> Any:
-    """What :func:`ght_cad.plotting.plot_surface` draws: the surface, or all strips of a composite."""
+def surface_designs(design: Design) -> list[Design]:
+    """One single-surface design per surface of ``design`` (for a ``[surface]`` design: itself).
+
+    The surface of entry ``i`` of ``[[surfaces]]`` is built, measured and unrolled exactly as the
+    same table given as ``[surface]`` (its name is the design name of the sub-design, so panels and
+    plots are labelled with it); errors name ``surfaces[i]``.
+    """
+    if design.surface is not None and design.surfaces == [design.surface] and design.surface.name is None:
+        return [design]
+    return [replace(design, name=str(spec.name), surface=spec, surfaces=[spec], optimize=design.optimize)
+            for spec in design.surfaces]
+
+
+def build_surfaces(design: Design, curves: dict[str, Any] | None = None) -> list["BuiltSurface"]:
+    """Every surface of the design built with the file's shape parameters (:func:`build_surface`).
+
+    Raises:
+        GHTError: a surface that cannot be built; the message names ``surfaces[i]`` and the surface
+            (or ``surface``).
+    """
+    if curves is None:
+        curves, _ = build_curves(design)
+    return [build_surface(sub, curves=curves) for sub in surface_designs(design)]
+
+
+def surface_view(built: "BuiltSurface | Sequence[BuiltSurface]") -> Any:
+    """What :func:`ght_cad.plotting.plot_surface` draws: the surface, all strips of a composite, or
+    for several built surfaces all of them."""
+    if isinstance(built, (list, tuple)):
+        if len(built) == 1:
+            return surface_view(built[0])
+        parts = [x for b in built for x in (b.surface.segments if _is_composite(b.surface) else [b.surface])]
+        return _CompositeView(parts)
     return _CompositeView(built.surface) if _is_composite(built.surface) else built.surface
 
 
@@ -222,6 +261,10 @@ def build_surface(design: Design, shape: dict[str, float] | None = None,
         GHTError: degenerate geometry (parallel planes, edge of regression inside the strip, ...).
     """
     if design.surface is None:
+        if design.surfaces:
+            raise DesignError(f"{design.source}: key 'surfaces': this works on one surface and the design has "
+                              f"{len(design.surfaces)} [[surfaces]]; allowed: ght-cad run, export or unroll "
+                              "(every surface), or a design with one surface")
         raise DesignError(f"{design.source}: key 'surface': missing; this command needs a [surface] table")
     if curves is None:
         curves, _ = build_curves(design)
@@ -233,11 +276,24 @@ def build_surface(design: Design, shape: dict[str, float] | None = None,
     except DesignError:
         raise
     except GHTError as exc:
+        spec = design.surface
         msg = " ".join(str(exc).split())
-        if msg.startswith(f"{design.source}: key 'surface"):  # already names the file and key (a strip)
-            raise
-        raise type(exc)(f"{design.source}: key 'surface': {msg}") from None
+        what = f" (surface {spec.name!r})" if spec.name is not None else ""
+        if msg.startswith(f"{design.source}: key '{spec.key}"):  # already names the file and key (a strip)
+            if not what:
+                raise
+            raise type(exc)(msg + what) from None
+        raise type(exc)(f"{design.source}: key '{spec.key}'{what}: {msg}") from None
     return BuiltSurface(design, surf, curves, sh)
+
+
+def _is_loft(surface: Any) -> bool:
+    return hasattr(surface, "segments") and hasattr(surface, "report") and hasattr(surface, "breakpoints")
+
+
+def surface_area(surface: Any) -> float:
+    """3-D area: of a loft the sum over its segments (:meth:`DevelopableLoft.area`), else :func:`ruled_area`."""
+    return float(surface.area()) if _is_loft(surface) else ruled_area(surface)
 
 
 def ruled_area(surface: Any, nodes: int = 64) -> float:
@@ -270,7 +326,7 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
         "surface": {
             "type": built.design.surface.type if built.design.surface else None,
             "shape_parameters": dict(built.shape),
-            "area_3d": ruled_area(s),
+            "area_3d": surface_area(s),
             "ruling_length_min": float(np.min(s.ruling_lengths(np.linspace(0, 1, 257)))),
             "ruling_length_max": float(np.max(s.ruling_lengths(np.linspace(0, 1, 257)))),
         },
@@ -282,7 +338,33 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
         out["surface"]["boundary_planes"] = np.asarray(s.boundary_planes).tolist()
         out["surface"]["normalized"] = bool(spec.normalize)
         out["surface"]["edge_of_regression"] = "outside the strip (checked on construction)"
+    if _is_loft(s):
+        loft = s.report.as_dict()
+        loft["fairness"] = float(s.fairness())
+        loft["curve_a"], loft["curve_b"] = spec.curve_a, spec.curve_b
+        out["surface"]["loft"] = loft
     return out
+
+
+def surfaces_summary(builts: Sequence[BuiltSurface]) -> dict[str, Any]:
+    """:func:`surface_summary` of a single surface; for several, ``surfaces`` (per surface: its name
+    and summary) and ``developability``, the worst surface's per quantity (θ_max and residual max,
+    θ_rms as the root mean square over surfaces, DD min, R summed)."""
+    if len(builts) == 1:
+        return surface_summary(builts[0])
+    rows = [{"name": b.design.name, **surface_summary(b)} for b in builts]
+    return {"surfaces": rows, "developability": _worst([r["developability"] for r in rows])}
+
+
+def _worst(ds: Sequence[dict[str, float]]) -> dict[str, float]:
+    """Per quantity the worst of several developability dicts (θ_max, θ_rms, DD, R, residual_max)."""
+    return {
+        "theta_max": max(d["theta_max"] for d in ds),
+        "theta_rms": float(math.sqrt(sum(d["theta_rms"] ** 2 for d in ds) / len(ds))),
+        "dd": min(d["dd"] for d in ds),
+        "R": float(sum(d["R"] for d in ds)),
+        "residual_max": max(d["residual_max"] for d in ds),
+    }
 
 
 def _composite_summary(built: BuiltSurface) -> dict[str, Any]:

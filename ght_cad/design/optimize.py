@@ -10,10 +10,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..errors import GHTError
-from .build import _initial_shape, _joined_curves, _make_composite, _make_surface, build_curves
+from .build import _initial_shape, _joined_curves, _make_composite, _make_surface, build_curves, make_loft
 from .objectives import _gauss_legendre, composite_dual_objectives, dual_curve_objectives
 from .schema import (METHODS, SHAPE_NAMES, Design, DesignError, OptimizeSpec, _Checker, _composite_parameters,
-                     _objectives_for, _shape_names)
+                     _objectives_for, _shape_names, default_objective)
 
 
 @dataclass
@@ -148,11 +148,12 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
             return vals[spec.objective]
 
         return f
+    rejoin = bool({str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins})
+    if surf.type == "rails":
+        return _rails_objective_fn(design, curves, spec, rejoin)
     from ..ruled import developability_from_jets
 
     t, wq = _gauss_legendre(64)
-
-    rejoin = bool({str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins})
 
     def g(sh: dict[str, float]) -> float:
         # a boundary curve that is a join's 'second' is re-solved for the candidate's shape
@@ -164,6 +165,40 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
     return g
 
 
+#: rulings sampled per loft segment for the report of an optimizer candidate (the result is rebuilt
+#: with the default)
+CANDIDATE_LOFT_SAMPLES = 33
+
+
+def _rails_objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
+                        rejoin: bool) -> Callable[[dict[str, float]], float]:
+    r"""Objective of a ``rails`` surface over the rails' shape parameters: the developable loft of
+    the candidate rails (:func:`ght_cad.developable_loft`) measured by
+    :meth:`ght_cad.loft.LoftProblem.measures_of`: ``fan_share`` = fan area / loft area,
+    ``fairness`` = ``∫_0^1 |d'(λ)|² dλ`` (d the unit ruling direction), ``regression`` =
+    ``∫ max(0, 1 - c/margin)² dλ`` (c the distance of the edge-of-regression parameter ``v*`` from
+    [0, 1]), or ``weighted`` = ``w0 fan_share + w1 fairness + w2 regression``. A candidate without a
+    loft raises (``+inf`` in :func:`optimize_design`)."""
+    from ..loft import LOFT_OBJECTIVES, LoftProblem
+
+    surf = design.surface
+    assert surf is not None
+    if spec.objective == "weighted":
+        weights = {k: float(w) for k, w in zip(LOFT_OBJECTIVES, spec.weights) if w > 0}
+    else:
+        weights = {spec.objective: 1.0}
+    problem = LoftProblem(curves[surf.curve_a], curves[surf.curve_b], weights)
+
+    def h(sh: dict[str, float]) -> float:
+        cv = _joined_curves(design, sh, measure=False)[0] if rejoin else curves
+        ca = cv[surf.curve_a].with_shape(sh["a.mu"], sh["a.nu"], sh["a.gamma"])
+        cb = cv[surf.curve_b].with_shape(sh["b.mu"], sh["b.nu"], sh["b.gamma"])
+        m = problem.measures_of(make_loft(surf, ca, cb, samples=CANDIDATE_LOFT_SAMPLES))
+        return float(sum(w * m[k] for k, w in weights.items()))
+
+    return h
+
+
 def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, progress: bool = True,
                     curves: dict[str, Any] | None = None) -> OptimizationOutcome:
     r"""Minimize the design's objective over its shape parameters (box ``[-1, 1]^k``).
@@ -173,7 +208,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
     ``composite`` the sum over strips of the same measure of each strip's dual curve as built
     (after the joins, :func:`composite_dual_objectives`), every joint keeping its requested
     G1/G2/G3 order; for a ``curves`` strip the developability objective
-    ``R = ∫(1 - n_a·n_b) du`` (spec 5, 7). Optimizers: PSO, GWO, I-GWO of
+    ``R = ∫(1 - n_a·n_b) du`` (spec 5, 7); for a ``rails`` surface the loft objectives fan share,
+    ruling-field fairness ``∫|d'|²`` or edge-of-regression distance (:func:`_rails_objective_fn`)
+    over the two rails' shape parameters. Optimizers: PSO, GWO, I-GWO of
     :mod:`ght_cad.optimize` (spec 8). The start values (those of the file) are in the first
     population and the result is never worse than them; candidates whose surface degenerates
     (singular join, edge of regression inside a strip, ...) get ``+inf``.
@@ -199,7 +236,7 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         raise DesignError(f"{design.source}: key 'surface': missing; optimization needs a [surface] table")
     stype = design.surface.type
     spec = design.optimize or OptimizeSpec(
-        objective="R" if stype == "curves" else "CVEn",
+        objective=default_objective(stype),
         parameters=list(_shape_names(design.surface)),
     )
     spec = OptimizeSpec(**{**spec.__dict__})

@@ -11,7 +11,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from .build import BuiltSurface, _is_composite, build_curves, build_surface, surface_summary, surface_view
+from .build import BuiltSurface, _is_composite, build_curves, build_surfaces, surfaces_summary, surface_view
 from .schema import Design, DesignError
 
 
@@ -56,6 +56,56 @@ def brep_shape(built: BuiltSurface, tol: float | None = None) -> Any:
     return brep_face(built, tol)
 
 
+def brep_shapes(builts: Sequence[BuiltSurface], tol: float | None = None) -> Any:
+    """The B-rep of a design's surfaces: :func:`brep_shape` of a single surface; for several, every
+    face of every surface sewn into one shell (:func:`sew_shell`), so surfaces meeting along a rail
+    share that edge."""
+    if len(builts) == 1:
+        return brep_shape(builts[0], tol)
+    return sew_shell([brep_shape(b, tol) for b in builts])
+
+
+def sew_shell(shapes: Sequence[Any], sew_tol: float | None = None) -> Any:
+    """One build123d ``Shell`` of all faces of ``shapes`` sewn together (``BRepBuilderAPI_Sewing``
+    with ``sew_tol``, default ``1e-6`` times the size of the whole): edges that coincide within the
+    tolerance become one edge shared by both faces (split where the faces' edges end at different
+    points).
+
+    Raises:
+        ConversionError: the faces do not make one shell, or the shell is not valid (BRepCheck).
+    """
+    from build123d import Compound, Shell
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    from ..cad.developable_faces import shell_faces
+    from ..cad.occ import is_valid, unwrap
+    from ..errors import ConversionError
+
+    faces = [f for sh in shapes for f in shell_faces(sh)]
+    if sew_tol is None:
+        bb = Compound(list(shapes)).bounding_box()
+        sew_tol = 1e-6 * float(max(bb.size.X, bb.size.Y, bb.size.Z))
+    sewing = BRepBuilderAPI_Sewing(float(sew_tol))
+    for f in faces:
+        sewing.Add(unwrap(f))
+    sewing.Perform()
+    exp = TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
+    shells = []
+    while exp.More():
+        shells.append(TopoDS.Shell_s(exp.Current()))
+        exp.Next()
+    if len(shells) != 1:
+        raise ConversionError(f"sewing the {len(faces)} faces of the {len(shapes)} surfaces gave {len(shells)} shells; "
+                              "expected one (surfaces must meet along a common rail)")
+    shell = Shell(shells[0])
+    if not is_valid(shell):
+        raise ConversionError("the sewn shell of the surfaces is not a valid B-rep (BRepCheck_Analyzer)")
+    return shell
+
+
 def shared_edge_count(shape: Any) -> int:
     """Number of edges of a B-rep shared by two or more of its faces (``TopExp`` edge→face map)."""
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -77,20 +127,22 @@ def curve_edges(curves: dict[str, Any]) -> list[Any]:
     return [make_edge(curve_to_bspline(c)) for c in curves.values() if c.dim in (2, 3)]
 
 
-def export_step(built: BuiltSurface, path: str | os.PathLike, *, with_curves: bool = True) -> Path:
-    """Write the surface face (and the design's curves as edges) to one STEP file, atomically; with a
-    ``[sheet]`` of thickness > 0 the plate solid(s) instead of the face (:func:`plate_solids`, faces
-    named inside/outside/edgeN)."""
+def export_step(built: BuiltSurface | Sequence[BuiltSurface], path: str | os.PathLike, *,
+                with_curves: bool = True) -> Path:
+    """Write the surface face(s) (:func:`brep_shapes`: several surfaces as one sewn shell) and the
+    design's curves as edges to one STEP file, atomically; with a ``[sheet]`` of thickness > 0 the
+    plate solid(s) instead of the face (:func:`plate_solids`, faces named inside/outside/edgeN)."""
     from ..cad.occ import write_step
 
-    edges = curve_edges(built.curves) if with_curves else []
-    plates = plate_solids(built)
+    builts = list(built) if isinstance(built, (list, tuple)) else [built]
+    edges = curve_edges(builts[0].curves) if with_curves else []
+    plates = plate_solids(builts[0]) if len(builts) == 1 else []
     if plates:
         from ..cad.sheet_solid import write_plate_step
 
-        write_plate_step(plates, path, units=built.design.units, extra=edges)
+        write_plate_step(plates, path, units=builts[0].design.units, extra=edges)
         return Path(path)
-    write_step([brep_shape(built)] + edges, path, units=built.design.units)
+    write_step([brep_shapes(builts)] + edges, path, units=builts[0].design.units)
     return Path(path)
 
 
@@ -108,10 +160,11 @@ def unroll_surface(built: BuiltSurface) -> Any:
         from ..unroll import unroll_composite
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                                units=d.units, labels=[g.name for g in d.surface.segments or []], sheet=sheet)
+                                samples=d.unroll.samples, units=d.units, labels=[g.name for g in d.surface.segments or []],
+                                sheet=sheet)
     best_effort = d.surface is not None and d.surface.type == "curves"
     return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                  units=d.units, label=d.name[:24], sheet=sheet)
+                  samples=d.unroll.samples, units=d.units, label=d.name[:24], sheet=sheet)
 
 
 def plate_solids(built: BuiltSurface) -> list[Any]:
@@ -125,6 +178,30 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
     sheet = d.sheet.to_sheet()
     parts = built.surface.segments if _is_composite(built.surface) else [built.surface]
     return [plate_solid(s, sheet, label=f"{d.name} part {i + 1}") for i, s in enumerate(parts)]
+
+
+def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
+    """Flat pattern of a design's surfaces: :func:`unroll_surface` of a single surface; for several,
+    one labelled panel per surface (per strip for a composite: ``<surface>.<strip>``) on one sheet
+    (:func:`ght_cad.unroll.unroll_composite`: panels laid side by side, matching edge marks ``E<k>``
+    on the edges two panels share in 3-D, e.g. a common rail)."""
+    if len(builts) == 1:
+        return unroll_surface(builts[0])
+    from ..unroll import unroll_composite
+
+    d = builts[0].design
+    parts: list[Any] = []
+    labels: list[str] = []
+    for b in builts:
+        if _is_composite(b.surface):
+            parts += list(b.surface.segments)
+            labels += [f"{b.design.name}.{g.name}" for g in b.design.surface.segments or []]
+        else:
+            parts.append(b.surface)
+            labels.append(b.design.name)
+    best_effort = any(b.design.surface is not None and b.design.surface.type == "curves" for b in builts)
+    return unroll_composite(parts, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                            samples=d.unroll.samples, units=d.units, labels=labels)
 
 
 def pattern_report(pattern: Any) -> dict[str, Any]:
@@ -202,8 +279,8 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
         if f.suffix.lower() not in allowed:
             raise DesignError(f"{f}: unknown output suffix {f.suffix!r}; allowed: {', '.join(allowed)}")
     curves, _ = build_curves(design)
-    built = build_surface(design, curves=curves) if design.surface is not None else None
-    if built is None:
+    builts = build_surfaces(design, curves)
+    if not builts:
         for f in files:
             if f.suffix.lower() in (".dxf", ".svg"):
                 raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
@@ -213,14 +290,14 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
         out: dict[str, str] = {}
         pattern = None
         for f in files:
-            pattern = _export_one(design, curves, built, f, stage.path(f), pattern)
+            pattern = _export_one(design, curves, builts, f, stage.path(f), pattern)
             suf = f.suffix.lower().lstrip(".")
             out[suf + (f"_{len(out)}" if suf in out else "")] = str(f)
         stage.commit()
     return out
 
 
-def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | None, target: Path,
+def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurface], target: Path,
                 tmp: Path, pattern: Any) -> Any:
     """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
     import json
@@ -229,28 +306,28 @@ def _export_one(design: Design, curves: dict[str, Any], built: BuiltSurface | No
 
     suf = target.suffix.lower()
     if suf in (".step", ".stp"):
-        if built is not None:
-            export_step(built, tmp)
+        if builts:
+            export_step(builts, tmp)
         else:
             from ..cad.occ import write_step
 
             write_step(curve_edges(curves), tmp, units=design.units)
     elif suf in (".dxf", ".svg"):
-        pattern = pattern or unroll_surface(built)
+        pattern = pattern or unroll_surfaces(builts)
         (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp)
     elif suf == ".json":
         summ = {"name": design.name, "units": design.units}
-        summ.update(surface_summary(built) if built is not None else {})
+        summ.update(surfaces_summary(builts) if builts else {})
         summ["curves"] = {k: c.to_dict() for k, c in curves.items()}
-        if built is not None:
-            pattern = pattern or unroll_surface(built)
+        if builts:
+            pattern = pattern or unroll_surfaces(builts)
             summ["flat_pattern"] = pattern_report(pattern)
         write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
     else:
         from ..plotting import plot_curve, plot_surface
 
-        if built is not None:
-            plot_surface(surface_view(built), tmp, title=design.name)
+        if builts:
+            plot_surface(surface_view(builts), tmp, title=design.name)
         else:
             plot_curve(list(curves.values()), tmp)
     return pattern

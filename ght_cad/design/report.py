@@ -32,36 +32,14 @@ def report_markdown(r: dict[str, Any]) -> str:
                      f"{'yes' if j['satisfied'] else 'NO'} |")
         L.append("")
     if r.get("surface"):
-        s = r["surface"]
-        L += ["## Surface", "", f"Type: `{s['type']}` · shape parameters: "
-              + ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
-              + f" · area {s['area_3d']:.9g} {r['units']}² · ruling length {s['ruling_length_min']:.6g}–"
-              f"{s['ruling_length_max']:.6g} {r['units']}", ""]
-        L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
-        for label, key in (("initial", "developability_initial"), ("final", "developability")):
-            d = r.get(key)
-            if d:
-                L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
-        L.append("")
+        L += _surface_section(r["surface"], r, "Surface", r.get("developability_initial"), r.get("developability"))
         if r.get("initial_surface_error"):
             L += [f"The file's shape parameters give no surface ({r['initial_surface_error']}); the values above "
                   "are those of the optimized parameters.", ""]
-        if s.get("strips"):
-            L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
-            for x in s["strips"]:
-                sp, d = x["shape_parameters"], x["developability"]
-                L.append(f"| {x['name']} | {sp['mu']:.4g} | {sp['nu']:.4g} | {sp['gamma']:.4g} | {x['area_3d']:.9g} | "
-                         f"{d['theta_max']:.3e} | {d['dd']:.12f} |")
-            L.append("")
-        if s.get("joints"):
-            L += ["### Joints between strips (measured independently of the construction)", "",
-                  "| first → second | requested | achieved | satisfied | plane angle [deg] | residuals |",
-                  "|---|---|---|---|---|---|"]
-            for j in s["joints"]:
-                L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
-                         f"{'yes' if j['satisfied'] else 'NO'} | {j['plane_angle_deg']:.2e} | "
-                         + ", ".join(f"{x:.1e}" for x in j["residuals"]) + " |")
-            L.append("")
+        L += _strips_section(r["surface"])
+    for x in r.get("surfaces") or []:
+        L += _surface_section(x["surface"], r, f"Surface `{x['name']}`", None, x["developability"])
+        L += _strips_section(x["surface"])
     if r.get("optimization"):
         o = r["optimization"]
         L += ["## Shape-parameter optimization", "",
@@ -110,3 +88,54 @@ def report_markdown(r: dict[str, Any]) -> str:
         L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))
     L.append("")
     return "\n".join(L)
+
+
+def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: dict[str, Any] | None,
+                     final: dict[str, Any] | None) -> list[str]:
+    """Type, shape parameters, area, ruling lengths and the developability table of one surface;
+    for a ``rails`` loft also its segments, fan share and edge of regression."""
+    L = [f"## {title}", "", f"Type: `{s['type']}` · shape parameters: "
+         + ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
+         + f" · area {s['area_3d']:.9g} {r['units']}² · ruling length {s['ruling_length_min']:.6g}–"
+         f"{s['ruling_length_max']:.6g} {r['units']}", ""]
+    L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
+    for label, d in (("initial", initial), ("final", final)):
+        if d:
+            L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
+    L.append("")
+    lf = s.get("loft")
+    if lf:
+        L += [f"### Developable loft between `{lf['curve_a']}` and `{lf['curve_b']}` (spec section 5.7)", "",
+              f"Fan share {lf['fan_share']:.6g} (fan area {lf['fan_area']:.6g} of {lf['area']:.9g} {r['units']}²) · "
+              f"θ_max {lf['theta_max_deg']:.3e}° over the sampled rulings · |F| residual {lf['f_residual_max']:.2e} · "
+              f"ruling-field fairness ∫|d'|² {lf['fairness']:.6g} · {len(lf['degenerate_rulings'])} degenerate ruling(s) · "
+              "edge of regression " + (f"between the rails at {len(lf['regression'])} sampled ruling(s)" if lf["regression"]
+                                       else f"clear of the rails (margin {_f(lf['regression_clearance'], '.3g')})")
+              + (" · rail b traced reversed" if lf["reversed_b"] else ""), "",
+              "| segment | t on rail a | s on rail b | area |", "|---|---|---|---|"]
+        for g in lf["segments"]:
+            L.append(f"| {g['kind']} | {g['t'][0]:.6g}–{g['t'][1]:.6g} | {g['s'][0]:.6g}–{g['s'][1]:.6g} | {g['area']:.9g} |")
+        L.append("")
+    return L
+
+
+def _strips_section(s: dict[str, Any]) -> list[str]:
+    """The strips and joints tables of a composite surface (nothing for other types)."""
+    L: list[str] = []
+    if s.get("strips"):
+        L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
+        for x in s["strips"]:
+            sp, d = x["shape_parameters"], x["developability"]
+            L.append(f"| {x['name']} | {sp['mu']:.4g} | {sp['nu']:.4g} | {sp['gamma']:.4g} | {x['area_3d']:.9g} | "
+                     f"{d['theta_max']:.3e} | {d['dd']:.12f} |")
+        L.append("")
+    if s.get("joints"):
+        L += ["### Joints between strips (measured independently of the construction)", "",
+              "| first → second | requested | achieved | satisfied | plane angle [deg] | residuals |",
+              "|---|---|---|---|---|---|"]
+        for j in s["joints"]:
+            L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
+                     f"{'yes' if j['satisfied'] else 'NO'} | {j['plane_angle_deg']:.2e} | "
+                     + ", ".join(f"{x:.1e}" for x in j["residuals"]) + " |")
+        L.append("")
+    return L

@@ -17,11 +17,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import GHTError
-from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, surface_summary,
-                    surface_view)
+from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, build_surfaces,
+                    surface_summary, surface_view, surfaces_summary)
 from .optimize import optimize_design
-from .outputs import (_jsonable, brep_shape, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
-                      unroll_surface)
+from .outputs import (_jsonable, brep_shapes, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
+                      unroll_surfaces)
 from .report import report_markdown
 from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
 
@@ -130,8 +130,16 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         report["joins"] = joins
 
         built = None
+        builts: list[Any] = []
         opt = None
-        if design.surface is not None:
+        if len(design.surfaces) > 1:
+            # 2. surfaces ([[surfaces]]: each built as if it were the only one)
+            step("surface")
+            builts = build_surfaces(design, curves)
+            report["developability_initial"] = surfaces_summary(builts)["developability"]
+            step("measure")
+            report.update(surfaces_summary(builts))
+        elif design.surface is not None:
             # 2. surface
             step("surface")
             try:
@@ -147,7 +155,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if design.optimize is not None:
                 step("optimize")
                 opt = optimize_design(design, progress=progress, curves=curves)
-                if design.surface.type == "curves":
+                if design.surface.type in ("curves", "rails"):
                     # the strip's boundary curves (and the curves joined to them) take the optimized
                     # shape parameters: STEP curve edges, figures and the report show those
                     curves, joins = build_curves(design, opt.shape)
@@ -158,25 +166,28 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             # 4. measures
             step("measure")
             report.update(surface_summary(built))
+            builts = [built]
+        if builts:
             # 5. B-rep
             step("B-rep + STEP")
-            face = brep_shape(built)
+            face = brep_shapes(builts)
             from ..cad.occ import is_valid
 
             valid = is_valid(face)
             nfaces = len(face.faces()) if hasattr(face, "faces") else 1
             report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": nfaces}
-            if _is_composite(built.surface):
-                from ..cad.developable_faces import joint_normal_deviation
-
+            if len(builts) > 1 or _is_composite(built.surface) or nfaces > 1:
                 report["brep"]["shape"] = "shell"
                 report["brep"]["shared_edges"] = shared_edge_count(face)
+            if built is not None and _is_composite(built.surface):
+                from ..cad.developable_faces import joint_normal_deviation
+
                 report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
             if not valid:
                 raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
             edges = curve_edges(curves)
             report["brep"]["curve_edges"] = len(edges)
-            plates = plate_solids(built)  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
+            plates = plate_solids(built) if built is not None else []  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
             if plates:
                 report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
                                    **design.sheet.to_sheet().as_dict()}
@@ -191,7 +202,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                     write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
             # 6. flat pattern
             step("flat pattern")
-            pattern = unroll_surface(built)
+            pattern = unroll_surfaces(builts)
             report["flat_pattern"] = pattern_report(pattern)
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
@@ -234,8 +245,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             P.plot_curve(list(curves.values()), stage.path(FIGURE_NAMES["curve"]))
         if "curvature" in want_figs and curves:
             P.plot_curvature(list(curves.values()), stage.path(FIGURE_NAMES["curvature"]))
-        if "surface" in want_figs and built is not None:
-            P.plot_surface(surface_view(built), stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
+        if "surface" in want_figs and builts:
+            P.plot_surface(surface_view(builts), stage.path(FIGURE_NAMES["surface"]), title=f"{design.name}: surface")
         if "flat_pattern" in want_figs and pattern is not None:
             plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
             if pattern.sheet is not None:  # roll-bending chart of the sheet's bend lines

@@ -35,7 +35,12 @@ PLANE_OBJECTIVES = ("AL", "En", "CVEn", "weighted")
 STRIP_OBJECTIVES = ("R",)
 
 
-SURFACE_TYPES = ("planes", "curves", "composite")
+#: objectives of a ``rails`` surface (the developable loft, :data:`ght_cad.loft.LOFT_OBJECTIVES`) and their
+#: weighted sum ``w0 fan_share + w1 fairness + w2 regression``
+RAILS_OBJECTIVES = ("fan_share", "fairness", "regression", "weighted")
+SURFACE_TYPES = ("planes", "curves", "rails", "composite")
+#: orientations of the second rail of a ``rails`` surface (:func:`ght_cad.developable_loft`)
+RAIL_ORIENTATIONS = ("auto", "same", "reversed")
 
 
 #: joins between the strips of a composite surface (spec 5.6)
@@ -113,8 +118,10 @@ class SegmentSpec:
 
 @dataclass
 class SurfaceSpec:
-    """The design's surface: ``type = "planes"`` (spec 5.2), ``"curves"`` (ruled strip) or
-    ``"composite"`` (several strips from control planes joined G1/G2/G3, spec 5.6)."""
+    """A surface of the design: ``type = "planes"`` (spec 5.2), ``"curves"`` (equal-parameter ruled
+    strip, quasi-developable), ``"rails"`` (the exact developable loft between two curves, spec 5.7)
+    or ``"composite"`` (several strips from control planes joined G1/G2/G3, spec 5.6). ``name`` is
+    the surface's name in ``[[surfaces]]`` (None for a single ``[surface]``)."""
 
     type: str
     planes: list[list[float]] | None = None
@@ -126,6 +133,10 @@ class SurfaceSpec:
     curve_b: str | None = None
     normalize: bool = True
     segments: list[SegmentSpec] | None = None
+    orientation: str = "auto"
+    name: str | None = None
+    #: where the surface is in the file (``surface`` or ``surfaces[i]``), for error messages
+    key: str = "surface"
 
 
 @dataclass
@@ -147,6 +158,8 @@ class UnrollSpec:
 
     rulings: int = 16
     tol_deg: float = 0.01
+    #: points per boundary edge of the outline polylines (the DXF/SVG outline is that polygon)
+    samples: int = 257
 
 
 @dataclass
@@ -192,6 +205,13 @@ class Design:
     outputs: OutputSpec = field(default_factory=OutputSpec)
     source: str = "<design>"
     sheet: SheetSpec | None = None
+    #: every surface: ``[surface]`` gives one (``surface`` is then that one), ``[[surfaces]]`` one per
+    #: entry (``surface`` is the only one for a single entry, else None)
+    surfaces: list[SurfaceSpec] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.surfaces and self.surface is not None:
+            self.surfaces = [self.surface]
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (as it would be written in TOML)."""
@@ -199,6 +219,10 @@ class Design:
 
         d = asdict(self)
         d.pop("source")
+        for sd in [d["surface"] or {}] + d["surfaces"]:
+            sd.pop("key", None)
+        if len(self.surfaces) <= 1 and all(s.name is None for s in self.surfaces):
+            d.pop("surfaces")  # a single [surface]: as before
         return d
 
 
@@ -369,7 +393,7 @@ def _range_text(lo: float | None, hi: float | None, lo_open: bool = False) -> st
     return ""
 
 
-_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "optimize", "unroll", "outputs", "sheet")
+_TOP_KEYS = ("name", "units", "curves", "joins", "surface", "surfaces", "optimize", "unroll", "outputs", "sheet")
 
 
 def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
@@ -440,52 +464,22 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         if seconds.count(s) > 1:
             raise ck.fail("joins", f"curve {s!r} is the 'second' of two joins; allowed: each curve re-solved at most once")
 
-    # surface
-    surface = None
-    st = ck.table(data, "surface", "surface")
-    if st is not None:
-        stype = ck.string(st, "type", "surface", "planes", choices=SURFACE_TYPES)
-        if stype != "composite" and "segments" in st:
-            raise ck.fail("surface.segments", f"strips need type = \"composite\" (this surface has type = \"{stype}\"); "
-                          "allowed: [[surface.segments]] only with type = \"composite\"")
-        if stype == "planes":
-            ck.keys(st, "surface", ("type", "planes", "boundary_planes", "mu", "nu", "gamma", "normalize"))
-            planes = ck.matrix(st, "planes", "surface", cols=(4,), min_rows=3)
-            bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
-            for key, rows in (("planes", planes), ("boundary_planes", bplanes)):
-                for i, r in enumerate(rows or []):
-                    if math.hypot(*r[1:]) < 1e-12:
-                        raise ck.fail(f"surface.{key}[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
-            shape = {k: ck.number(st, k, "surface", 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
-            normalize = ck.boolean(st, "normalize", "surface", True)
-            surface = SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
-        elif stype == "composite":
-            surface = _parse_composite(ck, st)
-        else:
-            ck.keys(st, "surface", ("type", "curve_a", "curve_b"))
-            names = sorted(seen)
-            if not names:
-                raise ck.fail("surface.curve_a", "a 'curves' surface needs two 3-D [[curves]]; none are defined")
-            ca = ck.string(st, "curve_a", "surface", required=True, choices=names)
-            cb = ck.string(st, "curve_b", "surface", required=True, choices=names)
-            for key, cn in (("curve_a", ca), ("curve_b", cb)):
-                spec = next(c for c in curves if c.name == cn)
-                if len(spec.control_points[0]) != 3:
-                    raise ck.fail(f"surface.{key}", f"curve {cn!r} is 2-D; allowed: a 3-D curve")
-            if ca == cb:
-                raise ck.fail("surface.curve_b", f"{cb!r} equals curve_a; allowed: another 3-D curve")
-            surface = SurfaceSpec("curves", curve_a=ca, curve_b=cb)
+    # surface(s)
+    surfaces = _parse_surfaces(ck, data, curves)
+    surface = surfaces[0] if len(surfaces) == 1 else None
 
     # optimize
     optimize = None
     ot = ck.table(data, "optimize", "optimize")
     if ot is not None:
         if surface is None:
-            raise ck.fail("optimize", "needs a [surface] table to optimize")
+            raise ck.fail("optimize", ("needs a [surface] table to optimize" if not surfaces else
+                                       f"optimizes one surface; this design has {len(surfaces)} [[surfaces]]; "
+                                       "allowed: [optimize] with a single [surface] or [[surfaces]] entry"))
         ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
         method = ck.string(ot, "method", "optimize", "hybrid", choices=METHODS)
         objs = _objectives_for(surface.type)
-        objective = ck.string(ot, "objective", "optimize", objs[0] if surface.type == "curves" else "CVEn", choices=objs)
+        objective = ck.string(ot, "objective", "optimize", default_objective(surface.type), choices=objs)
         weights = [1.0, 0.0, 0.0]
         if "weights" in ot:
             w = ot["weights"]
@@ -493,7 +487,8 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
                     or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x >= 0
                                for x in w)
                     or not any(x > 0 for x in w)):
-                raise ck.fail("optimize.weights", f"{_short(w)} is not allowed; allowed: three numbers >= 0 (weights of AL, En, CVEn), not all 0")
+                raise ck.fail("optimize.weights", f"{_short(w)} is not allowed; allowed: three numbers >= 0 (weights of "
+                              f"{', '.join(_weight_names(surface.type))}), not all 0")
             weights = [float(x) for x in w]
         pchoices = _shape_names(surface)
         if surface.type == "composite":
@@ -511,9 +506,10 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     unroll = UnrollSpec()
     ut = ck.table(data, "unroll", "unroll")
     if ut is not None:
-        ck.keys(ut, "unroll", ("rulings", "tol_deg"))
+        ck.keys(ut, "unroll", ("rulings", "tol_deg", "samples"))
         unroll = UnrollSpec(ck.integer(ut, "rulings", "unroll", 16, lo=0, hi=1000),
-                            ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True))
+                            ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True),
+                            ck.integer(ut, "samples", "unroll", 257, lo=9, hi=20001))
 
     # sheet (spec 6.1)
     sheet = None
@@ -538,7 +534,7 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         ck.keys(ot2, "outputs", ("files", "figures"))
         outputs = OutputSpec(ck.string_list(ot2, "files", "outputs", list(FILE_OUTPUTS), choices=FILE_OUTPUTS),
                              ck.string_list(ot2, "figures", "outputs", list(FIGURE_OUTPUTS), choices=FIGURE_OUTPUTS))
-    if surface is None:
+    if not surfaces:
         for key, kinds in (("files", ("dxf", "svg")), ("figures", ("surface", "flat_pattern"))):
             explicit = ot2 is not None and key in ot2
             needs = [f for f in getattr(outputs, key) if f in kinds]
@@ -561,13 +557,87 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
         outputs.figures = [f for f in outputs.figures if f not in ("curve", "curvature")]
     if not outputs.files and not outputs.figures:
         raise ck.fail("outputs", "requests nothing; allowed files: " + ", ".join(FILE_OUTPUTS) + "; figures: " + ", ".join(FIGURE_OUTPUTS))
-    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source, sheet=sheet)
+    return Design(name, units, curves, joins, surface, optimize, unroll, outputs, source, sheet=sheet, surfaces=surfaces)
 
 
 def _objectives_for(surface_type: str) -> tuple[str, ...]:
     """Objectives allowed for a surface type: dual-curve fairness for planes and composites, R for
-    curve-pair strips."""
+    curve-pair strips, the loft objectives for rails."""
+    if surface_type == "rails":
+        return RAILS_OBJECTIVES
     return STRIP_OBJECTIVES if surface_type == "curves" else PLANE_OBJECTIVES
+
+
+def default_objective(surface_type: str) -> str:
+    """The objective of ``[optimize]`` when none is given: R (curves), fan_share (rails), CVEn (else)."""
+    return {"curves": "R", "rails": "fan_share"}.get(surface_type, "CVEn")
+
+
+def _weight_names(surface_type: str) -> tuple[str, str, str]:
+    """What ``optimize.weights`` weighs: (fan_share, fairness, regression) for rails, else (AL, En, CVEn)."""
+    return ("fan_share", "fairness", "regression") if surface_type == "rails" else ("AL", "En", "CVEn")
+
+
+def _parse_surfaces(ck: _Checker, data: dict, curves: list[CurveSpec]) -> list[SurfaceSpec]:
+    """``[surface]`` (one surface) or ``[[surfaces]]`` (named surfaces of any type; names unique)."""
+    if "surface" in data and "surfaces" in data:
+        raise ck.fail("surfaces", "given together with [surface]; allowed: either one [surface] table or "
+                      "a [[surfaces]] array of tables")
+    st = ck.table(data, "surface", "surface")
+    if st is not None:
+        return [_parse_surface(ck, st, "surface", curves)]
+    if "surfaces" not in data:
+        return []
+    raw = data["surfaces"]
+    if not isinstance(raw, list) or not raw or not all(isinstance(x, dict) for x in raw):
+        raise ck.fail("surfaces", f"expected a non-empty array of tables [[surfaces]], got {_tname(raw)} {_short(raw)}")
+    out: list[SurfaceSpec] = []
+    for i, t in enumerate(raw):
+        path = f"surfaces[{i}]"
+        name = ck.string(t, "name", path, f"surface{i + 1}")
+        if any(s.name == name for s in out):
+            raise ck.fail(f"{path}.name", f"{name!r} is used twice; allowed: a name unique among [[surfaces]]")
+        spec = _parse_surface(ck, t, path, curves)
+        spec.name, spec.key = name, path
+        out.append(spec)
+    return out
+
+
+def _parse_surface(ck: _Checker, st: dict, path: str, curves: list[CurveSpec]) -> SurfaceSpec:
+    """One surface table (``[surface]`` or an entry of ``[[surfaces]]`` at ``path``)."""
+    stype = ck.string(st, "type", path, "planes", choices=SURFACE_TYPES)
+    extra = ("name",) if path != "surface" else ()
+    if stype != "composite" and "segments" in st:
+        raise ck.fail(f"{path}.segments", f"strips need type = \"composite\" (this surface has type = \"{stype}\"); "
+                      f"allowed: [[{path}.segments]] only with type = \"composite\"")
+    if stype == "planes":
+        ck.keys(st, path, ("type", "planes", "boundary_planes", "mu", "nu", "gamma", "normalize") + extra)
+        planes = ck.matrix(st, "planes", path, cols=(4,), min_rows=3)
+        bplanes = ck.matrix(st, "boundary_planes", path, cols=(4,), min_rows=2, max_rows=2)
+        for key, rows in (("planes", planes), ("boundary_planes", bplanes)):
+            for i, r in enumerate(rows or []):
+                if math.hypot(*r[1:]) < 1e-12:
+                    raise ck.fail(f"{path}.{key}[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
+        shape = {k: ck.number(st, k, path, 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
+        normalize = ck.boolean(st, "normalize", path, True)
+        return SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
+    if stype == "composite":
+        return _parse_composite(ck, st, path, extra)
+    rails = stype == "rails"
+    ck.keys(st, path, ("type", "curve_a", "curve_b") + (("orientation",) if rails else ()) + extra)
+    names = sorted(c.name for c in curves)
+    if not names:
+        raise ck.fail(f"{path}.curve_a", f"a '{stype}' surface needs two 3-D [[curves]]; none are defined")
+    ca = ck.string(st, "curve_a", path, required=True, choices=names)
+    cb = ck.string(st, "curve_b", path, required=True, choices=names)
+    for key, cn in (("curve_a", ca), ("curve_b", cb)):
+        spec = next(c for c in curves if c.name == cn)
+        if len(spec.control_points[0]) != 3:
+            raise ck.fail(f"{path}.{key}", f"curve {cn!r} is 2-D; allowed: a 3-D curve")
+    if ca == cb:
+        raise ck.fail(f"{path}.curve_b", f"{cb!r} equals curve_a; allowed: another 3-D curve")
+    orientation = ck.string(st, "orientation", path, "auto", choices=RAIL_ORIENTATIONS) if rails else "auto"
+    return SurfaceSpec(stype, curve_a=ca, curve_b=cb, orientation=orientation)
 
 
 def _composite_parameters(ck: _Checker, ot: dict, surface: SurfaceSpec) -> list[str]:
@@ -604,48 +674,48 @@ def _composite_parameters(ck: _Checker, ot: dict, surface: SurfaceSpec) -> list[
 _SEGMENT_KEYS = ("name", "planes", "mu", "nu", "gamma", "continuity", "k", "beta2", "beta3")
 
 
-def _parse_composite(ck: _Checker, st: dict) -> SurfaceSpec:
-    """``[surface] type = "composite"``: shared boundary planes and ``[[surface.segments]]``."""
-    ck.keys(st, "surface", ("type", "boundary_planes", "normalize", "segments"))
-    bplanes = ck.matrix(st, "boundary_planes", "surface", cols=(4,), min_rows=2, max_rows=2)
+def _parse_composite(ck: _Checker, st: dict, path: str = "surface", extra: tuple[str, ...] = ()) -> SurfaceSpec:
+    """``type = "composite"`` at ``path``: shared boundary planes and ``[[<path>.segments]]``."""
+    ck.keys(st, path, ("type", "boundary_planes", "normalize", "segments") + extra)
+    bplanes = ck.matrix(st, "boundary_planes", path, cols=(4,), min_rows=2, max_rows=2)
     for i, r in enumerate(bplanes or []):
         if math.hypot(*r[1:]) < 1e-12:
-            raise ck.fail(f"surface.boundary_planes[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane "
+            raise ck.fail(f"{path}.boundary_planes[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane "
                           "u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
-    normalize = ck.boolean(st, "normalize", "surface", True)
-    raw = ck.required(st, "segments", "surface", "an array of at least 2 tables [[surface.segments]]")
+    normalize = ck.boolean(st, "normalize", path, True)
+    raw = ck.required(st, "segments", path, f"an array of at least 2 tables [[{path}.segments]]")
     if not isinstance(raw, list) or not all(isinstance(x, dict) for x in raw):
-        raise ck.fail("surface.segments", f"expected an array of tables [[surface.segments]], got {_tname(raw)} {_short(raw)}")
+        raise ck.fail(f"{path}.segments", f"expected an array of tables [[{path}.segments]], got {_tname(raw)} {_short(raw)}")
     if len(raw) < 2:
-        raise ck.fail("surface.segments", f"has {len(raw)} strip(s); allowed: at least 2 (one strip: use type = \"planes\")")
+        raise ck.fail(f"{path}.segments", f"has {len(raw)} strip(s); allowed: at least 2 (one strip: use type = \"planes\")")
     segs: list[SegmentSpec] = []
     names: set[str] = set()
     prev: dict[str, float] = {k: 0.0 for k in SHAPE_NAMES}
     for i, t in enumerate(raw):
-        path = f"surface.segments[{i}]"
-        ck.keys(t, path, _SEGMENT_KEYS)
-        name = ck.string(t, "name", path, f"strip{i + 1}")
+        spath = f"{path}.segments[{i}]"
+        ck.keys(t, spath, _SEGMENT_KEYS)
+        name = ck.string(t, "name", spath, f"strip{i + 1}")
         if name in names:
-            raise ck.fail(f"{path}.name", f"{name!r} is used twice; allowed: a name unique among the strips")
+            raise ck.fail(f"{spath}.name", f"{name!r} is used twice; allowed: a name unique among the strips")
         names.add(name)
         if i == 0:
             for key in ("continuity", "k", "beta2", "beta3"):
                 if key in t:
-                    raise ck.fail(f"{path}.{key}", "the first strip has no joint before it; allowed: "
+                    raise ck.fail(f"{spath}.{key}", "the first strip has no joint before it; allowed: "
                                   "continuity, k, beta2, beta3 on segments[1] and later")
             cont, k, b2, b3 = None, 1.0, 0.0, 0.0
         else:
-            cont = ck.string(t, "continuity", path, "G1", choices=STRIP_JOINS)
-            k = ck.number(t, "k", path, 1.0, lo=0.0, lo_open=True)
-            b2 = ck.number(t, "beta2", path, 0.0)
-            b3 = ck.number(t, "beta3", path, 0.0)
+            cont = ck.string(t, "continuity", spath, "G1", choices=STRIP_JOINS)
+            k = ck.number(t, "k", spath, 1.0, lo=0.0, lo_open=True)
+            b2 = ck.number(t, "beta2", spath, 0.0)
+            b3 = ck.number(t, "beta3", spath, 0.0)
         order = int(cont[1]) if cont else 0
-        planes = ck.matrix(t, "planes", path, cols=(4,), min_rows=max(3, order + 1))
+        planes = ck.matrix(t, "planes", spath, cols=(4,), min_rows=max(3, order + 1))
         for j, r in enumerate(planes or []):
             if math.hypot(*r[1:]) < 1e-12:
-                raise ck.fail(f"{path}.planes[{j}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane with a non-zero normal")
+                raise ck.fail(f"{spath}.planes[{j}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane with a non-zero normal")
         # shape parameters default to the previous strip's (as join_developable does)
-        shape = {key: ck.number(t, key, path, prev[key], lo=-1.0, hi=1.0) for key in SHAPE_NAMES}
+        shape = {key: ck.number(t, key, spath, prev[key], lo=-1.0, hi=1.0) for key in SHAPE_NAMES}
         prev = shape
         segs.append(SegmentSpec(name, planes, shape["mu"], shape["nu"], shape["gamma"], cont, k, b2, b3))  # type: ignore[arg-type]
     return SurfaceSpec("composite", boundary_planes=bplanes, normalize=normalize, segments=segs)
