@@ -334,7 +334,7 @@ BROKEN_STRIPS = {
                    "type, boundary_planes, normalize, segments"),
     "optimize": (TWO_STRIPS.replace("[unroll]", "[optimize]\nparameters = [\"third.mu\"]\n\n[unroll]"),
                  "optimize.parameters", "unknown segment 'third'"),
-    "bad type": (strips_edit('type = "composite"', 'type = "strips"'), "surface.type", "planes, curves, composite"),
+    "bad type": (strips_edit('type = "composite"', 'type = "strips"'), "surface.type", "planes, curves, rails, composite"),
     "type missing": (strips_edit('type = "composite"\n', ''), "surface.segments", 'only with type = "composite"'),
     "normalize type": (strips_edit("normalize = false", 'normalize = "no"'), "surface.normalize", "true or false"),
     "G3 with 3 planes": (strips_edit('continuity = "G2"', 'continuity = "G3"').replace(

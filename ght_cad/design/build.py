@@ -216,6 +216,21 @@ class _CompositeView:
                                for s, m in zip(self.segments, self._split(n))])
 
 
+class _StackedView:
+    """Several surfaces in one plot: their grids side by side across the rulings (``v``), so
+    surfaces that follow each other through a shared rail (keel–chine, chine–sheer) meet along it;
+    ``theta`` is the largest of the surfaces' at each ``u``."""
+
+    def __init__(self, parts: Sequence[Any]) -> None:
+        self.parts = list(parts)
+
+    def grid(self, nu: int, nv: int) -> np.ndarray:
+        return np.concatenate([p.grid(nu, nv) for p in self.parts], axis=1)
+
+    def theta(self, u: Any) -> np.ndarray:
+        return np.max([np.asarray(p.theta(u), dtype=float) for p in self.parts], axis=0)
+
+
 def surface_designs(design: Design) -> list[Design]:
     """One single-surface design per surface of ``design`` (for a ``[surface]`` design: itself).
 
@@ -247,8 +262,7 @@ def surface_view(built: "BuiltSurface | Sequence[BuiltSurface]") -> Any:
     if isinstance(built, (list, tuple)):
         if len(built) == 1:
             return surface_view(built[0])
-        parts = [x for b in built for x in (b.surface.segments if _is_composite(b.surface) else [b.surface])]
-        return _CompositeView(parts)
+        return _StackedView([surface_view(b) for b in built])
     return _CompositeView(built.surface) if _is_composite(built.surface) else built.surface
 
 
