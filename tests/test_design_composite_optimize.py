@@ -243,7 +243,9 @@ def test_candidate_objective_is_inf_exactly_when_the_composite_degenerates(x: li
         return
     assert math.isfinite(v) and v >= 0.0
     assert [rep.order for rep in comp.joints()] == [1]
-    assert max(dv.theta_max for dv in comp.developability()) < 1e-9
+    # round-off: up to 1.05e-8 deg measured at box corners (x = [-1, -1, -0.5, -0.5, 1, -1]), where the
+    # joined strip's dual curve is nearly stationary at its start
+    assert max(dv.theta_max for dv in comp.developability()) < 1e-7
 
 
 def test_degenerate_candidates_do_not_stop_the_run() -> None:

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("build123d")
 
@@ -393,6 +395,35 @@ def test_other_rails_objectives(objective: str) -> None:
         text = text.replace("seed = 3", "seed = 3\nweights = [1.0, 0.01, 1.0]")
     o = optimize_design(parse_design_text(text), progress=False)
     assert math.isfinite(o.best_value) and o.best_value <= o.initial_value
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.lists(st.floats(-0.6, 0.6), min_size=6, max_size=6))
+def test_hopper_loft_exact_over_a_box_of_shape_parameters(x: list[float]) -> None:
+    """Over the box [-0.6, 0.6]^6 of the hopper rails' shape parameters, the rails surface built from
+    the design is an exact developable (θ_max ≤ 1e-8° over the sampled rulings of every segment, and
+    the developability degree DD = 1 to 1e-12) covering both rails end to end."""
+    from ght_cad.design import build_surface
+
+    d = load_design(HOPPER)
+    shape = dict(zip(("a.mu", "a.nu", "a.gamma", "b.mu", "b.nu", "b.gamma"), x))
+    cv, _ = build_curves(d, shape)
+    lf = build_surface(d, shape, curves=cv).surface
+    dev = lf.developability()
+    assert dev.theta_max <= 1e-8 and abs(dev.dd - 1.0) <= 1e-12
+    t0, _ = lf.parameters(np.array([0.0]))
+    t1, _ = lf.parameters(np.array([1.0]))
+    assert (t0[0], t1[0]) == (0.0, 1.0)
+    u = np.linspace(0.0, 1.0, 401)
+    assert np.max(np.abs(np.diff(lf.parameters(u)[1]))) <= 0.05  # s covers [0, 1] without jumps
+    s = lf.parameters(u)[1]
+    assert min(s[0], s[-1]) == 0.0 and max(s[0], s[-1]) == 1.0
+
+
+def test_optimize_command_refuses_several_surfaces(tmp_path: Path, capsys) -> None:
+    rc = main(["optimize", str(DORY)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "key 'surfaces'" in err and "2 [[surfaces]]" in err and len(err.splitlines()) == 1
 
 
 def test_rails_objective_override_refused() -> None:

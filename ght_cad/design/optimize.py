@@ -233,6 +233,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
     from ..progress import Progress
 
     if design.surface is None:
+        if design.surfaces:
+            raise DesignError(f"{design.source}: key 'surfaces': optimization works on one surface and the design "
+                              f"has {len(design.surfaces)} [[surfaces]]; allowed: a design with one surface")
         raise DesignError(f"{design.source}: key 'surface': missing; optimization needs a [surface] table")
     stype = design.surface.type
     spec = design.optimize or OptimizeSpec(
