@@ -453,3 +453,19 @@ def test_quasi_developable_example_kept() -> None:
     d = load_design(EXAMPLES / "design_hull_plate_quasi.toml")
     assert d.surface is not None and d.surface.type == "curves" and d.optimize is not None
     assert d.optimize.objective == "R"
+
+
+def test_export_and_unroll_commands_take_every_surface(tmp_path: Path, capsys) -> None:
+    """`ght-cad export` of a [[surfaces]] design: one STEP shell with both panels' faces, a DXF with
+    both labelled panels, a JSON with a section per surface; `ght-cad unroll` gives the same sheet."""
+    from ght_cad.cad.occ import is_valid, read_step
+
+    step, dxf, js, dxf2 = (tmp_path / n for n in ("d.step", "d.dxf", "d.json", "u.dxf"))
+    assert main(["export", str(DORY), str(step), str(dxf), str(js)]) == 0
+    assert is_valid(read_step(step)) and len(step_faces(step)) == 6
+    r = json.loads(js.read_text())
+    assert [s["name"] for s in r["surfaces"]] == ["bottom", "side"]
+    assert [p["label"] for p in r["flat_pattern"]["panels"]] == ["bottom", "side"]
+    assert main(["unroll", str(DORY), "--dxf", str(dxf2)]) == 0
+    assert sorted(dxf_outline_areas(dxf2)) == pytest.approx(sorted(dxf_outline_areas(dxf)), rel=1e-12)
+    assert len(dxf_outline_areas(dxf)) == 2
