@@ -831,7 +831,7 @@ class DevelopableLoft(RuledSurface):
     """
 
     def __init__(self, rail_a: Any, rail_b: Any, pair: _Pair, branch: _Branch, *, samples: int = 257,
-                 candidates: Sequence[dict[str, Any]] = ()) -> None:
+                 candidates: Sequence[dict[str, Any]] = (), area_rtol: float = 1e-13) -> None:
         self.rail_a = rail_a
         self.rail_b = rail_b
         self._pair = pair
@@ -855,7 +855,7 @@ class DevelopableLoft(RuledSurface):
         self._edges = np.array([segs[0].lam_range[0]] + [sg.lam_range[1] for sg in segs])
         self._edges[0], self._edges[-1] = 0.0, 1.0
         self.breakpoints = tuple(float(x) for x in self._edges[1:-1])
-        self.report = self._make_report(samples, list(candidates))
+        self.report = self._make_report(samples, list(candidates), area_rtol)
 
     # -- parametrization -----------------------------------------------------------------
     def _given_s(self, s: np.ndarray) -> np.ndarray:
@@ -1021,7 +1021,7 @@ class DevelopableLoft(RuledSurface):
         return f"DevelopableLoft({', '.join(sg.kind for sg in self.segments)}; fan share {self.report.fan_share:.3g})"
 
     # -- report --------------------------------------------------------------------------
-    def _make_report(self, samples: int, candidates: list[dict[str, Any]]) -> LoftReport:
+    def _make_report(self, samples: int, candidates: list[dict[str, Any]], area_rtol: float) -> LoftReport:
         from .unroll import ruled_area
         from .ruled import _theta
 
@@ -1034,7 +1034,7 @@ class DevelopableLoft(RuledSurface):
         clearance = math.inf
         fres = 0.0
         for i, sg in enumerate(self.segments):
-            ar = ruled_area(sg, rtol=1e-13)
+            ar = ruled_area(sg, rtol=area_rtol)
             area += ar
             if sg.kind != "main":
                 fan_area += ar
@@ -1270,11 +1270,15 @@ def developable_loft(
     if not found:
         raise refuse()
     lofts = []
+    # with several candidates, rank them on a coarse report (65 rulings, areas to 1e-9) and build
+    # the full report for the chosen one only
+    coarse = branch == "auto" and len(found) > 1
     for i, (pair, br) in enumerate(found):
         if branch != "auto" and i != branch:
             continue
         try:
-            lf = DevelopableLoft(rail_a, rail_b, pair, br, samples=samples, candidates=cands)
+            lf = DevelopableLoft(rail_a, rail_b, pair, br, samples=min(samples, 65) if coarse else samples,
+                                 candidates=cands, area_rtol=1e-9 if coarse else 1e-13)
             lf._index = i
             folds = lf.joint_folds()
             if folds:
@@ -1298,6 +1302,13 @@ def developable_loft(
                 c["regression_inside"] = bool(lf.report.regression)
     best = min(lofts, key=lambda lf: (bool(lf.report.regression), round(lf.report.fan_share, 9),
                                       len(lf.segments)))
+    if coarse:
+        index = best._index
+        best = DevelopableLoft(rail_a, rail_b, best._pair, best._branch, samples=samples, candidates=cands)
+        best._index = index
+        for c in cands:
+            if c.get("index") == index:
+                c["fan_share"] = best.report.fan_share
     best.report.candidates = cands
     return best
 

@@ -188,7 +188,9 @@ def test_dory_chine_sheer() -> None:
     assert len(pattern.panels) == 1
     assert pattern.errors["max"] <= 1e-9
     assert pattern.panels[0].bend_lines.shape[0] > 0
-    # σ solves F = 0 on the main part and increases
+    # σ on the fans is the apex parameter; on the main part it solves F = 0 and increases
+    assert loft.sigma(0.5 * loft.segments[0].t_range[1]) == 0.0
+    assert loft.sigma(1.0) == 1.0
     t0, t1 = loft.segments[1].t_range
     t = np.linspace(t0, t1, 201)[1:-1]
     s = loft.sigma(t)
@@ -396,3 +398,31 @@ def test_to_face_shell() -> None:
 
     # θ from OCCT normals on every face, fans included (their apex edge is collapsed)
     assert max(face_developability(f).theta_max for f in shell.faces()) <= 1e-3
+
+
+def test_round_to_oval_closed_rails() -> None:
+    """Round-to-oval transition between a circle and an ellipse running the other way (closed
+    rails in parallel planes): the rulings join points with parallel, equally directed tangents
+    (1e-9), no fans, the loft closes (first ruling = last), one flat panel."""
+
+    def ellipse(A: float, B: float, z: float, sense: float) -> CallableRail:
+        def pos(s: np.ndarray) -> np.ndarray:
+            th = sense * 2 * np.pi * s
+            return np.column_stack([A * np.cos(th), B * np.sin(th), np.full_like(s, z)])
+
+        def d1(s: np.ndarray) -> np.ndarray:
+            th = sense * 2 * np.pi * s
+            return sense * 2 * np.pi * np.column_stack([-A * np.sin(th), B * np.cos(th), 0 * s])
+
+        return CallableRail(pos, d1)
+
+    loft = developable_loft(ellipse(1.0, 1.0, 0.0, 1.0), ellipse(1.6, 0.8, 1.2, -1.0))
+    assert loft.reversed_b and [sg.kind for sg in loft.segments] == ["main"]
+    u = np.linspace(0.0, 1.0, 1001)
+    A1, B1 = loft.a(u, 1), loft.b(u, 1)
+    sine = np.linalg.norm(np.cross(A1, B1), axis=1) / (np.linalg.norm(A1, axis=1) * np.linalg.norm(B1, axis=1))
+    assert sine.max() <= 1e-9 and np.all(np.einsum("ij,ij->i", A1, B1) > 0)
+    np.testing.assert_allclose(loft.ruling(np.array([0.0])), loft.ruling(np.array([1.0])), atol=1e-12)
+    assert loft.report.theta_max_deg <= 1e-8
+    pattern = ght_cad.unroll(loft)
+    assert len(pattern.panels) == 1 and pattern.errors["max"] <= 1e-9
