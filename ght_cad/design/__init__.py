@@ -112,6 +112,7 @@ from .optimize import (  # noqa: F401
     CANDIDATE_LOFT_SAMPLES,
     OptimizationOutcome,
     composite_objective,
+    composite_value_and_grad,
     optimize_design,
     _composite_before_after,
     _composite_candidate,
@@ -203,4 +204,5 @@ __all__ = [
     "dual_curve_objectives",
     "composite_dual_objectives",
     "composite_objective",
+    "composite_value_and_grad",
 ]

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import GHTError
 from .build import _initial_shape, _joined_curves, _make_composite, _make_surface, build_curves, make_loft
-from .objectives import _gauss_legendre, composite_dual_objectives, dual_curve_objectives
+from .objectives import _gauss_legendre, composite_dual_objectives, composite_dual_objectives_grad, dual_curve_objectives
 from .schema import (METHODS, SHAPE_NAMES, Design, DesignError, OptimizeSpec, _Checker, _composite_parameters,
                      _objectives_for, _shape_names, default_objective)
 
@@ -36,6 +36,8 @@ class OptimizationOutcome:
     strips: list[dict[str, Any]] | None = None
     #: composite only: per joint ``first``, ``second``, ``requested``, ``achieved_G`` (after), ``satisfied``
     joints: list[dict[str, Any]] | None = None
+    #: exact gradients evaluated (one per point; 0 with finite differences or a population method)
+    njev: int = 0
 
     def summary(self) -> dict[str, Any]:
         """Plain-data form for the report (``optimization`` block); composites add ``strips``
@@ -165,6 +167,58 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec) ->
     return g
 
 
+def composite_value_and_grad(design: Design, shape: dict[str, float], names: Sequence[str],
+                             objective: str = "CVEn", weights: Sequence[float] = (1.0, 0.0, 0.0)
+                             ) -> tuple[float, np.ndarray]:
+    r""":func:`composite_objective` and its exact gradient with respect to the shape parameters
+    ``names`` (``"<segment>.mu|nu|gamma"``), the joins differentiated as re-solved for every
+    candidate (:func:`ght_cad.design.objectives.composite_dual_objectives_grad`, spec 8.1).
+
+    Returns:
+        ``(F, ∂F/∂names)``; ``(+inf, 0)`` for a candidate that :func:`composite_objective` rejects.
+    """
+    segs = design.surface.segments if design.surface is not None else None
+    if not segs or design.surface is None or design.surface.type != "composite":
+        raise DesignError(f"{design.source}: key 'surface.type': composite_value_and_grad needs type = \"composite\"")
+    sh = dict(_initial_shape(design, {}))
+    sh.update(shape)
+    idx = {f"{g.name}.{k}": (s, j) for s, g in enumerate(segs) for j, k in enumerate(SHAPE_NAMES)}
+    zero = np.zeros(len(names))
+    try:
+        with np.errstate(all="ignore"):
+            comp = _composite_candidate(design, sh)
+            value = composite_dual_objectives(comp, objective, weights)[0]
+            joins = [(g.continuity or "G1", g.k, g.beta2, g.beta3) for g in segs[1:]]
+            _, dF = composite_dual_objectives_grad(comp, joins, objective, weights)
+    except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+        return math.inf, zero
+    g = np.array([dF[idx[n]] for n in names], dtype=float)
+    if not (math.isfinite(value) and np.all(np.isfinite(g))):
+        return math.inf, zero
+    return float(value), g
+
+
+def _value_and_grad_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec, names: Sequence[str],
+                       shape_of: Callable[[np.ndarray], dict[str, float]]
+                       ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+    """Population ``value_and_grad(X) -> ((pop,), (pop, dim))`` of the design objective where it is
+    exact (composite; rails through :class:`ght_cad.loft.LoftProblem`), else None."""
+    surf = design.surface
+    assert surf is not None
+    if surf.type != "composite":
+        return None
+
+    def vg(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        f = np.empty(X.shape[0])
+        G = np.zeros(X.shape)
+        for i, x in enumerate(X):
+            f[i], G[i] = composite_value_and_grad(design, shape_of(x), names, spec.objective, spec.weights)
+        return f, G
+
+    return vg
+
+
 #: rulings sampled per loft segment for the report of an optimizer candidate (the result is rebuilt
 #: with the default)
 CANDIDATE_LOFT_SAMPLES = 33
@@ -200,7 +254,7 @@ def _rails_objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSp
 
 
 def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, progress: bool = True,
-                    curves: dict[str, Any] | None = None) -> OptimizationOutcome:
+                    curves: dict[str, Any] | None = None, exact_gradients: bool = True) -> OptimizationOutcome:
     r"""Minimize the design's objective over its shape parameters (box ``[-1, 1]^k``).
 
     Objectives: for a ``planes`` surface the fairness of the dual curve of unit-normal control
@@ -220,6 +274,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         overrides: replaces ``method``, ``objective``, ``iterations``, ``population``, ``seed``.
         progress: progress bar on a terminal.
         curves: already built curves (joins applied).
+        exact_gradients: give the optimizer the exact gradient where one exists (composites:
+            :func:`composite_value_and_grad`; rails: :meth:`ght_cad.loft.LoftProblem.value_and_grad`);
+            ``False`` leaves the objective a plain callable (``hybrid`` then uses finite differences).
 
     Returns:
         :class:`OptimizationOutcome` (for a composite with ``strips``: the measures of every strip
@@ -279,6 +336,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
                 out[i] = np.inf
         return out
 
+    vg = _value_and_grad_fn(design, curves, spec, names, shape_of) if exact_gradients else None
+    if vg is not None:
+        F.value_and_grad = vg  # type: ignore[attr-defined]
     x0 = np.array([base[k] for k in names])
     initial = float(F(x0[None, :])[0])
     bounds = (-np.ones(len(names)), np.ones(len(names)))
@@ -294,6 +354,7 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         x, best = x0, initial
     out = OptimizationOutcome(spec.method, spec.objective, names, x, best, initial, np.asarray(res.history),
                               int(res.nfev), int(res.nit), float(res.time), shape_of(x), list(spec.weights))
+    out.njev = int(getattr(res, "njev", 0) or 0)
     if stype == "composite":
         out.strips, out.joints = _composite_before_after(design, spec, base, out.shape)
     return out
