@@ -17,12 +17,15 @@ sweep, :mod:`ght_cad.sweep`) hold one row per design:
 * key figures: ``area`` (flat pattern area), ``theta_max`` (degrees, spec section 5),
   ``pattern_error`` (largest relative error of the flat pattern), ``optimization``
   (method, objective, best value and parameters) and ``best_value``;
-* ``elapsed_s``, ``host``, ``pid``, ``worker`` (``local`` or the Dask worker's address) and
+* ``elapsed_s`` (wall time of the design in its worker), ``cpu_s`` (CPU time of the worker's
+  process on it: well below ``elapsed_s`` means the worker waited for a core), ``host``, ``pid``, ``worker`` (``local`` or the Dask worker's address) and
   ``attempts``.
 
 A local worker process that dies (killed, or a crash in the CAD kernel) breaks the process pool:
-every design not finished is run again in a fresh pool, and a design that was running when its
-process died for the :data:`MAX_ATTEMPTS`-th time is reported ``failed``. On Dask the scheduler
+every design not finished is run again in a fresh pool (forked from this process with the run's
+modules loaded, :func:`preload_run_modules`), and a design whose own process died under it for
+the :data:`MAX_ATTEMPTS`-th time is reported ``failed``. The designs that were running in the
+other workers (which the pool terminates) are run again without counting against them. On Dask the scheduler
 reruns a task whose worker died (its ``allowed-failures``, default 3) before reporting
 ``KilledWorker``, which becomes ``failed``.
 
@@ -34,6 +37,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import signal
 import socket
 import sys
 import tempfile
@@ -45,7 +49,7 @@ from typing import Any, Callable, Sequence
 from .errors import GHTError
 
 __all__ = ["BatchJob", "BatchResult", "collect_jobs", "run_batch", "run_task", "MAX_ATTEMPTS", "batch_markdown",
-           "map_step_faces"]
+           "map_step_faces", "preload_run_modules"]
 
 #: How often a design may be running in a local worker process that dies before it is reported failed.
 MAX_ATTEMPTS = 2
@@ -197,9 +201,9 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
     caller knows which designs were running in a process that died).
 
     Returns:
-        ``{"status", "error", "report", "files": {name: bytes}, "elapsed_s", "host", "pid", "worker"}``.
+        ``{"status", "error", "report", "files": {name: bytes}, "elapsed_s", "cpu_s", "host", "pid", "worker"}``.
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     if task.get("marker"):
         Path(task["marker"]).write_text(str(os.getpid()))
     out: dict[str, Any] = {"status": OK, "error": None, "report": None, "files": {}, **_where()}
@@ -216,6 +220,7 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - an internal failure of one design; the batch goes on
         out.update(status=FAILED, error=f"internal failure: {type(exc).__name__}: {_one_line(exc)}")
     out["elapsed_s"] = time.perf_counter() - t0
+    out["cpu_s"] = time.process_time() - c0
     return out
 
 
@@ -265,6 +270,7 @@ def _row(job: BatchJob, status: str, error: str | None, result: dict[str, Any] |
         **_figures(res.get("report") if status == OK else None),
         "files": sorted(res.get("files") or {}) if status == OK else [],
         "elapsed_s": res.get("elapsed_s"),
+        "cpu_s": res.get("cpu_s"),
         "host": res.get("host"),
         "pid": res.get("pid"),
         "worker": res.get("worker"),
@@ -273,24 +279,56 @@ def _row(job: BatchJob, status: str, error: str | None, result: dict[str, Any] |
     }
 
 
+#: Modules a design run imports on first use (OCP through build123d, matplotlib, scipy.optimize:
+#: several seconds, against well under a second per design once loaded).
+_RUN_MODULES = ("ght_cad.design", "ght_cad.design.run", "ght_cad.design.outputs", "ght_cad.cad.occ",
+                "ght_cad.cad.developable_faces", "ght_cad.plotting", "ght_cad.developable", "ght_cad.unroll",
+                "scipy.optimize", "matplotlib.figure", "matplotlib.backends.backend_agg", "build123d")
+
+
+def preload_run_modules() -> float:
+    """Import what a design run needs (:data:`_RUN_MODULES`) into this process; returns the seconds taken.
+
+    Called before local worker processes are forked, so they start with everything loaded (and
+    share those pages) instead of each importing it on its first design; a fresh pool after a
+    worker died starts warm too. A module that is not installed is skipped (the design that
+    needs it reports the error).
+    """
+    import importlib
+
+    t0 = time.perf_counter()
+    for name in _RUN_MODULES:
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            pass
+    return time.perf_counter() - t0
+
+
 def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, Any] | None, int, str | None], None]) -> None:
     """Run ``jobs`` in ``n`` local processes; ``finish(job, result, attempts, death)`` per design."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
-    ctx = multiprocessing.get_context("fork" if sys.platform.startswith("linux") else None)
+    fork = sys.platform.startswith("linux")
+    ctx = multiprocessing.get_context("fork" if fork else None)
+    if fork:
+        preload_run_modules()
     markers = Path(tempfile.mkdtemp(prefix="ght-cad-batch-markers."))
     pending = {j.index: j for j in jobs}
-    attempts = {j.index: 0 for j in jobs}
+    attempts = {j.index: 0 for j in jobs}  # times started
+    deaths = {j.index: 0 for j in jobs}  # times its own process died under it
     try:
         while pending:
             broken = False
+            procs: dict[int, Any] = {}
             with ProcessPoolExecutor(max_workers=max(1, min(n, len(pending))), mp_context=ctx) as ex:
                 futs = {}
                 for j in pending.values():
                     task = {"folder": j.folder, "source": j.source, "data": j.data, "marker": str(markers / str(j.index))}
                     futs[ex.submit(run_task, task)] = j
+                procs = dict(getattr(ex, "_processes", None) or {})  # pid -> Process (all started at once with fork)
                 for fut in as_completed(futs):
                     j = futs[fut]
                     try:
@@ -304,20 +342,36 @@ def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, A
                     finish(j, res, attempts[j.index], None)
             if not broken:
                 break
-            started = [i for i in pending if (markers / str(i)).exists()]
+            started = {i: _marker_pid(markers / str(i)) for i in pending if (markers / str(i)).exists()}
             if not started:  # the pool died before running anything: no retry would help
                 for i in list(pending):
                     finish(pending.pop(i), None, attempts[i], "internal failure: the worker processes could not start")
                 break
-            for i in started:
+            # the pool terminates (SIGTERM) its other workers when one dies: the designs running in
+            # those are run again without counting; a design whose own process died counts a death
+            # (if no process can be told apart, every started design counts one)
+            culprits = {pid for pid, pr in procs.items() if pr.exitcode is not None and pr.exitcode != -signal.SIGTERM}
+            if not culprits & set(started.values()):
+                culprits = set(started.values())
+            for i, pid in started.items():
                 (markers / str(i)).unlink()
                 attempts[i] += 1
-                if attempts[i] >= MAX_ATTEMPTS:
+                if pid in culprits:
+                    deaths[i] += 1
+                if deaths[i] >= MAX_ATTEMPTS:
                     finish(pending.pop(i), None, attempts[i],
-                           f"internal failure: the worker process running it died {attempts[i]} times "
+                           f"internal failure: the worker process running it died {deaths[i]} times "
                            "(killed, out of memory or a crash in the CAD kernel)")
     finally:
         shutil.rmtree(markers, ignore_errors=True)
+
+
+def _marker_pid(path: Path) -> int | None:
+    """The worker pid a started design's marker file holds (None if unreadable)."""
+    try:
+        return int(path.read_text().strip())
+    except (OSError, ValueError):
+        return None
 
 
 def _dask(jobs: list[BatchJob], scheduler: str,

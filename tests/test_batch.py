@@ -13,6 +13,7 @@ which every folder's report.json must match to 1e-9 (relative).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -156,25 +157,81 @@ def _children(pid: int) -> list[int]:
     return [int(x) for x in text.split()]
 
 
+def _running_marker(tmpdir: Path, timeout: float = 90.0) -> tuple[int, int]:
+    """Wait until a local worker runs a design: (its index in the batch, the worker's pid), read
+    from the batch's marker files (``ght-cad-batch-markers.*`` in the batch's TMPDIR)."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        for d in tmpdir.glob("ght-cad-batch-markers.*"):
+            for m in d.iterdir():
+                try:
+                    return int(m.name), int(m.read_text())
+                except (OSError, ValueError):  # being written
+                    pass
+        time.sleep(0.02)
+    raise AssertionError("no design started within the timeout")
+
+
 def test_batch_local_worker_killed(designs, tmp_path):
-    """SIGKILL one worker process mid-run: the designs it was running are run again, all complete."""
+    """SIGKILL the worker process while it runs a design: that design is run again (attempts 2),
+    all complete and exact, nothing half-written in DIR."""
     paths, areas = designs
     good = [p for p in paths if p.stem != "broken"][:4]
     out = tmp_path / "out"
+    tmpdir = tmp_path / "tmp"
+    tmpdir.mkdir()
     proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
-                             "--jobs", "2", "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    t0 = time.monotonic()
-    kids: list[int] = []
-    while time.monotonic() - t0 < 60 and len(kids) < 2:
-        kids = _children(proc.pid)
-        time.sleep(0.05)
-    assert len(kids) >= 2, "the batch never started its worker processes"
-    time.sleep(1.0)  # the workers are importing / running their first design
-    os.kill(kids[0], signal.SIGKILL)
+                             "--jobs", "2", "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "TMPDIR": str(tmpdir)})
+    index, pid = _running_marker(tmpdir)
+    assert pid in _children(proc.pid)
+    os.kill(pid, signal.SIGKILL)
     stdout, stderr = proc.communicate(timeout=240)
     assert proc.returncode == 0, stderr
     summary = check_batch(out, {p.stem: areas[p.stem] for p in good}, expect_broken=False)
-    assert max(r["attempts"] for r in summary["rows"]) == 2  # the killed one was retried
+    killed = summary["rows"][index]
+    assert killed["attempts"] == 2 and killed["pid"] != pid  # run again, in another process
+    assert all(r["attempts"] in (1, 2) for r in summary["rows"])
+    assert not list(tmpdir.glob("ght-cad-batch-*"))  # markers and workers' folders removed
+
+
+from ght_cad.batch import run_task  # noqa: E402 - the real one (the test below patches the module's)
+
+
+def crash_on_cone_03(task):
+    """run_task, except that the worker process running cone-03 kills itself (SIGKILL) mid-design."""
+    if task["folder"] == "cone-03":
+        Path(task["marker"]).write_text(str(os.getpid()))
+        os.kill(os.getpid(), signal.SIGKILL)
+    return run_task(task)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forked workers inherit the patched task")
+def test_batch_local_design_that_always_kills_its_worker(designs, tmp_path, monkeypatch):
+    """A design whose worker dies every time: reported failed after MAX_ATTEMPTS deaths, the design
+    running beside it (terminated by the pool) is run again without counting, all others exact."""
+    import ght_cad.batch as gb
+
+    paths, areas = designs
+    good = [p for p in paths if p.stem != "broken"][:5]
+    monkeypatch.setattr(gb, "run_task", crash_on_cone_03)
+    out = tmp_path / "out"
+    res = run_batch(good, out, jobs=2, progress=False)
+    rows = {r["name"]: r for r in res.rows}
+    bad = rows.pop("cone-03")
+    assert bad["status"] == "failed" and bad["attempts"] == gb.MAX_ATTEMPTS and bad["folder"] is None
+    assert f"died {gb.MAX_ATTEMPTS} times" in bad["error"]
+    assert not (out / "cone-03").exists()
+    assert res.exit_code == 1
+    assert all(r["status"] == "ok" for r in rows.values())
+    summary = json.loads((out / "batch.json").read_text())
+    assert summary["failed"] == 1 and summary["succeeded"] == 4
+    for name in rows:
+        folder = out / name
+        assert sorted(p.name for p in folder.iterdir()) == FILES
+        rep = json.loads((folder / "report.json").read_text())
+        assert abs(rep["flat_pattern"]["area"] - areas[name]) <= 1e-9 * areas[name]
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -196,15 +253,18 @@ def _start_worker(address: str, log: Path) -> subprocess.Popen:
                             stderr=open(log, "w"))
 
 
-@pytest.fixture
-def dask_cluster(tmp_path):
+@contextlib.contextmanager
+def start_cluster(tmp_path: Path, env: dict[str, str] | None = None):
+    """A scheduler and two 1-thread workers (no nanny) on 127.0.0.1: yields (address, processes)."""
     pytest.importorskip("distributed")
     from distributed import Client
 
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
+    penv = {**os.environ, **(env or {})}
     procs = [subprocess.Popen([_dask_bin(), "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                               "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=open(tmp_path / "scheduler.log", "w"))]
+                               "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=open(tmp_path / "scheduler.log", "w"),
+                              env=penv)]
     try:
         procs += [_start_worker(address, tmp_path / f"worker{i}.log") for i in range(2)]
         with Client(address, timeout="60s") as client:
@@ -220,6 +280,12 @@ def dask_cluster(tmp_path):
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait()
+
+
+@pytest.fixture
+def dask_cluster(tmp_path):
+    with start_cluster(tmp_path) as c:
+        yield c
 
 
 def test_batch_dask_cluster(designs, dask_cluster, tmp_path, capsys):
@@ -238,50 +304,74 @@ def test_batch_dask_cluster(designs, dask_cluster, tmp_path, capsys):
     assert (local / "cone-01" / "flat_pattern.svg").read_bytes() == (out / "cone-01" / "flat_pattern.svg").read_bytes()
 
 
-def test_unroll_step_on_dask_identical_to_serial(dask_cluster, tmp_path):
-    import importlib.util
-
-    from ght_cad.design import unroll_step
-
-    address, _ = dask_cluster
-    spec = importlib.util.spec_from_file_location("bench_batch", Path(__file__).parents[1] / "bench" / "bench_batch.py")
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    step = tmp_path / "few.step"
-    bench.many_faces_step(step, 24)
-    serial = unroll_step(step)
-    remote = unroll_step(step, scheduler=address)
-    assert remote.faces == serial.faces
-    for a, b in zip(serial.pattern.panels, remote.pattern.panels):
-        assert a.label == b.label and a.offset.tobytes() == b.offset.tobytes()
-        assert [e.flat.tobytes() for lp in a.loops for e in lp] == [e.flat.tobytes() for lp in b.loops for e in lp]
-        assert [m.tobytes() for m in a.marks] == [m.tobytes() for m in b.marks] and a.texts == b.texts
+def _kill_running_worker(client, victim: str, worker_proc: subprocess.Popen) -> set[str]:
+    """Wait until ``victim`` runs a task, let it run 0.5 s, SIGKILL the worker; returns the design
+    folders of the tasks it held at that moment."""
+    t0 = time.monotonic()
+    keys: list[str] = []
+    while time.monotonic() - t0 < 90 and not keys:
+        keys = [str(k) for k in client.processing(workers=[victim]).get(victim, ())]
+        time.sleep(0.05)
+    assert keys, "no task reached the worker"
+    time.sleep(0.5)
+    keys = [str(k) for k in client.processing(workers=[victim]).get(victim, ())] or keys
+    worker_proc.kill()
+    return {k.split("ght-cad-batch-", 1)[1].rsplit("-", 2)[0] for k in keys}
 
 
 def test_batch_dask_worker_killed(designs, dask_cluster, tmp_path):
-    """SIGKILL one of the two Dask workers mid-run: the scheduler reruns its task, all complete."""
+    """SIGKILL one of the two Dask workers while it runs a design: the scheduler reruns that task
+    on the other worker, all complete and exact, nothing half-written."""
+    from distributed import Client
+
     paths, areas = designs
     address, procs = dask_cluster
     good = [p for p in paths if p.stem != "broken"][:4]
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
-                             "--scheduler", address, "--no-progress"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    from distributed import Client
-
     with Client(address, timeout="30s") as client:
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < 60:
-            proc_info = client.processing()
-            if sum(len(v) for v in proc_info.values()) >= 2:
-                break
-            time.sleep(0.1)
-    time.sleep(1.0)
-    procs[1].kill()
+        victim = next(a for a, pid in client.run(os.getpid).items() if pid == procs[1].pid)
+        proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
+                                 "--scheduler", address, "--no-progress"], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        held = _kill_running_worker(client, victim, procs[1])
     stdout, stderr = proc.communicate(timeout=240)
     assert proc.returncode == 0, stderr
     summary = check_batch(out, {p.stem: areas[p.stem] for p in good}, expect_broken=False)
-    assert len({r["worker"] for r in summary["rows"]}) >= 1
+    rows = {r["name"]: r for r in summary["rows"]}
+    assert held and any(rows[n]["worker"] != victim for n in held)  # run again on the other worker
+
+
+def test_batch_dask_worker_killed_no_retry(designs, tmp_path):
+    """A scheduler allowing no failures (allowed-failures 0): SIGKILL the worker running a design,
+    that design is reported failed (KilledWorker) in batch.json, the others complete and are exact,
+    no folder or staging is left for it."""
+    from distributed import Client
+
+    paths, areas = designs
+    good = [p for p in paths if p.stem != "broken"][:4]
+    out = tmp_path / "out"
+    with start_cluster(tmp_path, {"DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}) as (address, procs):
+        with Client(address, timeout="30s") as client:
+            victim = next(a for a, pid in client.run(os.getpid).items() if pid == procs[1].pid)
+            proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
+                                     "--scheduler", address, "--no-progress"], stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True)
+            seen = _kill_running_worker(client, victim, procs[1])
+            stdout, stderr = proc.communicate(timeout=240)
+    assert proc.returncode == 1, stderr
+    summary = json.loads((out / "batch.json").read_text())
+    rows = {r["name"]: r for r in summary["rows"]}
+    failed = [n for n, r in rows.items() if r["status"] == "failed"]
+    assert failed and set(failed) <= seen, (failed, seen)
+    for n in failed:
+        assert "KilledWorker" in rows[n]["error"] and rows[n]["folder"] is None and not (out / n).exists()
+    ok = {n: areas[n] for n, r in rows.items() if r["status"] == "ok"}
+    assert len(ok) + len(failed) == 4 and ok
+    for n, area in ok.items():
+        assert sorted(p.name for p in (out / n).iterdir()) == FILES
+        rep = json.loads((out / n / "report.json").read_text())
+        assert abs(rep["flat_pattern"]["area"] - area) <= 1e-9 * area
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]
 
 
 # ---------------------------------------------------------------------------------------------

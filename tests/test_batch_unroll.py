@@ -32,6 +32,11 @@ def many_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return p
 
 
+@pytest.fixture(scope="module")
+def serial(many_step):
+    return unroll_step(many_step)
+
+
 def signature(res) -> list:
     """Everything a pattern's files are made of, per panel, bit for bit."""
     out = []
@@ -43,8 +48,7 @@ def signature(res) -> list:
     return out
 
 
-def test_200_faces_parallel_identical_to_serial(many_step):
-    serial = unroll_step(many_step)
+def test_200_faces_parallel_identical_to_serial(many_step, serial):
     parallel = unroll_step(many_step, jobs=2)
     assert len(serial.pattern.panels) >= 200
     kinds = {f["surface_type"] for f in serial.faces}
@@ -60,6 +64,17 @@ def test_200_faces_parallel_identical_to_serial(many_step):
     serial.pattern.export_svg(d / "s.svg")
     parallel.pattern.export_svg(d / "p.svg")
     assert (d / "s.svg").read_bytes() == (d / "p.svg").read_bytes()
+
+
+def test_200_faces_on_dask_identical_to_serial(many_step, serial, tmp_path):
+    """The same 200 faces on a real Dask cluster (scheduler and two workers on 127.0.0.1, started
+    and stopped here): panel for panel identical to the serial result."""
+    from test_batch import start_cluster
+
+    with start_cluster(tmp_path) as (address, _):
+        remote = unroll_step(many_step, scheduler=address)
+    assert remote.faces == serial.faces
+    assert signature(remote) == signature(serial)
 
 
 def test_unroll_cli_jobs(many_step, capsys):
@@ -85,3 +100,33 @@ def test_parallel_error_is_the_serial_one(tmp_path):
     with pytest.raises(NotDevelopableError) as e2:
         unroll_step(p, jobs=2)
     assert str(e1.value) == str(e2.value) and "face 10 of 10" in str(e1.value)
+
+
+def entities(dxf: bytes) -> bytes:
+    """The ENTITIES section of a DXF (the header holds creation times and GUIDs)."""
+    start = dxf.index(b"\nENTITIES\n")
+    return dxf[start:dxf.index(b"\nENDSEC\n", start)]
+
+
+def test_unroll_jobs_with_sheet_forming_identical_to_serial(tmp_path, capsys):
+    """``--thickness --forming-png --jobs 2``: the forming data (bend radii, angles, edge lengths
+    inside/neutral/outside, the roll chart) are computed in the worker with the development map and
+    travel in ``panel.info``: JSON, DXF (FORMING layer), SVG and roll-chart PNG equal the serial run's."""
+    step = tmp_path / "sheet.step"
+    _bench().many_faces_step(step, 8)
+    outs = {}
+    for tag, extra in (("serial", []), ("jobs", ["--jobs", "2"])):
+        d = tmp_path / tag
+        d.mkdir()
+        code = main(["unroll", str(step), "--thickness", "0.5", "--k-factor", "0.4", "--json",
+                     "--dxf", str(d / "p.dxf"), "--svg", str(d / "p.svg"), "--forming-png", str(d / "f.png"), *extra])
+        assert code == 0
+        res = json.loads(capsys.readouterr().out)
+        res.pop("outputs")
+        outs[tag] = (res, *((d / f).read_bytes() for f in ("p.dxf", "p.svg", "f.png")))
+    serial, par = outs["serial"], outs["jobs"]
+    assert len(serial[0]["sheet"]) == serial[0]["panels"] >= 8
+    assert any(row["forming"] for row in serial[0]["sheet"])  # curved faces have bend lines with radii
+    assert par[0] == serial[0]
+    assert entities(par[1]) == entities(serial[1]) and b"FORMING" in entities(serial[1])
+    assert par[2] == serial[2] and par[3] == serial[3]
