@@ -1802,6 +1802,12 @@ def loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve,
             where F does not vanish) or a quantity is singular (zero ruling, F_s = F_t on the
             branch, a non-finite derivative); the caller falls back to finite differences.
     """
+    with np.errstate(all="ignore"):
+        return _loft_measures_and_gradients(lf, ca, cb, margin, nodes, area_nodes)
+
+
+def _loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve, margin: float, nodes: int,
+                                 area_nodes: int) -> tuple[dict[str, float], dict[str, np.ndarray]]:
     x, w = gauss_legendre(nodes)
     xa, wa = gauss_legendre(area_nodes)
     (t0, s0), (t1, s1) = lf._branch.start, lf._branch.end

@@ -205,6 +205,8 @@ def _value_and_grad_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpe
     exact (composite; rails through :class:`ght_cad.loft.LoftProblem`), else None."""
     surf = design.surface
     assert surf is not None
+    if surf.type == "rails":
+        return _rails_value_and_grad_fn(design, curves, spec, names, shape_of)
     if surf.type != "composite":
         return None
 
@@ -216,6 +218,76 @@ def _value_and_grad_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpe
             f[i], G[i] = composite_value_and_grad(design, shape_of(x), names, spec.objective, spec.weights)
         return f, G
 
+    return vg
+
+
+def _rails_value_and_grad_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec, names: Sequence[str],
+                             shape_of: Callable[[np.ndarray], dict[str, float]]
+                             ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+    r"""``value_and_grad`` of a ``rails`` objective (:func:`_rails_objective_fn`): the same loft and
+    measures, and the exact gradient :meth:`ght_cad.loft.LoftProblem.gradient_of` (implicit-function
+    derivative of the traced branch, moving breakpoints). Where the loft's structure is not
+    locally fixed (:class:`ght_cad.loft.LoftGradientFallback`) forward differences of step 1e-7
+    inwards, their evaluations counted in ``vg.extra_nfev``. None when a rail is re-solved by a
+    join for every candidate (the join is not differentiated here: finite differences).
+    """
+    from ..loft import LOFT_OBJECTIVES, LoftGradientFallback, LoftProblem
+
+    surf = design.surface
+    assert surf is not None
+    if {str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins}:
+        return None
+    if spec.objective == "weighted":
+        weights = {k: float(w) for k, w in zip(LOFT_OBJECTIVES, spec.weights) if w > 0}
+    else:
+        weights = {spec.objective: 1.0}
+    problem = LoftProblem(curves[surf.curve_a], curves[surf.curve_b], weights)
+    h = _rails_objective_fn(design, curves, spec, False)
+    all6 = [f"{r}.{k}" for r in ("a", "b") for k in SHAPE_NAMES]
+    idx = [all6.index(n) for n in names]
+
+    def one(x: np.ndarray) -> tuple[float, np.ndarray]:
+        sh = shape_of(x)
+        try:
+            with np.errstate(all="ignore"):
+                ca = curves[surf.curve_a].with_shape(sh["a.mu"], sh["a.nu"], sh["a.gamma"])
+                cb = curves[surf.curve_b].with_shape(sh["b.mu"], sh["b.nu"], sh["b.gamma"])
+                lf = make_loft(surf, ca, cb, samples=CANDIDATE_LOFT_SAMPLES)
+                m = problem.measures_of(lf)
+                value = float(sum(w * m[k] for k, w in weights.items()))
+        except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+            return math.inf, np.zeros(len(names))
+        if not math.isfinite(value):
+            return math.inf, np.zeros(len(names))
+        try:
+            with np.errstate(all="ignore"):
+                return value, problem.gradient_of(lf, ca, cb)[idx]
+        except (LoftGradientFallback, GHTError) as exc:
+            vg.fallbacks.append(str(exc))  # type: ignore[attr-defined]
+        g = np.zeros(len(names))
+        for j in range(len(names)):
+            step = 1e-7 if x[j] + 1e-7 <= 1.0 else -1e-7
+            y = np.array(x, dtype=float)
+            y[j] += step
+            try:
+                with np.errstate(all="ignore"):
+                    fj = h(shape_of(y))
+            except (GHTError, np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError):
+                fj = math.inf
+            vg.extra_nfev += 1  # type: ignore[attr-defined]
+            g[j] = (fj - value) / step if math.isfinite(fj) else 0.0
+        return value, g
+
+    def vg(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        f = np.empty(X.shape[0])
+        G = np.zeros(X.shape)
+        for i, x in enumerate(X):
+            f[i], G[i] = one(x)
+        return f, G
+
+    vg.extra_nfev = 0  # type: ignore[attr-defined]
+    vg.fallbacks = []  # type: ignore[attr-defined]
     return vg
 
 
@@ -355,6 +427,7 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
     out = OptimizationOutcome(spec.method, spec.objective, names, x, best, initial, np.asarray(res.history),
                               int(res.nfev), int(res.nit), float(res.time), shape_of(x), list(spec.weights))
     out.njev = int(getattr(res, "njev", 0) or 0)
+    out.nfev += int(getattr(vg, "extra_nfev", 0))  # finite-difference fallbacks of an exact gradient
     if stype == "composite":
         out.strips, out.joints = _composite_before_after(design, spec, base, out.shape)
     return out
