@@ -5,6 +5,12 @@ The values below were computed on main before the hybrid method and the gradient
 count and the sum of the history, for two seeds on the bench's problems and a Rosenbrock function.
 A change in any of the thesis' algorithms, in the random stream they draw, or in the problems'
 evaluation shows up here as a mismatch.
+
+One exception, measured: the interpolation problem's control points come from
+``numpy.linalg.solve`` (LAPACK in numpy's bundled OpenBLAS), whose last bits differ between numpy
+builds (numpy 2.4.6's wheel moves the best value by 1-4 units in the last place against the
+values below, with the same best point and count). For that problem the values are compared to
+1e-13 relative; the best point (the algorithm's path) and the counts stay bit-exact.
 """
 
 from __future__ import annotations
@@ -63,4 +69,10 @@ def test_thesis_optimizers_bit_identical(key):
     fun, bounds = _problem(name)
     r = {"pso": pso, "gwo": gwo, "igwo": igwo}[method](fun, bounds, pop_size=12, max_iter=15, seed=seed)
     got = ([float(v).hex() for v in r.x], float(r.fun).hex(), r.nfev, float(r.history.sum()).hex())
-    assert got == PINNED[key]
+    if name != "interp":
+        assert got == PINNED[key]
+        return
+    x, fun, nfev, hist = PINNED[key]
+    assert (got[0], got[2]) == (x, nfev)
+    assert float(r.fun) == pytest.approx(float.fromhex(fun), rel=1e-13, abs=0.0)
+    assert float(r.history.sum()) == pytest.approx(float.fromhex(hist), rel=1e-13, abs=0.0)

@@ -163,21 +163,29 @@ def plate_solid(
         face = faces[0]
         _face_sheet_check(face, sheet, label)
     T = sheet.thickness
-    with quiet_occt():
-        mo = BRepOffset_MakeOffset()
-        # skin mode, no intersection/self-intersection, arc joins, thickening (a solid), keep edges
-        mo.Initialize(face, sheet.outside_offset, 1e-7, BRepOffset_Skin, False, False, GeomAbs_Arc, True, False)
-        mo.MakeOffsetShape()
-    if not mo.IsDone():
-        raise GHTError(f"OCCT could not thicken {label!r} by thickness={T!r} (BRepOffset error {mo.Error()})")
-    solid = mo.Shape()
-    if solid.ShapeType() != TopAbs_SOLID:
-        exp = TopExp_Explorer(solid, TopAbs_SOLID)
-        if not exp.More():
-            raise GHTError(f"thickening {label!r} by thickness={T!r} gave no solid")
-        solid = TopoDS.Solid_s(exp.Current())
-    if not is_valid(solid):
-        raise GHTError(f"thickening {label!r} by thickness={T!r} gave an invalid solid (BRepCheck_Analyzer)")
+    # OCCT's offset tolerance: 1e-7 first; a few faces (measured: a quarter cone frustum r 200..400,
+    # T = 4, fitted as a degree-5 B-spline) give an invalid solid there and a valid one at 1e-6, so
+    # the tolerance is raised step by step up to 1e-5 (far below any sheet tolerance) before refusing.
+    solid = None
+    for offset_tol in (1e-7, 1e-6, 1e-5):
+        with quiet_occt():
+            mo = BRepOffset_MakeOffset()
+            # skin mode, no intersection/self-intersection, arc joins, thickening (a solid), keep edges
+            mo.Initialize(face, sheet.outside_offset, offset_tol, BRepOffset_Skin, False, False, GeomAbs_Arc, True, False)
+            mo.MakeOffsetShape()
+        if not mo.IsDone():
+            raise GHTError(f"OCCT could not thicken {label!r} by thickness={T!r} (BRepOffset error {mo.Error()})")
+        solid = mo.Shape()
+        if solid.ShapeType() != TopAbs_SOLID:
+            exp = TopExp_Explorer(solid, TopAbs_SOLID)
+            if not exp.More():
+                raise GHTError(f"thickening {label!r} by thickness={T!r} gave no solid")
+            solid = TopoDS.Solid_s(exp.Current())
+        if is_valid(solid):
+            break
+    else:
+        raise GHTError(f"thickening {label!r} by thickness={T!r} gave an invalid solid (BRepCheck_Analyzer, "
+                       f"offset tolerances 1e-7 to 1e-5 tried)")
     inside, outside, edges = None, None, []
     for f in _faces(solid):
         u0, u1, v0, v1 = BRepTools.UVBounds_s(f)  # a point on the face (its centre of mass is not)
