@@ -309,15 +309,170 @@ class Problem:
         return {"objective": self.value(x)}
 
 
+_I1 = np.array([1, 2, 0])
+_I2 = np.array([2, 0, 1])
+
+
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` over the last axis (length 3) with broadcasting; like ``numpy.cross`` without its axis handling."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+    """``a × b`` over the last axis (length 3) with broadcasting: ``a[1] b[2] - a[2] b[1]``, ... per
+    component, the arithmetic of ``numpy.cross`` (same results bit for bit) without its axis handling."""
+    return np.take(a, _I1, axis=-1) * np.take(b, _I2, axis=-1) - np.take(a, _I2, axis=-1) * np.take(b, _I1, axis=-1)
 
 
 def _split(all_params: np.ndarray, start: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return all_params[:, start], all_params[:, start + 1], all_params[:, start + 2]
+
+
+class _StripKernel:
+    r"""Fast evaluation of the strip's ``R`` and its exact gradient on fixed Gauss–Legendre nodes.
+
+    **Values**: bit for bit those of the basis-matrix route (:class:`PopulationBasis` ->
+    ``b^(r) @ control_points`` -> ``numpy.cross``, kept as
+    :meth:`StripProblem._r_and_grad_reference`). Every elementwise operation of the seed formula
+    (:func:`ght_cad.seeds.ght_seed_jet`, orders 0 and 1) is done once on arrays stacked over
+    (curve, f0/f2) instead of once per curve and order; everything that depends on the nodes only
+    (sin/cos, their squares, ``(1-t)²``, ``t²``, Bernstein matrices) is computed once; the basis
+    ``b^(r)_{i,m} = Σ_s C(r,s) Σ_k B^(r-s)_{i-k,n} f_k^(s)`` is one product with zero-padded
+    Bernstein matrices (terms in the order of :func:`ght_cad.basis.basis_from_jets`, the padding
+    adds exact zeros) summed over the terms. Same operations in the same order per element: same
+    floating-point results (checked in tests/test_optimize_problems.py).
+
+    **Gradient** (spec 8.1): ``∂X^(r)/∂μ = v U_r``, ``∂X^(r)/∂ν = v V_r``,
+    ``∂X^(r)/∂γ = W_r - (μ U_r + ν V_r)/2`` with ``v = (1-γ)/2`` and the fixed fields
+    ``(U, V, W)_r = ∂X^(r)/∂(μ, ν, γ)`` at ``(μ, ν, γ) = (0, 0, -1)`` (:class:`CurveParameterJets`;
+    f0 is bilinear in (μ, w), f2 in (ν, w)). With ``K_a = n_b/(|n_a||n_b|) - c n_a/|n_a|²`` and
+    ``K_b = n_a/(|n_a||n_b|) - c n_b/|n_b|²`` (so ``∂c = ∂n_a·K_a + ∂n_b·K_b``) and the triple
+    product ``(x×y)·z = x·(y×z)``:
+
+    ``∂c = ∂A'·(g×K_a) + ∂A·M + ∂B'·(g×K_b) - ∂B·M``, ``M = A'×K_a + B'×K_b``, ``g = B - A``,
+
+    so the gradient costs four cross products per node whatever the number of parameters, and
+    ``∂R/∂θ = -Σ_j w_j ∂c_j`` (0 where the clip of c to [-1, 1] is active) is one small matrix
+    product with the fixed fields per curve.
+    """
+
+    def __init__(self, t: np.ndarray, curves: Sequence[GHTCurve]) -> None:
+        from ..seeds import _HALF_PI, _trig_values
+
+        self.t = t
+        N = t.size
+        sa, ca, sp, _ = _trig_values(t, range(2))  # the arrays ght_seed_derivatives(t, ..., 1) uses
+        col = (2, 1, 1, N)  # (f0/f2, curve, row, node)
+        self._x1 = np.stack([sa, ca]).reshape(col)                    # s, c
+        self._x2 = np.stack([sa * sa, ca * ca]).reshape(col)          # s², c²
+        self._poly0 = np.stack([(1.0 - t) ** 2, t * t]).reshape(col)  # (1-t)², t²
+        self._xs1 = np.stack([ca, sa]).reshape(col)                   # s' ∝ cos, c' ∝ -sin
+        self._xd = sp                                                 # (s²)' = -(c²)' ∝ sin(πt)
+        hr = _HALF_PI ** 1
+        self._hs = np.array([hr * 1.0, hr * -1.0]).reshape(2, 1, 1, 1)  # (π/2) sign of s', c'
+        self._half_d = 0.5 * math.pi ** 1 * -1.0
+        self._sgn = np.array([-1.0, 1.0]).reshape(2, 1, 1, 1)          # f0' = a - b, f2' = a + b
+        degs = [c.degree for c in curves]
+        groups = [list(range(len(curves)))] if len(set(degs)) == 1 else [[i] for i in range(len(curves))]
+        self.groups = []
+        for grp in groups:
+            m1 = degs[grp[0]] + 1
+            n1 = m1 - 2
+            b0, b1 = bernstein(t, n1 - 1, 0), bernstein(t, n1 - 1, 1)
+            # terms (f0, f1, f2, f0', f1', f2') per t-order: order 0 uses B f_k, order 1 B' f_k then B f_k'
+            bst = np.zeros((2, 6, N, m1))
+            for k in range(3):
+                bst[0, k, :, k:k + n1] = b0
+                bst[1, k, :, k:k + n1] = b1
+                bst[1, 3 + k, :, k:k + n1] = b0
+            cp = np.stack([np.asarray(curves[i].control_points, dtype=float) for i in grp])[:, None]
+            cols_l = [3 * i for i in grp] + [3 * i + 1 for i in grp]  # (μ of each curve, ν of each curve)
+            cols_g = [3 * i + 2 for i in grp]
+            self.groups.append((grp, cols_l, cols_g, bst[:, :, None, None], cp))
+        self.n_curves = len(curves)
+        # fixed gradient fields (U, V, W) per curve and t-order, each (N*3, 3)
+        f0, f1 = [], []
+        for c in curves:
+            d = CurveParameterJets(t, c.control_points, 1)(np.zeros(1), np.zeros(1), -np.ones(1), (0, 1))
+            f0.append(d[0][:, 0].reshape(3, -1).T)
+            f1.append(d[1][:, 0].reshape(3, -1).T)
+        self._fields0 = np.concatenate(f0, axis=1)  # (N*3, 6): ∂X fields of curve A then curve B
+        self._fields1 = np.stack(f1)                # (2, N*3, 3): ∂X' fields
+
+    def jets_stacked(self, F: np.ndarray) -> list[tuple[list[int], np.ndarray]]:
+        """Per group of curves of one degree: (curve indices, ``[X, X']`` of shape (2, G, P, N, 3))."""
+        P = F.shape[0]
+        N = self.t.size
+        out = []
+        for grp, cols_l, cols_g, bst, cp in self.groups:
+            G = len(grp)
+            lam = F[:, cols_l].T.reshape(2, G, P, 1)  # (μ, ν) x curve
+            ga = F[:, cols_g].T.reshape(1, G, P, 1)
+            w = 0.5 * (1.0 + ga)
+            v = 1.0 - w
+            lam1 = 1.0 + lam
+            w2 = 2.0 * w
+            # seed jets (f0, f1, f2, f0', f1', f2'), f1 = δ_r0 - f0 - f2, straight into the term array
+            fs = np.empty((6, G, P, N))
+            # order 0: (1-w)(1 - (1+λ)x + λx²) + w p   (f0: λ = μ, x = s, p = (1-t)²; f2: ν, c, t²)
+            np.add(v * (1.0 - lam1 * self._x1 + lam * self._x2), w * self._poly0, out=fs[0:3:2])
+            np.subtract(1.0, fs[0], out=fs[1])
+            np.subtract(fs[1], fs[2], out=fs[1])
+            # order 1: -(1-w)(1+λ) x' + (1-w) λ (x²)' + w p'   (p0' = 2wt - 2w, p2' = 2wt)
+            d1 = (-(v * lam1)) * self._hs * self._xs1 + (((v * lam) * self._half_d) * self._sgn) * self._xd
+            wt = w2 * self.t
+            np.add(d1[0], wt[0] - w2[0], out=fs[3])
+            np.add(d1[1], wt[0], out=fs[5])
+            np.subtract(0.0, fs[3], out=fs[4])
+            np.subtract(fs[4], fs[5], out=fs[4])
+            J = np.add.reduce(bst * fs[..., None], axis=1) @ cp  # basis (2, G, P, N, m+1) @ points
+            out.append((grp, J))
+        return out
+
+    def jets(self, F: np.ndarray) -> list[np.ndarray]:
+        """``[X, X']`` per curve: a list of (2, P, N, 3) arrays (curve order of the constructor)."""
+        out: list[Any] = [None] * self.n_curves
+        for grp, J in self.jets_stacked(F):
+            for j, i in enumerate(grp):
+                out[i] = J[:, j]
+        return out
+
+    def value_and_grad(self, F: np.ndarray, w: np.ndarray, grad: bool) -> tuple[np.ndarray, Any]:
+        """``R`` (pop,) and, with ``grad``, its gradient (pop, 6) on full rows."""
+        js = self.jets_stacked(F)
+        if len(js) == 1:
+            J = js[0][1]
+            D = J[1]  # A', B'
+            g = J[0, 1] - J[0, 0]
+        else:
+            (_, Ja), (_, Jb) = js
+            D = np.concatenate([Ja[1], Jb[1]])
+            g = Jb[0, 0] - Ja[0, 0]
+        n = _cross(D, g)  # n_a, n_b
+        L = np.sqrt(np.add.reduce(n * n, axis=-1))  # numpy.linalg.norm(n, axis=-1)
+        la, lb = L[0], L[1]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            dot = np.add.reduce(n[0] * n[1], axis=-1) / (la * lb)
+            val = (1.0 - np.clip(dot, -1.0, 1.0)) @ w
+            val = np.where(np.isfinite(val), val, np.inf)
+            if not grad:
+                return val, None
+            P = F.shape[0]
+            # K_a, K_b, weighted by w_j where c is not clipped (rows with a non-finite value get G = 0)
+            K = n[::-1] / (la * lb)[..., None] - (dot / (L * L))[..., None] * n
+            K *= np.where(np.abs(dot) < 1.0, w, 0.0)[..., None]
+            X3 = np.empty((3,) + g.shape)
+            X3[0] = g
+            X3[1:] = D
+            C = _cross(X3[:, None], K)  # (g, A', B') x (K_a, K_b)
+            M = (C[1, 0] + C[2, 1]).reshape(P, -1)  # A'×K_a + B'×K_b
+            S0 = M @ self._fields0  # (P, 6): Σ_j w_j M·(U, V, W) for curve A, then curve B
+            S1 = C[0].reshape(2, P, -1) @ self._fields1  # (2, P, 3): Σ_j w_j (g×K_c)·(U', V', W')
+            S = S1 + np.stack([S0[:, :3], -S0[:, 3:]])  # (2, P, 3) per curve
+            Fc = F.reshape(P, 2, 3).transpose(1, 0, 2)  # (2, P, 3): μ, ν, γ per curve
+            v = 1.0 - 0.5 * (1.0 + Fc[..., 2])
+            G = np.empty((P, 2, 3))
+            Gt = G.transpose(1, 0, 2)
+            np.multiply(-v[..., None], S[..., :2], out=Gt[..., :2])
+            np.subtract(0.5 * (Fc[..., 0] * S[..., 0] + Fc[..., 1] * S[..., 1]), S[..., 2], out=Gt[..., 2])
+            G = G.reshape(P, 6)
+        G[~np.isfinite(val)] = 0.0
+        return val, G
 
 
 # --------------------------------------------------------------------------------------------
@@ -369,16 +524,13 @@ class StripProblem(Problem):
         self._basis = (PopulationBasis(self.t, curve_a.degree), PopulationBasis(self.t, curve_b.degree))
         self._pjets = (CurveParameterJets(self.t, curve_a.control_points, 1),
                        CurveParameterJets(self.t, curve_b.control_points, 1))
+        self._kernel = _StripKernel(self.t, (curve_a, curve_b))
 
     def jets(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``A, A', B, B'`` at the nodes for full parameter rows F: each (pop, N, 3)."""
-        out = []
-        for k, c, pb in ((0, self.curve_a, self._basis[0]), (3, self.curve_b, self._basis[1])):
-            mu, nu, ga = _split(F, k)
-            Bm = pb(mu, nu, ga, (0, 1))
-            for r in (0, 1):
-                out.append(Bm[r] @ c.control_points)
-        return out[0], out[1], out[2], out[3]
+        """``A, A', B, B'`` at the nodes for full parameter rows F: each (pop, N, 3) (bit for bit
+        ``population_basis(...) @ control_points``)."""
+        Ja, Jb = self._kernel.jets(np.asarray(F, dtype=float))
+        return Ja[0], Ja[1], Jb[0], Jb[1]
 
     def evaluate_full(self, F: np.ndarray) -> np.ndarray:
         return self._r_and_grad(F, False)[0]
@@ -395,7 +547,16 @@ class StripProblem(Problem):
         return self._r_and_grad(F, True)
 
     def _r_and_grad(self, F: np.ndarray, grad: bool) -> tuple[np.ndarray, Any]:
-        A, A1, B, B1 = self.jets(F)
+        return self._kernel.value_and_grad(F, self.w, grad)
+
+    def _r_and_grad_reference(self, F: np.ndarray, grad: bool) -> tuple[np.ndarray, Any]:
+        """The direct implementation (one basis and one jet call per curve, a cross product per
+        parameter), kept to check :class:`_StripKernel` against (tests)."""
+        out = []
+        for k, c, pb in ((0, self.curve_a, self._basis[0]), (3, self.curve_b, self._basis[1])):
+            Bm = pb(*_split(F, k), (0, 1))
+            out += [Bm[r] @ c.control_points for r in (0, 1)]
+        A, A1, B, B1 = out
         g = B - A
         na = np.cross(A1, g)
         nb = np.cross(B1, g)
