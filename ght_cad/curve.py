@@ -7,6 +7,7 @@ the classical Bézier curve of degree ``n = m-2`` on ``P_k .. P_{k+n}``.
 
 from __future__ import annotations
 
+import functools
 from functools import cached_property
 from math import comb
 from typing import Any, Iterable
@@ -23,9 +24,19 @@ __all__ = ["GHTCurve", "gauss_legendre", "integrate"]
 _CHUNK = 1 << 15
 
 
+@functools.lru_cache(maxsize=64)
+def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``numpy.polynomial.legendre.leggauss(n)`` computed once per n (an eigenvalue problem of
+    size n; read-only arrays)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
+
+
 def gauss_legendre(n: int, a: float = 0.0, b: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Gauss–Legendre nodes and weights on [a, b] (exact for polynomials of degree 2n-1)."""
-    x, w = np.polynomial.legendre.leggauss(int(n))
+    x, w = _leggauss(int(n))
     h = 0.5 * (b - a)
     return a + h * (x + 1.0), h * w
 

@@ -62,6 +62,9 @@ __all__ = [
 Bounds = tuple[float, float, float, float]
 #: surface kinds with a structural ruling direction "v" (their v-isolines are straight lines)
 RULED_KINDS = ("plane", "cylinder", "cone", "extrusion")
+#: surface kinds whose area density ``|S_u × S_v|`` does not depend on u (a plane: constant; a
+#: cylinder or cone: u is the angle about the axis), so :func:`face_area` needs no inner integral
+U_FREE_DENSITY_KINDS = ("plane", "cylinder", "cone")
 
 
 class SurfaceAdapter:
@@ -97,6 +100,23 @@ class SurfaceAdapter:
         """Parameters in ``direction`` ("u" or "v") where the surface is not C∞ (B-spline knots);
         may include the ends; empty for analytic surfaces."""
         return np.zeros(0)
+
+    def jet(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        """``[S]`` (order 0), ``[S, S_u, S_v]`` (1) or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` (2) at the
+        points in one evaluation (override when that is cheaper than :meth:`value` + :meth:`d1`)."""
+        return surface_jet(self, u, v, order, own=False)
+
+
+def surface_jet(ev: Any, u: np.ndarray, v: np.ndarray, order: int, own: bool = True) -> list[np.ndarray]:
+    """``ev.jet(u, v, order)`` when the adapter has one (``own``), else from ``value``/``d1``/``d2``
+    (adapters that are not :class:`SurfaceAdapter` subclasses, e.g. a sheet's offset surface)."""
+    if own and hasattr(ev, "jet"):
+        return ev.jet(u, v, order)
+    if order <= 0:
+        return [ev.value(u, v)]
+    if order == 1:
+        return [ev.value(u, v), *ev.d1(u, v)]
+    return ev.d2(u, v)
 
 
 @dataclass
@@ -158,6 +178,24 @@ class FaceRuledSurface(RuledSurface):
             self.t0, self.t1, self.s0, self.s1 = v0, v1, u0, u1
         ks = np.asarray(surface.breaks("u" if ruled == "v" else "v"), dtype=float)
         self.breakpoints = tuple(((ks - self.t0) / (self.t1 - self.t0)).tolist())
+        self._jets: dict[bytes, tuple[int, list[np.ndarray]]] = {}
+
+    def _jet(self, t: np.ndarray, order: int) -> list[np.ndarray]:
+        """Jets of the surface at both boundaries ``(t, s0)`` and ``(t, s1)`` stacked (2n points), one
+        surface evaluation per parameter array (kept for the last 8 arrays: the quadrature and the
+        developability ask for a, a', b, b' at the same parameters)."""
+        key = t.tobytes()
+        hit = self._jets.get(key)
+        if hit is not None and hit[0] >= order:
+            return hit[1]
+        tt = np.concatenate([t, t])
+        ss = np.concatenate([np.zeros(t.size), np.ones(t.size)])
+        u, v = self.uv(tt, ss)
+        jet = surface_jet(self.ev, u, v, order)
+        if len(self._jets) >= 8:
+            self._jets.pop(next(iter(self._jets)))
+        self._jets[key] = (order, jet)
+        return jet
 
     def uv(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Face parameters of ruled parameters (t, s) ∈ [0, 1]²."""
@@ -171,15 +209,15 @@ class FaceRuledSurface(RuledSurface):
         return (tp - self.t0) / (self.t1 - self.t0), (sp - self.s0) / (self.s1 - self.s0)
 
     def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        u, v = self.uv(t, np.full_like(t, s))
-        if derivative == 0:
-            return self.ev.value(u, v)
+        t = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
         if derivative > 2:
             raise GHTError(f"derivative={derivative} is not available for faces; allowed 0, 1, 2")
-        d = self.ev.d2(u, v)
+        d = self._jet(t, derivative)
+        part = slice(0, t.size) if s == 0.0 else slice(t.size, 2 * t.size)
+        if derivative == 0:
+            return d[0][part].copy()
         k = (1 if self.ruled == "v" else 2) if derivative == 1 else (3 if self.ruled == "v" else 4)
-        return d[k] * (self.t1 - self.t0) ** derivative
+        return d[k][part] * (self.t1 - self.t0) ** derivative
 
     def a(self, u: Any, derivative: int = 0) -> np.ndarray:
         return self._edge(u, 0.0, derivative)
@@ -188,7 +226,25 @@ class FaceRuledSurface(RuledSurface):
         return self._edge(u, 1.0, derivative)
 
 
-def isoline_stats(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> tuple[float, float]:
+def _isoline_points(ev: SurfaceAdapter, bounds: Bounds, directions: Sequence[str]) -> dict[str, np.ndarray]:
+    """Points of the nine isolines along each of ``directions`` (fixed other parameter at 0, 1/8,
+    ..., 1 of its range, 33 points each): ``{direction: (9, 33, 3)}``, one surface evaluation."""
+    u0, u1, v0, v1 = bounds
+    run = np.linspace(0.0, 1.0, 33)
+    us, vs = [], []
+    for direction in directions:
+        for f in np.linspace(0.0, 1.0, 9):
+            if direction == "v":
+                us.append(np.full_like(run, u0 + f * (u1 - u0)))
+                vs.append(v0 + run * (v1 - v0))
+            else:
+                us.append(u0 + run * (u1 - u0))
+                vs.append(np.full_like(run, v0 + f * (v1 - v0)))
+    p = np.asarray(ev.value(np.concatenate(us), np.concatenate(vs)), dtype=float).reshape(len(directions), 9, 33, 3)
+    return {d: p[k] for k, d in enumerate(directions)}
+
+
+def isoline_stats(ev: SurfaceAdapter, bounds: Bounds, direction: str, points: np.ndarray | None = None) -> tuple[float, float]:
     r"""Straightness and openness of the isolines running along ``direction``.
 
     Nine isolines (fixed other parameter at 0, 1/8, ..., 1 of its range), each sampled at 33
@@ -204,37 +260,31 @@ def isoline_stats(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> tuple[f
         bounds: (u0, u1, v0, v1).
         direction: "u" (isolines along u) or "v".
 
+        points: the isolines' points (:func:`_isoline_points`) when already evaluated.
+
     Returns:
         ``(deviation, openness)``: the largest deviation and the smallest ``|c| / L`` over the
         non-degenerate isolines (``openness`` 0 for closed isolines, 1 for straight ones);
         ``(0.0, 1.0)`` when every isoline is degenerate.
     """
-    u0, u1, v0, v1 = bounds
-    fixed = np.linspace(0.0, 1.0, 9)
-    run = np.linspace(0.0, 1.0, 33)
+    if points is None:
+        points = _isoline_points(ev, bounds, (direction,))[direction]
     worst, openness = 0.0, 1.0
-    for f in fixed:
-        if direction == "v":
-            u = np.full_like(run, u0 + f * (u1 - u0))
-            v = v0 + run * (v1 - v0)
-        else:
-            u = u0 + run * (u1 - u0)
-            v = np.full_like(run, v0 + f * (v1 - v0))
-        p = ev.value(u, v)
-        L = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-        if not math.isfinite(L) or L <= 1e-14 * max(1.0, float(np.abs(p).max())):
-            continue  # the isoline is a point (pole, apex)
-        c = p[-1] - p[0]
-        chord = float(np.linalg.norm(c))
-        if chord > 1e-9 * L:
-            origin, axis = p[0], c / chord
-        else:  # closed isoline: its best-fitting straight line
-            origin = p.mean(axis=0)
-            axis = np.linalg.svd(p - origin, full_matrices=False)[2][0]
-        dev = float(np.linalg.norm(np.cross(p - origin, axis), axis=1).max()) / L
-        worst = max(worst, dev)
-        openness = min(openness, chord / L)
-    return worst, openness
+    lengths = np.linalg.norm(np.diff(points, axis=1), axis=2).sum(axis=1)
+    with np.errstate(invalid="ignore", over="ignore"):
+        scale = np.maximum(1.0, np.abs(points).max(axis=(1, 2)))
+        good = np.isfinite(lengths) & ~(lengths <= 1e-14 * scale)  # else the isoline is a point (pole, apex)
+    if not good.any():
+        return worst, openness
+    p, L = points[good], lengths[good]
+    c = p[:, -1] - p[:, 0]
+    chord = np.linalg.norm(c, axis=1)
+    origin, axis = p[:, 0].copy(), c / np.where(chord > 0, chord, 1.0)[:, None]
+    for k in np.nonzero(~(chord > 1e-9 * L))[0]:  # closed isoline: its best-fitting straight line
+        origin[k] = p[k].mean(axis=0)
+        axis[k] = np.linalg.svd(p[k] - origin[k], full_matrices=False)[2][0]
+    dev = np.linalg.norm(np.cross(p - origin[:, None, :], axis[:, None, :]), axis=2).max(axis=1) / L
+    return max(worst, float(dev.max())), min(openness, float((chord / L).min()))
 
 
 def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | None, dict[str, float]]:
@@ -252,10 +302,11 @@ def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | Non
         (:func:`end_isoline_length`). Planes, cylinders, cones and extrusions return ``"v"``,
         a structurally ruled B-spline/Bézier its ``ruled_hint``.
     """
-    dv, ov = isoline_stats(surface, bounds, "v")
-    du, ou = isoline_stats(surface, bounds, "u")
+    pts = _isoline_points(surface, bounds, ("v", "u"))
+    dv, ov = isoline_stats(surface, bounds, "v", pts["v"])
+    du, ou = isoline_stats(surface, bounds, "u", pts["u"])
     info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
-    info.update({f"end_length_{d}": end_isoline_length(surface, bounds, d) for d in ("u", "v")})
+    info.update({f"end_length_{d}": end_isoline_length(surface, bounds, d, pts[d]) for d in ("u", "v")})
     if surface.kind in RULED_KINDS:
         return "v", info
     if surface.ruled_hint in ("u", "v"):
@@ -267,7 +318,7 @@ def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | Non
     return None, info
 
 
-def end_isoline_length(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> float:
+def end_isoline_length(ev: SurfaceAdapter, bounds: Bounds, direction: str, points: np.ndarray | None = None) -> float:
     r"""How far the two end isolines along ``direction`` are from being points.
 
     For ``direction == "u"``: the u-isolines ``S(·, v0)`` and ``S(·, v1)`` (the boundary curves
@@ -279,20 +330,15 @@ def end_isoline_length(ev: SurfaceAdapter, bounds: Bounds, direction: str) -> fl
         ev: the surface.
         bounds: (u0, u1, v0, v1).
         direction: "u" or "v".
+        points: the isolines' points (:func:`_isoline_points`) when already evaluated.
 
     Returns:
         The ratio in [0, 1] (1.0 when every isoline is a point).
     """
-    u0, u1, v0, v1 = bounds
-    run = np.linspace(0.0, 1.0, 33)
-    lengths = []
-    for f in np.linspace(0.0, 1.0, 9):
-        if direction == "v":
-            u, v = np.full_like(run, u0 + f * (u1 - u0)), v0 + run * (v1 - v0)
-        else:
-            u, v = u0 + run * (u1 - u0), np.full_like(run, v0 + f * (v1 - v0))
-        L = float(np.linalg.norm(np.diff(ev.value(u, v), axis=0), axis=1).sum())
-        lengths.append(L if math.isfinite(L) else 0.0)
+    if points is None:
+        points = _isoline_points(ev, bounds, (direction,))[direction]
+    lengths = [L if math.isfinite(L) else 0.0
+               for L in np.linalg.norm(np.diff(points, axis=1), axis=2).sum(axis=1).tolist()]
     top = max(lengths)
     return max(lengths[0], lengths[-1]) / top if top > 0 else 1.0
 
@@ -363,7 +409,8 @@ def face_area(
     ``breaks`` attribute of ``duv``), the inner one by 12-point panels, at least 2 per interval
     between ``u_breaks`` (the surface's knots) and none wider than ``u_span / 8`` (an analytic
     but non-polynomial ``f``, e.g. an extruded ellipse over its whole period), i.e. exact up to
-    the smoothness of ``f``.
+    the smoothness of ``f``. On a plane, cylinder or cone (``ev.kind``; u the angle about the axis)
+    ``f`` does not depend on u and ``P(u, v) = (u - u_lo) f(u_lo, v)`` in closed form.
 
     Args:
         ev: the surface (``d1``).
@@ -395,10 +442,15 @@ def face_area(
         return 0.0
     u = np.concatenate([p[2] for p in parts])
     v = np.concatenate([p[3] for p in parts])
-    s_all, v_all, w_all, own = _inner_nodes(u, v, u_lo, u_breaks, u_span, xg, wg)
-    d = ev.d1(s_all, v_all)
-    f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
-    P = np.bincount(own, weights=f * w_all, minlength=u.size)
+    if getattr(ev, "kind", "other") in U_FREE_DENSITY_KINDS:
+        # |S_u × S_v| does not depend on u: P(u, v) = (u - u_lo) f(u_lo, v) exactly
+        d = ev.d1(np.full_like(v, u_lo), v)
+        P = (u - u_lo) * np.linalg.norm(np.cross(d[0], d[1]), axis=1)
+    else:
+        s_all, v_all, w_all, own = _inner_nodes(u, v, u_lo, u_breaks, u_span, xg, wg)
+        d = ev.d1(s_all, v_all)
+        f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
+        P = np.bincount(own, weights=f * w_all, minlength=u.size)
     i = 0
     for k, wdv, uu, _ in parts:
         totals[k] += float(np.sum(P[i:i + uu.size] * wdv))
@@ -583,8 +635,8 @@ def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds) -> dict[str, np.
     uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
     vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
     U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
-    d = ev.d2(U, V)
-    return metric_angles(d[1], d[2], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
+    d = ev.d1(U, V)
+    return metric_angles(d[0], d[1], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
 
 
 class ClosedFormMap:
@@ -731,9 +783,7 @@ def unroll_face_data(
                 duv = _with_breaks(e.duv, e.breaks)
             loop_uv.append((e.uv, duv))
 
-            def flat_fn(t: np.ndarray, uvf: Callable = e.uv) -> np.ndarray:
-                u, v = uvf(t)
-                return dmap.map(u, v)
+            flat_fn = _strided_memo(lambda t, uvf=e.uv: dmap.map(*uvf(t)))
 
             name = e.name or f"edge{k}"
             if fsheet is None:
@@ -767,12 +817,17 @@ def unroll_face_data(
             vv = v0 + t * (v1 - v0)
             return np.full_like(t, u0), vv, np.full_like(t, u1), vv
 
+        # one evaluation of the surface and one of the map for the ruling ends and the bend lines
         ua, va, ub, vb = ends(tt)
-        g3 = np.linalg.norm(ev.value(ub, vb) - ev.value(ua, va), axis=1)
-        gf = np.linalg.norm(dmap.map(ub, vb) - dmap.map(ua, va), axis=1)
+        n = tt.size
+        p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
+        g3 = np.linalg.norm(p3[:n] - p3[n:], axis=1)
+        ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
+        pf = dmap.map(np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
+        gf = np.linalg.norm(pf[:n] - pf[n:2 * n], axis=1)
         if rulings:
-            ua, va, ub, vb = ends(tb)
-            bends = np.stack([dmap.map(ua, va), dmap.map(ub, vb)], axis=1)
+            k = tb.size
+            bends = np.stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
     area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"), u1 - u0)
     panel = FlatPanel(
         label=label,
@@ -793,6 +848,26 @@ def unroll_face_data(
     lo, _ = panel.bbox()
     panel.translate(-lo)
     return FlatPattern([panel], units=units)
+
+
+def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
+    """``fun`` (pointwise in t) remembering its last result: a parameter array equal to every k-th
+    entry of the last one (the outline's 257 samples after the length's 513) is answered by
+    slicing (the same values, not recomputed)."""
+    last: list[Any] = [None, None]
+
+    def f(t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        t0, r0 = last
+        if t0 is not None and t.ndim == 1 and t.size > 1 and t0.size > t.size and (t0.size - 1) % (t.size - 1) == 0:
+            k = (t0.size - 1) // (t.size - 1)
+            if np.array_equal(t0[::k], t):
+                return r0[::k].copy()
+        r = np.asarray(fun(t), dtype=float)
+        last[0], last[1] = t.copy(), r
+        return r.copy()
+
+    return f
 
 
 def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:

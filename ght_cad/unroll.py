@@ -81,15 +81,34 @@ class _PanelSeries:
         self.offsets = offsets  # (P, m) value at each panel's left end (integrals) or None
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
-        u = np.asarray(u, dtype=float)
+        u = np.asarray(u, dtype=float).ravel()
         idx = np.clip(np.searchsorted(self.edges, u, side="right") - 1, 0, self.edges.size - 2)
         lo, hi = self.edges[idx], self.edges[idx + 1]
         x = np.clip((2.0 * u - lo - hi) / (hi - lo), -1.0, 1.0)
         out = np.empty((u.size, self.coefs.shape[2]))
-        step = 8192
-        for s in range(0, u.size, step):
-            sl = slice(s, s + step)
-            out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
+        P = self.edges.size - 1
+        if P <= 64 and u.size > 4 * P:
+            # few panels: T_j(x) by the three-term recurrence, then one small product per panel
+            T = np.empty((self.coefs.shape[1], u.size))
+            T[0] = 1.0
+            if T.shape[0] > 1:
+                T[1] = x
+            x2 = 2.0 * x
+            for j in range(2, T.shape[0]):
+                np.multiply(x2, T[j - 1], out=T[j])
+                T[j] -= T[j - 2]
+            order = np.argsort(idx, kind="stable")
+            counts = np.bincount(idx, minlength=P)
+            start = 0
+            for p in np.nonzero(counts)[0].tolist():
+                sel = order[start:start + counts[p]]
+                start += counts[p]
+                out[sel] = np.einsum("jn,jm->nm", T[:, sel], self.coefs[p])
+        else:
+            step = 8192
+            for s in range(0, u.size, step):
+                sl = slice(s, s + step)
+                out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
         if self.offsets is not None:
             out += self.offsets[idx]
         return out
@@ -202,6 +221,8 @@ class RuledDevelopment:
         offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
         self._phi = _PanelSeries(edges, cw, offw)
         self._A = _PanelSeries(edges, cA, offA)
+        #: φ and A as one series (columns φ, A_x, A_y): the map evaluates both at once
+        self._phiA = _PanelSeries(edges, np.concatenate([cw, cA], axis=2), np.concatenate([offw, offA], axis=1))
         # rigid placement: a-edge chord along +x, bounding box at the origin (applied in .map)
         self._R = np.eye(2)
         self._t = np.zeros(2)
@@ -240,7 +261,10 @@ class RuledDevelopment:
         """Flat image ``Y(u, v) = A(u) + v L(u) D(u)`` of ``X(u, v)``; u, v broadcast, shape (n, 2)."""
         uu, vv = broadcast_uv(u, v)
         L = self.surface.ruling_lengths(uu)
-        return self.directrix(uu) + (vv * L)[:, None] * self.ruling_direction(uu)
+        r = self._phiA(uu)  # the same values as phi(uu), directrix(uu)
+        ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
+        A = r[:, 1:3] @ self._R.T + self._t
+        return A + (vv * L)[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)
 
     def map_points(self, u: Any, points: np.ndarray) -> np.ndarray:
         """Flat image of 3-D points lying on the rulings at ``u`` (projected onto the ruling)."""
@@ -340,8 +364,14 @@ def metric_angles(
     Returns:
         ``{"angle_3d", "angle_flat", "xu_len", "yu_len"}``, each (n,).
     """
-    yu = _fd5(lambda s: flat_map(u + s, v), hu)
-    yv = _fd5(lambda s: flat_map(u, v + s), hv)
+    # the eight stencil points of both differences in one call of the map (it is pointwise)
+    n = u.size
+    steps = (2 * hu, hu, -hu, -2 * hu)
+    F = np.asarray(flat_map(np.concatenate([u + s for s in steps] + [u] * 4),
+                            np.concatenate([v] * 4 + [v + s for s in (2 * hv, hv, -hv, -2 * hv)])), dtype=float)
+    F = F.reshape(8, n, 2)
+    yu = (-F[0] + 8 * F[1] - 8 * F[2] + F[3]) / (12 * hu)
+    yv = (-F[4] + 8 * F[5] - 8 * F[6] + F[7]) / (12 * hv)
     a3 = np.arctan2(np.linalg.norm(np.cross(xu, xv), axis=1), np.einsum("ij,ij->i", xu, xv))
     a2 = np.arctan2(np.abs(yu[:, 0] * yv[:, 1] - yu[:, 1] * yv[:, 0]), np.einsum("ij,ij->i", yu, yv))
     return {"angle_3d": a3, "angle_flat": a2, "xu_len": np.linalg.norm(xu, axis=1), "yu_len": np.linalg.norm(yu, axis=1)}
