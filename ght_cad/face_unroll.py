@@ -410,7 +410,9 @@ def face_area(
     between ``u_breaks`` (the surface's knots) and none wider than ``u_span / 8`` (an analytic
     but non-polynomial ``f``, e.g. an extruded ellipse over its whole period), i.e. exact up to
     the smoothness of ``f``. On a plane, cylinder or cone (``ev.kind``; u the angle about the axis)
-    ``f`` does not depend on u and ``P(u, v) = (u - u_lo) f(u_lo, v)`` in closed form.
+    ``f`` does not depend on u and ``P(u, v) = (u - u_lo) f(u_lo, v)`` in closed form. Along an
+    edge with constant u (an isoline of the parameter box) every node has the same inner nodes:
+    the density is evaluated on that grid (``ev.density_grid(s, v)`` when the adapter has it).
 
     Args:
         ev: the surface (``d1``).
@@ -447,10 +449,25 @@ def face_area(
         d = ev.d1(np.full_like(v, u_lo), v)
         P = (u - u_lo) * np.linalg.norm(np.cross(d[0], d[1]), axis=1)
     else:
-        s_all, v_all, w_all, own = _inner_nodes(u, v, u_lo, u_breaks, u_span, xg, wg)
-        d = ev.d1(s_all, v_all)
-        f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
-        P = np.bincount(own, weights=f * w_all, minlength=u.size)
+        P = np.zeros(u.size)
+        general = np.ones(u.size, dtype=bool)
+        grid = getattr(ev, "density_grid", None)
+        i = 0
+        for _, _, uu, vv in parts if grid is not None else ():
+            m = uu.size
+            if m and np.all(uu == uu[0]):  # an edge along v (u constant): its inner nodes are shared
+                s_n, _, w_n, _ = _inner_nodes(uu[:1], vv[:1], u_lo, u_breaks, u_span, xg, wg)
+                if s_n.size:
+                    f = grid(s_n, vv)
+                    P[i:i + m] = np.einsum("k,kj->j", w_n, f)
+                general[i:i + m] = False
+            i += m
+        if general.any():
+            ug, vg = u[general], v[general]
+            s_all, v_all, w_all, own = _inner_nodes(ug, vg, u_lo, u_breaks, u_span, xg, wg)
+            d = ev.d1(s_all, v_all)
+            f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
+            P[general] = np.bincount(own, weights=f * w_all, minlength=ug.size)
     i = 0
     for k, wdv, uu, _ in parts:
         totals[k] += float(np.sum(P[i:i + uu.size] * wdv))

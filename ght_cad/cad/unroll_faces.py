@@ -247,6 +247,17 @@ class _SurfEval(SurfaceAdapter):
             return self._nurbs.eval(u, v, min(order, 2))
         return _core.surface_jet(self, u, v, order, own=False)
 
+    def density_grid(self, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``|S_u × S_v|`` at every (s_i, v_j), shape (len(s), len(v)) (a B-spline: each basis
+        series evaluated once per s and once per v)."""
+        s, v = np.asarray(s, dtype=float), np.asarray(v, dtype=float)
+        if self._ax is None and self._nurbs is not None:
+            r = self._nurbs.density_grid(s, v)
+            if r is not None:
+                return r
+        d = self.d1(np.repeat(s, v.size), np.tile(v, s.size))
+        return np.linalg.norm(np.cross(d[0], d[1]), axis=1).reshape(s.size, v.size)
+
     def _occ_d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
         p, (du, dv, duu, dvv, duv) = self._p, self._v
         ad = self.ad
@@ -300,6 +311,8 @@ class _Nurbs:
             cv, hv = 0.5 * (self.V[sv] + self.V[sv + 1]), 0.5 * (self.V[sv + 1] - self.V[sv])
             self.patches = (self.U[su], cu, hu, self.V[sv], cv, hv,
                             np.ascontiguousarray(pt.reshape(su.size * sv.size, -1)))
+            #: the patches as a (u-span, e) x (v-span, f, k) matrix (:meth:`_patch_hom`)
+            self.patches_u = np.ascontiguousarray(np.moveaxis(pt, 2, 1).reshape(su.size * (self.pu + 1), -1))
 
     @classmethod
     def of(cls, ad: BRepAdaptor_Surface) -> "_Nurbs | None":
@@ -379,6 +392,36 @@ class _Nurbs:
         return [S, Su, Sv, Suu, Svv, Suv]
 
 
+    def density_grid(self, s: np.ndarray, v: np.ndarray) -> np.ndarray | None:
+        """Area density ``|S_u × S_v|`` on the grid ``s × v``, shape (len(s), len(v)), from the
+        patches: the u-series once per s, then one small product per v-span (coordinates kept
+        component-major); None without patches."""
+        if self.patches is None:
+            return None
+        starts_u, cu, hu, starts_v, cv, hv, pt = self.patches
+        A, B = self.pu + 1, self.pv + 1
+        iu = np.clip(np.searchsorted(starts_u, s, side="right") - 1, 0, starts_u.size - 1)
+        iv = np.clip(np.searchsorted(starts_v, v, side="right") - 1, 0, starts_v.size - 1)
+        Tu = _cheb_t((s - cu[iu]) / hu[iu], self.pu, 1, hu[iu])
+        Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, 1, hv[iv])
+        P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu]  # (i, v-span, e, f, k)
+        G = [np.ascontiguousarray(np.einsum("ie,isefk->iskf", T, P)) for T in Tu]  # (i, v-span, k, f)
+        ms, mv = s.size, v.size
+        H = {key: np.empty((4, ms, mv)) for key in ((0, 0), (1, 0), (0, 1))}
+        for sv in np.unique(iv).tolist():
+            sel = np.nonzero(iv == sv)[0]
+            for (ku, kv), out in H.items():
+                r = G[ku][:, sv].reshape(ms * 4, B) @ Tv[kv][sel].T  # (i k, j)
+                out[:, :, sel] = r.reshape(ms, 4, sel.size).transpose(1, 0, 2)
+        W = H[(0, 0)][3]
+        S = H[(0, 0)][:3] / W
+        Su = (H[(1, 0)][:3] - H[(1, 0)][3] * S) / W
+        Sv = (H[(0, 1)][:3] - H[(0, 1)][3] * S) / W
+        cx = Su[1] * Sv[2] - Su[2] * Sv[1]
+        cy = Su[2] * Sv[0] - Su[0] * Sv[2]
+        cz = Su[0] * Sv[1] - Su[1] * Sv[0]
+        return np.sqrt(cx * cx + cy * cy + cz * cz)
+
     def _patch_hom(self, u: np.ndarray, v: np.ndarray, order: int) -> dict[tuple[int, int], np.ndarray]:
         """``∂^ku_u ∂^kv_v H`` for ku + kv <= order from the Chebyshev patches: on the knot-span
         patch of (u, v), ``H = Σ_e Σ_f T_e(x) T_f(y) P_ef`` with ``x = (u - c_u) / h_u``,
@@ -388,8 +431,21 @@ class _Nurbs:
         iv = np.clip(np.searchsorted(starts_v, v, side="right") - 1, 0, starts_v.size - 1)
         Tu = _cheb_t((u - cu[iu]) / hu[iu], self.pu, order, hu[iu])
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, order, hv[iv])
-        P = np.take(pt, iu * starts_v.size + iv, axis=0).reshape(u.size, self.pu + 1, self.pv + 1, 4)
+        nsu, nsv, A, B = starts_u.size, starts_v.size, self.pu + 1, self.pv + 1
         out = {}
+        if nsu == 1 and nsv == 1:
+            # one patch (a Bézier surface, a B-spline without interior knots): plain 2-D products
+            M = self.patches_u  # (e, (f, k))
+            for ku in range(order + 1):
+                X = (Tu[ku] @ M).reshape(u.size, B, 4)
+                for kv in range(order + 1 - ku):
+                    T = Tv[kv]
+                    h = T[:, 0, None] * X[:, 0]
+                    for f in range(1, B):
+                        h += T[:, f, None] * X[:, f]
+                    out[(ku, kv)] = h
+            return out
+        P = np.take(pt, iu * starts_v.size + iv, axis=0).reshape(u.size, self.pu + 1, self.pv + 1, 4)
         for ku in range(order + 1):
             tmp = np.einsum("ne,nefk->nfk", Tu[ku], P)
             for kv in range(order + 1 - ku):
