@@ -119,3 +119,48 @@ def test_hybrid_uses_the_exact_loft_gradient() -> None:
     assert ex.njev > 0 and pe.fallbacks == []
     assert ex.fun <= fd.fun * (1 + 1e-6) and ex.fun == pytest.approx(fd.fun, rel=1e-6)
     assert ex.nfev < fd.nfev
+
+
+def _design_fns(text: str):
+    from ght_cad.design import parse_design_text
+    from ght_cad.design.build import _initial_shape, build_curves
+    from ght_cad.design.optimize import _objective_fn, _value_and_grad_fn
+
+    d = parse_design_text(text, "plate.toml")
+    curves, _ = build_curves(d)
+    base = _initial_shape(d, curves)
+    names = list(d.optimize.parameters)
+
+    def shape_of(x):
+        sh = dict(base)
+        sh.update(dict(zip(names, (float(v) for v in x))))
+        return sh
+
+    return _objective_fn(d, curves, d.optimize), _value_and_grad_fn(d, curves, d.optimize, names, shape_of), shape_of
+
+
+def test_design_rails_objective_gradient_matches_fd() -> None:
+    """examples/design_hull_plate.toml's objective (fan share of the candidate loft, the sheer being
+    the first curve of a G1 join, so not re-solved): the value_and_grad given to hybrid has the
+    objective's values and its gradient to 1e-8 (4th-order differences of the design objective)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "examples" / "design_hull_plate.toml").read_text()
+    f, vg, shape_of = _design_fns(text)
+    x = np.array([0.3, -0.2, 0.1, -0.4, 0.2, 0.5])
+    v, G = vg(x[None, :])
+    assert v[0] == f(shape_of(x)) and vg.fallbacks == [] and vg.extra_nfev == 0
+    ref = np.array([(-f(shape_of(x + 2 * e)) + 8 * f(shape_of(x + e)) - 8 * f(shape_of(x - e))
+                     + f(shape_of(x - 2 * e))) / (12 * H) for e in H * np.eye(6)])
+    assert np.max(np.abs(G[0] - ref)) <= REL * np.max(np.abs(ref))
+
+
+def test_design_rail_re_solved_by_a_join_uses_finite_differences() -> None:
+    """A rail that is the second curve of a join is re-solved for every candidate; that join is not
+    differentiated here, so the design objective stays a plain callable (hybrid: finite differences)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "examples" / "design_hull_plate.toml").read_text()
+    text = text.replace('first = "sheer"\nsecond = "stem"', 'first = "stem"\nsecond = "sheer"')
+    _, vg, _ = _design_fns(text)
+    assert vg is None
