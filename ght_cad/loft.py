@@ -31,6 +31,7 @@ This module imports numpy and scipy only; matplotlib is imported inside :func:`p
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
@@ -1611,9 +1612,25 @@ def _rail_parameter_jets(curve: GHTCurve, t: np.ndarray, k: int, reverse: bool) 
     return [((-1.0) ** q if reverse else 1.0) * J[q][:, 0] for q in range(k + 1)]
 
 
+def _cross3(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``x × y`` over the last axis with broadcasting (explicit: np.cross is slow on small arrays)."""
+    x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
+    y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
+    return np.stack([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0], axis=-1)
+
+
 def _det6(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     """:func:`_det` broadcast over a leading parameter axis: (..., N, 3) -> (..., N)."""
-    return np.einsum("...i,...i->...", x, np.cross(y, z))
+    return np.einsum("...i,...i->...", x, _cross3(y, z))
+
+
+@functools.lru_cache(maxsize=8)
+def _gl(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cached :func:`ght_cad.curve.gauss_legendre` on [0, 1]."""
+    t, w = gauss_legendre(n)
+    t.setflags(write=False)
+    w.setflags(write=False)
+    return t, w
 
 
 class _LoftJets:
@@ -1686,19 +1703,30 @@ class _LoftJets:
         self.all = A[2] * (tl**2)[:, None] + A[1] * tll[:, None]
         self.gll = B[2] * (sl**2)[:, None] + B[1] * sll[:, None] - self.all
 
+    def part(self, sl: slice) -> "_LoftJets":
+        """The same quantities at a subset of the nodes."""
+        out = object.__new__(_LoftJets)
+        for k in ("al", "g", "gl", "all", "gll"):
+            setattr(out, k, getattr(self, k)[sl])
+        for k in ("dal", "dg", "dgl"):
+            setattr(out, k, getattr(self, k)[:, sl])
+        return out
+
     # integrands q(λ) and their derivatives at fixed λ
     def area(self) -> tuple[np.ndarray, np.ndarray]:
         r"""``ρ = Σ_v w_v |(a_λ + v g_λ) × g|`` (16-node Gauss–Legendre in v, as :func:`ght_cad.unroll.ruled_area`)
         and ``∂ρ = Σ_v w_v c_v·∂c_v / |c_v|``."""
-        tv, wv = gauss_legendre(16)
+        tv, wv = _gl(16)
+        ca_, cg_ = _cross3(self.al, self.g), _cross3(self.gl, self.g)  # c_v = ca + v cg
+        dca = _cross3(self.dal, self.g) + _cross3(self.al, self.dg)
+        dcg = _cross3(self.dgl, self.g) + _cross3(self.gl, self.dg)
         rho = np.zeros(self.g.shape[0])
         drho = np.zeros((6, self.g.shape[0]))
         for v, w in zip(tv, wv):
-            c = np.cross(self.al + v * self.gl, self.g)
-            dc = np.cross(self.dal + v * self.dgl, self.g) + np.cross(self.al + v * self.gl, self.dg)
-            nc = np.linalg.norm(c, axis=-1)
+            c = ca_ + v * cg_
+            nc = np.sqrt(np.sum(c * c, axis=-1))
             rho += w * nc
-            drho += w * np.einsum("nd,pnd->pn", c, dc) / nc
+            drho += (w / nc) * (np.einsum("nd,pnd->pn", c, dca) + v * np.einsum("nd,pnd->pn", c, dcg))
         return rho, drho
 
     def fairness(self) -> tuple[np.ndarray, np.ndarray]:
@@ -1719,10 +1747,10 @@ class _LoftJets:
         fixed λ (``dc/dv* = -1`` below 0, ``+1`` above 1) and ``q_λ`` (``c1_λ = a_λλ × g + a_λ × g_λ``,
         ``c2_λ = g_λλ × g``): q is only C¹ in λ, so the penalty's quadrature is differentiated
         node by node (moving nodes) rather than as the exact integral."""
-        c1 = np.cross(self.al, self.g)
-        c2 = np.cross(self.gl, self.g)
-        dc1 = np.cross(self.dal, self.g) + np.cross(self.al, self.dg)
-        dc2 = np.cross(self.dgl, self.g) + np.cross(self.gl, self.dg)
+        c1 = _cross3(self.al, self.g)
+        c2 = _cross3(self.gl, self.g)
+        dc1 = _cross3(self.dal, self.g) + _cross3(self.al, self.dg)
+        dc2 = _cross3(self.dgl, self.g) + _cross3(self.gl, self.dg)
         num = np.sum(c1 * c2, axis=-1)
         den = np.sum(c2 * c2, axis=-1)
         vs = regression_v(self.al, self.g, self.gl)
@@ -1737,8 +1765,8 @@ class _LoftJets:
         q = m**2
         slope = np.where(fin & (m > 0), -2.0 * m / margin * sgn, 0.0)
         dq = slope * np.where(fin, dvs, 0.0)
-        c1l = np.cross(self.all, self.g) + np.cross(self.al, self.gl)
-        c2l = np.cross(self.gll, self.g)
+        c1l = _cross3(self.all, self.g) + _cross3(self.al, self.gl)
+        c2l = _cross3(self.gll, self.g)
         with np.errstate(divide="ignore", invalid="ignore"):
             vl = -(np.sum(c1l * c2, axis=-1) + np.sum(c1 * c2l, axis=-1)) / den \
                 + num * 2.0 * np.sum(c2 * c2l, axis=-1) / den**2
@@ -1808,8 +1836,8 @@ def loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve,
 
 def _loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve, margin: float, nodes: int,
                                  area_nodes: int) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    x, w = gauss_legendre(nodes)
-    xa, wa = gauss_legendre(area_nodes)
+    x, w = _gl(nodes)
+    xa, wa = _gl(area_nodes)
     (t0, s0), (t1, s1) = lf._branch.start, lf._branch.end
     shift = {"start": _side_shift(lf, ca, cb, t0, s0, "start"), "end": _side_shift(lf, ca, cb, t1, s1, "end")}
     zero = np.zeros(6)
@@ -1820,10 +1848,9 @@ def _loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve
         dlo = zero if i == 0 else (shift["start"] if sg.kind == "main" else shift["end"])
         dhi = zero if i == len(lf.segments) - 1 else (shift["end"] if sg.kind == "main" else shift["start"])
         L = hi - lo
-        ends = np.array([lo, hi])
-        je = _LoftJets(lf, ca, cb, sg, ends)
-        jq = _LoftJets(lf, ca, cb, sg, lo + L * x)
-        ja = _LoftJets(lf, ca, cb, sg, lo + L * xa)
+        nq, na = x.size, xa.size
+        jall = _LoftJets(lf, ca, cb, sg, np.concatenate([[lo, hi], lo + L * x, lo + L * xa]))
+        je, jq, ja = jall.part(slice(0, 2)), jall.part(slice(2, 2 + nq)), jall.part(slice(2 + nq, 2 + nq + na))
         rho, drho = ja.area()
         rho_e, _ = je.area()
         dA = L * (drho @ wa) + rho_e[1] * dhi - rho_e[0] * dlo
