@@ -204,3 +204,27 @@ def test_strip_kernel_is_the_reference_evaluation(make, data):
 
 
 _STRIPS: dict = {}
+
+
+def _moved_dual(p, T=np.zeros(3), L=1.0):
+    """The same design after x -> L x + T: plane u0 + n·x = 0 becomes (L u0 - n·T) + n·x = 0."""
+    U, E = p.raw_planes.copy(), p.boundary_planes.copy()
+    U[:, 0] = L * U[:, 0] - U[:, 1:] @ T
+    E[:, 0] = L * E[:, 0] - E[:, 1:] @ T
+    return type(p)(U, E, objective="AL")
+
+
+def test_stationary_end_test_is_scale_free_and_refuses_the_corner():
+    """The nearly-stationary-end guard of the dual problem (turning rate of the unit normal at the
+    ends against its mean) gives the same verdicts for the design in other units or far from the
+    origin, and refuses the three-plane corner mu = gamma = -1 and its neighbourhood."""
+    base = default_dual_problem("AL")
+    three = type(base)(base.raw_planes[[0, 1, 3]], base.boundary_planes, objective="AL")
+    eps = np.logspace(-5, 0, 200)
+    X = np.column_stack([-1 + eps, np.zeros_like(eps), -1 + eps])
+    X = np.concatenate([X, np.random.default_rng(1).uniform(-1, 1, (200, 3))])
+    ok = three._end_speeds_ok(three.full(X))
+    assert not ok[0] and not three._end_speeds_ok(three.full([[-1.0, 0.3, -1.0]]))[0]
+    assert ok[np.argmax(eps > 0.1)]
+    for T, L in ((np.array([50.0, -30.0, 0.0]), 1.0), (np.zeros(3), 1000.0), (np.array([5.0, 3.0, 7.0]), 0.01)):
+        assert np.array_equal(_moved_dual(three, T, L)._end_speeds_ok(three.full(X)), ok)
