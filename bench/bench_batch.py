@@ -125,6 +125,13 @@ def _start_peak() -> float:
     return _status_mb("VmRSS") or 0.0
 
 
+def _cpu_s() -> float:
+    """CPU time (user + system) of this process and its finished children, s: less sensitive than wall
+    time to other work on a shared machine."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
 def _peaks_mb() -> tuple[float, float]:
     """Peak resident set of this process since :func:`_start_peak` (else since start) and of its
     largest finished child (forked after it), MB."""
@@ -140,11 +147,11 @@ def case_faces(step: str, jobs: int) -> dict[str, Any]:
 
     unroll_step(Path(step), faces=[1])  # loads OCP, scipy and the unroll code
     base = _start_peak()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), _cpu_s()
     res = unroll_step(Path(step), jobs=jobs)
-    dt = time.perf_counter() - t0
+    dt, cpu = time.perf_counter() - t0, _cpu_s() - c0
     me, kids = _peaks_mb()
-    return {"faces": res.face_count, "panels": len(res.pattern.panels), "time": dt, "peak_mb": me,
+    return {"faces": res.face_count, "panels": len(res.pattern.panels), "time": dt, "cpu": cpu, "peak_mb": me,
             "worker_peak_mb": kids, "base_mb": base,
             "marks": sum(1 for p in res.pattern.panels for t in p.texts if t[2].startswith("E"))}
 
@@ -159,12 +166,12 @@ def case_sweep(n: int, jobs: int) -> dict[str, Any]:
         p = Path(tmp) / "sweep.toml"
         p.write_text(cone_design("sweep", 800.0, 0.5, 400.0, figures="[]")
                      + f'\n[sweep]\n"surface.boundary_planes.1.0" = {{ start = -100, stop = -500, num = {n} }}\n')
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), _cpu_s()
         res = run_batch([p], Path(tmp) / "out", jobs=jobs, progress=False)
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, _cpu_s() - c0
         assert res.exit_code == 0, res.rows
     me, kids = _peaks_mb()
-    return {"designs": n, "time": dt, "peak_mb": me, "worker_peak_mb": kids, "base_mb": base}
+    return {"designs": n, "time": dt, "cpu": cpu, "peak_mb": me, "worker_peak_mb": kids, "base_mb": base}
 
 
 def _in_subprocess(*case: Any) -> dict[str, Any]:
@@ -184,8 +191,10 @@ def growth_exponent(n: list[float], y: list[float]) -> float:
 def _growth_text(rows: list[dict[str, Any]], key: str) -> str:
     n = [r[key] for r in rows]
     t = growth_exponent(n, [r["time"] for r in rows])
+    c = growth_exponent(n, [r["cpu"] for r in rows])
     m = growth_exponent(n, [max(r["peak_mb"], r["worker_peak_mb"]) - r["base_mb"] for r in rows])
-    return f"growth exponents (1 = linear): time {t:.2f}, peak memory above the base {m:.2f}"
+    return (f"growth exponents (1 = linear): wall time {t:.2f}, CPU time {c:.2f}, "
+            f"peak memory above the base {m:.2f}")
 
 
 def _load() -> str:
@@ -232,7 +241,7 @@ def bench_faces(counts: tuple[int, ...]) -> None:
             rows = [_in_subprocess("faces", steps[n], jobs) for n in counts]
             for r in rows:
                 print(f"2. unroll_step jobs={jobs}: {r['faces']:5d} faces {r['time']:7.2f} s "
-                      f"({1e3 * r['time'] / r['faces']:.1f} ms/face), {r['marks']} edge marks, peak memory "
+                      f"({1e3 * r['time'] / r['faces']:.1f} ms/face; CPU {r['cpu']:.2f} s), {r['marks']} edge marks, peak memory "
                       f"{r['peak_mb']:.0f} MB (worker {r['worker_peak_mb']:.0f} MB; base after imports "
                       f"{r['base_mb']:.0f} MB)", flush=True)
             print(f"   {_growth_text(rows, 'faces')}; load average {_load()}", flush=True)
@@ -242,7 +251,7 @@ def bench_sweep(counts: tuple[int, ...]) -> None:
     rows = [_in_subprocess("sweep", n, 2) for n in counts]
     for r in rows:
         print(f"3. sweep jobs=2: {r['designs']:4d} variants {r['time']:7.2f} s "
-              f"({r['time'] / r['designs']:.2f} s/variant), peak memory {r['peak_mb']:.0f} MB "
+              f"({r['time'] / r['designs']:.2f} s/variant; CPU {r['cpu']:.2f} s), peak memory {r['peak_mb']:.0f} MB "
               f"(worker {r['worker_peak_mb']:.0f} MB; base after imports {r['base_mb']:.0f} MB)", flush=True)
     print(f"   {_growth_text(rows, 'designs')}; load average {_load()}", flush=True)
 

@@ -198,7 +198,8 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
 
     Runs in a worker (local process or Dask worker). ``task`` holds ``folder``, ``source`` and
     ``data`` (the parsed TOML), optionally ``marker`` (a file written with the pid on start, so the
-    caller knows which designs were running in a process that died).
+    caller knows which designs were running in a process that died; the temporary folder is then
+    made beside it, in the caller's private folder, which the caller removes at the end).
 
     Returns:
         ``{"status", "error", "report", "files": {name: bytes}, "elapsed_s", "cpu_s", "host", "pid", "worker"}``.
@@ -211,7 +212,9 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
         from .design import parse_design, run_design
 
         design = parse_design(task["data"], task["source"])
-        with tempfile.TemporaryDirectory(prefix="ght-cad-batch.") as tmp:
+        # beside the marker: in the caller's private folder, removed with it even if this process is killed
+        where = str(Path(task["marker"]).parent) if task.get("marker") else None
+        with tempfile.TemporaryDirectory(prefix="ght-cad-batch.", dir=where) as tmp:
             folder = Path(tmp) / task["folder"]
             out["report"] = run_design(design, folder, progress=False)
             out["files"] = {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
@@ -305,6 +308,24 @@ def preload_run_modules() -> float:
     return time.perf_counter() - t0
 
 
+def _limit_threads(threads: int) -> None:
+    """Worker initializer: at most ``threads`` BLAS/OpenMP threads in this process.
+
+    numpy's and scipy's OpenBLAS and OCCT's OpenMP start one thread per core in every process;
+    ``n`` workers on as many cores would run ``n`` times too many (and OpenBLAS's idle threads spin),
+    so each worker gets ``max(1, cores // n)`` (:mod:`threadpoolctl` when installed; else unchanged).
+    """
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - threadpoolctl comes with scikit-learn (build123d)
+        return
+    threadpool_limits(threads)
+
+
+def _worker_threads(n: int) -> int:
+    return max(1, (os.cpu_count() or 1) // max(1, n))
+
+
 def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, Any] | None, int, str | None], None]) -> None:
     """Run ``jobs`` in ``n`` local processes; ``finish(job, result, attempts, death)`` per design."""
     import multiprocessing
@@ -323,7 +344,9 @@ def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, A
         while pending:
             broken = False
             procs: dict[int, Any] = {}
-            with ProcessPoolExecutor(max_workers=max(1, min(n, len(pending))), mp_context=ctx) as ex:
+            workers = max(1, min(n, len(pending)))
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_limit_threads,
+                                     initargs=(_worker_threads(workers),)) as ex:
                 futs = {}
                 for j in pending.values():
                     task = {"folder": j.folder, "source": j.source, "data": j.data, "marker": str(markers / str(j.index))}
@@ -636,7 +659,9 @@ def map_step_faces(path: Path, all_faces: list[Any], chosen: Sequence[int], fkw:
         _STEP_FACES[(key, fkw["unit"])] = all_faces
         ctx = multiprocessing.get_context("fork" if sys.platform.startswith("linux") else None)
         try:
-            with ProcessPoolExecutor(max_workers=min(jobs, len(chunks)), mp_context=ctx) as ex:
+            workers = min(jobs, len(chunks))
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_limit_threads,
+                                     initargs=(_worker_threads(workers),)) as ex:
                 parts = list(ex.map(_step_faces_task, [{**base, "key": key, "faces": c} for c in chunks]))
         finally:
             _STEP_FACES.pop((key, fkw["unit"]), None)
