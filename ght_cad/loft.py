@@ -1431,6 +1431,22 @@ class LoftProblem(Problem):
     :func:`ght_cad.optimize.minimize` (``problem(X) -> (pop,)``); it has the attributes of
     :class:`ght_cad.optimize.problems.Problem` (names, lb, ub, x0, build, report).
 
+    Gradients (:meth:`value_and_grad`, used by ``method="hybrid"``, spec 8.1): exact where the
+    loft's structure is locally fixed (same chosen branch and orientation, same fans):
+    :func:`loft_measures_and_gradients`. Where it is not, the objective itself is not
+    differentiable and the gradient is as follows:
+
+    * a branch end within ``MIN_FAN`` of a corner of the (t, s) square where F does not vanish (a
+      fan appears or vanishes; for GHT rails the end tangents are ``∝ P_1 - P_0``, so F at a corner
+      vanishes for all shape parameters or for none and this is a coincidence of measure zero) and
+      a non-finite derivative (a zero ruling where the rails meet: ``|d'|²`` is a limit there;
+      ``F_s = F_t`` on the branch): forward finite differences, reason in :attr:`fallbacks`,
+      evaluations in :attr:`fallback_nfev`;
+    * a switch of the chosen branch or orientation between candidates (:func:`developable_loft`
+      ranks them), or the regression penalty where ``v*`` touches [0, 1] (a kink): not detected;
+      the gradient is that of the loft built at the point (one-sided).
+    
+
     Args:
         rail_a, rail_b: 3-D GHTCurve objects with the 'ght' seed.
         objective: a name of :data:`LOFT_OBJECTIVES` or a mapping name -> weight.
