@@ -36,6 +36,7 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d, BRepAdaptor_
 from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.GeomAbs import (
+    GeomAbs_BezierCurve,
     GeomAbs_BezierSurface,
     GeomAbs_BSplineCurve,
     GeomAbs_BSplineSurface,
@@ -641,6 +642,18 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
         def f(p: np.ndarray) -> np.ndarray:
             return O + R * (np.cos(p)[:, None] * X + np.sin(p)[:, None] * Y)
         scale = max(1.0, float(np.abs(O).max()) + R)
+    elif kind in (GeomAbs_BSplineCurve, GeomAbs_BezierCurve):
+        nc = _NurbsCurve.of(c, dim)
+        if nc is None:
+            return None
+        def f(p: np.ndarray) -> np.ndarray:
+            return nc.value(p)
+        scale = max(1.0, float(np.abs(nc.cw[:, :dim] / nc.cw[:, dim:]).max()))
+        ps = np.linspace(c.FirstParameter(), c.LastParameter(), 5)
+        if float(np.abs(f(ps) - np.array([c.Value(x).Coord() for x in ps.tolist()])).max()) > 1e-12 * scale:
+            return None  # pragma: no cover - a representation we do not read right: use OCCT
+        f.derivative = nc.derivative  # type: ignore[attr-defined]
+        return f
     else:
         return None
     ps = np.array([c.FirstParameter(), c.LastParameter()])
@@ -648,6 +661,64 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
     if ps.size and float(np.abs(f(ps) - np.array([c.Value(x).Coord() for x in ps.tolist()])).max()) > 1e-12 * scale:
         return None  # pragma: no cover - a convention we do not know: evaluate by OCCT
     return f
+
+
+class _NurbsCurve:
+    r"""A (rational) B-spline or Bézier curve adaptor (2-D or 3-D) read once from OCCT and evaluated
+    in numpy: homogeneous poles ``C_i = (w_i P_i, w_i)``, ``H(p) = Σ_a N_{i-d+a, d}(p) C_{i-d+a}``
+    (Cox–de Boor, :func:`_basis`), ``H' = Σ_a N_{i-d+1+a, d-1}(p) C'_{i-d+a}`` with the difference
+    poles ``C'_i = d (C_{i+1} - C_i) / (U_{i+d+1} - U_{i+1})``; ``P = A / W``,
+    ``P' = (A' - W' P) / W``. Periodic curves: None (left to OCCT)."""
+
+    def __init__(self, knots: np.ndarray, degree: int, cw: np.ndarray) -> None:
+        self.U, self.p, self.cw = knots, degree, cw
+        self.d1 = _diff_net(cw[:, None, :], knots, degree, 1, 0)[:, 0, :] if degree >= 1 else None
+
+    @classmethod
+    def of(cls, c: Any, dim: int) -> "_NurbsCurve | None":
+        if c.GetType() == GeomAbs_BSplineCurve:
+            g = c.BSpline()
+            if g.IsPeriodic():
+                return None
+            seq = g.KnotSequence()
+            U = np.array([seq.Value(i) for i in range(seq.Lower(), seq.Upper() + 1)])
+        else:
+            g = c.Bezier()
+            U = np.r_[np.zeros(g.Degree() + 1), np.ones(g.Degree() + 1)]
+        n, p = g.NbPoles(), g.Degree()
+        if U.size != n + p + 1:
+            return None  # pragma: no cover - not a clamped flat knot vector
+        cw = np.empty((n, dim + 1))
+        for i in range(1, n + 1):
+            w = g.Weight(i)
+            cw[i - 1, :dim] = np.array(g.Pole(i).Coord()) * w
+            cw[i - 1, dim] = w
+        return cls(U, p, cw)
+
+    def _hom(self, x: np.ndarray, order: int) -> list[np.ndarray]:
+        span, lev = _basis(self.U, self.p, x, order)
+        out = []
+        for k, net in zip(range(order + 1), (self.cw, self.d1)):
+            if lev[k] is None or net is None:
+                out.append(np.zeros((x.size, self.cw.shape[1])))
+                continue
+            idx = (span - self.p)[:, None] + np.arange(lev[k].shape[1])[None, :]
+            out.append(np.einsum("na,nak->nk", lev[k], np.take(net, idx, axis=0)))
+        return out
+
+    def value(self, x: np.ndarray) -> np.ndarray:
+        """Points at the curve parameters ``x``, (n, dim)."""
+        x = np.asarray(x, dtype=float).ravel()
+        H = self._hom(x, 0)[0]
+        return H[:, :-1] / H[:, -1:]
+
+    def derivative(self, x: np.ndarray) -> np.ndarray:
+        """First derivatives at ``x``, (n, dim)."""
+        x = np.asarray(x, dtype=float).ravel()
+        H, H1 = self._hom(x, 1)
+        W = H[:, -1:]
+        P = H[:, :-1] / W
+        return (H1[:, :-1] - H1[:, -1:] * P) / W
 
 
 def _memo(fun: Callable[[np.ndarray], Any]) -> Callable[[np.ndarray], Any]:
@@ -671,7 +742,8 @@ def _memo(fun: Callable[[np.ndarray], Any]) -> Callable[[np.ndarray], Any]:
 def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callable, Callable, float, Callable]:
     """(t -> (u, v), t -> xyz, 3-D length, t -> (u', v')) of one edge, t ∈ [0, 1] in wire order.
 
-    Line and circle curves (pcurve and 3-D curve) are evaluated in numpy (:func:`_curve_eval`),
+    Line, circle and non-periodic B-spline/Bézier curves (pcurve and 3-D curve) are evaluated in
+    numpy (:func:`_curve_eval`, :class:`_NurbsCurve`),
     others point by point through OCCT; results are memoized per parameter array (:func:`_memo`).
     """
     c2 = BRepAdaptor_Curve2d(edge, face)
@@ -720,6 +792,8 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     def duv(t: np.ndarray) -> np.ndarray:
         if line2:
             return np.broadcast_to(d2 * (p1 - p0), (t.size, 2)).copy()
+        if f2 is not None and hasattr(f2, "derivative"):
+            return f2.derivative(p0 + t * (p1 - p0)) * (p1 - p0)
         p, vec = gp_Pnt2d(), gp_Vec2d()
         rows = []
         for x in (p0 + t * (p1 - p0)).tolist():
