@@ -760,8 +760,11 @@ class _Box:
         self.lb, self.ub, self.width = lb, ub, ub - lb
 
     def x(self, z: np.ndarray) -> np.ndarray:
-        z = np.clip(z, 0.0, 1.0)
-        return np.where(z >= 1.0, self.ub, np.where(z <= 0.0, self.lb, self.lb + z * self.width))
+        z = np.asarray(z, dtype=float)
+        x = self.lb + z * self.width
+        np.copyto(x, self.ub, where=z >= 1.0)  # z clipped to [0, 1], its ends mapped exactly
+        np.copyto(x, self.lb, where=z <= 0.0)
+        return x
 
     def z(self, x: np.ndarray) -> np.ndarray:
         return np.clip((np.asarray(x, dtype=float) - self.lb) / self.width, 0.0, 1.0)

@@ -220,6 +220,7 @@ class Problem:
             raise GHTError(f"free={free!r} repeats a parameter name")
         self.names = free
         self._idx = np.array([self.all_names.index(n) for n in free], dtype=int)
+        self._all_free = free == self.all_names
         lb = -np.ones(len(free))
         ub = np.ones(len(free))
         for name, (lo, hi) in (bounds or {}).items():
@@ -252,6 +253,8 @@ class Problem:
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.dim:
             raise GHTError(f"X has {X.shape[1]} columns; this problem has {self.dim} free parameters {self.names}")
+        if self._all_free:  # every parameter free, in order: the rows themselves
+            return X.copy()
         F = np.repeat(self.base[None, :], X.shape[0], axis=0)
         F[:, self._idx] = X
         return F
