@@ -208,6 +208,21 @@ class FaceRuledSurface(RuledSurface):
         tp, sp = (u, v) if self.ruled == "v" else (v, u)
         return (tp - self.t0) / (self.t1 - self.t0), (sp - self.s0) / (self.s1 - self.s0)
 
+    def value_and_ends(self, t: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``S(u, v)`` at points on the rulings at ``t``, evaluated together with the ruling ends
+        ``a(t)``, ``b(t)`` (kept for :meth:`a`, :meth:`b`) in one surface evaluation."""
+        t = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        key = t.tobytes()
+        if key in self._jets:
+            return self.ev.value(u, v)
+        ue, ve = self.uv(np.concatenate([t, t]), np.concatenate([np.zeros(t.size), np.ones(t.size)]))
+        n = np.size(u)
+        p = self.ev.value(np.concatenate([np.ravel(u), ue]), np.concatenate([np.ravel(v), ve]))
+        if len(self._jets) >= 8:
+            self._jets.pop(next(iter(self._jets)))
+        self._jets[key] = (0, [p[n:]])
+        return p[:n]
+
     def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
         if derivative > 2:
@@ -684,7 +699,7 @@ class _RuledFaceMap:
         u, v = broadcast_uv(u, v)
         t, s = self.rs.ts(u, v)
         if self.project:  # exact ruled face: project the true point onto its ruling
-            return self.dev.map_points(t, self.ev.value(u, v))
+            return self.dev.map_points(t, self.rs.value_and_ends(t, u, v))
         return self.dev.map(t, s)
 
 

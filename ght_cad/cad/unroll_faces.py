@@ -406,14 +406,19 @@ class _Nurbs:
         Tu = _cheb_t((s - cu[iu]) / hu[iu], self.pu, 1, hu[iu])
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, 1, hv[iv])
         P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu]  # (i, v-span, e, f, k)
-        G = [np.ascontiguousarray(np.einsum("ie,isefk->iskf", T, P)) for T in Tu]  # (i, v-span, k, f)
+        G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
         ms, mv = s.size, v.size
-        H = {key: np.empty((4, ms, mv)) for key in ((0, 0), (1, 0), (0, 1))}
-        for sv in np.unique(iv).tolist():
-            sel = np.nonzero(iv == sv)[0]
-            for (ku, kv), out in H.items():
-                r = G[ku][:, sv].reshape(ms * 4, B) @ Tv[kv][sel].T  # (i k, j)
-                out[:, :, sel] = r.reshape(ms, 4, sel.size).transpose(1, 0, 2)
+        keys = ((0, 0), (1, 0), (0, 1))
+        spans = np.unique(iv)
+        if spans.size == 1:  # one v-span: (k i, f) @ (f, j) is already component-major
+            sv = int(spans[0])
+            H = {(ku, kv): (G[ku][sv].reshape(4 * ms, B) @ Tv[kv].T).reshape(4, ms, mv) for ku, kv in keys}
+        else:
+            H = {key: np.empty((4, ms, mv)) for key in keys}
+            for sv in spans.tolist():
+                sel = np.nonzero(iv == sv)[0]
+                for (ku, kv), out in H.items():
+                    out[:, :, sel] = (G[ku][sv].reshape(4 * ms, B) @ Tv[kv][sel].T).reshape(4, ms, sel.size)
         W = H[(0, 0)][3]
         S = H[(0, 0)][:3] / W
         Su = (H[(1, 0)][:3] - H[(1, 0)][3] * S) / W
