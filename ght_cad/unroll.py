@@ -235,7 +235,7 @@ class RuledDevelopment:
         ca, sa = math.cos(ang), math.sin(ang)
         self._R = np.array([[ca, -sa], [sa, ca]])
         uu = np.linspace(0, 1, 257)
-        pts = np.concatenate([self.map(uu, np.zeros_like(uu)), self.map(uu, np.ones_like(uu))])
+        pts = self.map(np.concatenate([uu, uu]), np.concatenate([np.zeros_like(uu), np.ones_like(uu)]))
         self._t = -pts.min(axis=0)
 
     # -- raw (unplaced) series ---------------------------------------------------------
