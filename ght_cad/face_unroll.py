@@ -828,6 +828,7 @@ def unroll_face_data(
             loops_uv.append(loop_uv)
     # the outer loop first: an adapter's "outer wire" is not always right (FreeCAD 0.20's
     # Face.OuterWire hands out a hole of a drilled cylinder), the outer loop encloses the others
+    _seed_edge_samples(loops, loops_uv, dmap, samples)
     k_out = outer_loop_index(loops_uv)
     if k_out:
         loops.insert(0, loops.pop(k_out))
@@ -883,15 +884,16 @@ def unroll_face_data(
 
 
 def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
-    """``fun`` (pointwise in t) remembering its last result: a parameter array equal to every k-th
-    entry of the last one (the outline's 257 samples after the length's 513) is answered by
-    slicing (the same values, not recomputed)."""
+    """``fun`` (pointwise in t) remembering its last result: a parameter array equal to the last
+    one or to every k-th entry of it (the outline's 257 samples after the length's 513) is
+    answered by slicing (the same values, not recomputed). ``f.seed(t, r)`` stores ``r = fun(t)``
+    computed elsewhere (all edges of a face in one map call, :func:`_seed_edge_samples`)."""
     last: list[Any] = [None, None]
 
     def f(t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
         t0, r0 = last
-        if t0 is not None and t.ndim == 1 and t.size > 1 and t0.size > t.size and (t0.size - 1) % (t.size - 1) == 0:
+        if t0 is not None and t.ndim == 1 and t.size > 1 and t0.size >= t.size and (t0.size - 1) % (t.size - 1) == 0:
             k = (t0.size - 1) // (t.size - 1)
             if np.array_equal(t0[::k], t):
                 return r0[::k].copy()
@@ -899,7 +901,29 @@ def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarr
         last[0], last[1] = t.copy(), r
         return r.copy()
 
+    def seed(t: np.ndarray, r: np.ndarray) -> None:
+        last[0], last[1] = np.array(t, dtype=float), np.asarray(r, dtype=float)
+
+    f.seed = seed  # type: ignore[attr-defined]
     return f
+
+
+def _seed_edge_samples(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[Callable, Callable]]],
+                       dmap: Any, samples: int) -> None:
+    """Map every edge's ``samples`` outline parameters ``t_i = i / (samples - 1)`` in one
+    ``dmap.map`` call and seed the edges' memos with the results (the same pointwise values as
+    one call per edge, without the per-call overhead)."""
+    edges = [(e, uvf) for loop, luv in zip(loops, loops_uv) for e, (uvf, _) in zip(loop, luv)
+             if hasattr(e.flat_fn, "seed")]
+    if not edges or samples < 2:
+        return
+    t = np.linspace(0.0, 1.0, samples)
+    uvs = [uvf(t) for _, uvf in edges]
+    us = [np.broadcast_to(np.asarray(u, dtype=float), t.shape) for u, _ in uvs]
+    vs = [np.broadcast_to(np.asarray(v, dtype=float), t.shape) for _, v in uvs]
+    flat = np.asarray(dmap.map(np.concatenate(us), np.concatenate(vs)), dtype=float)
+    for k, (e, _) in enumerate(edges):
+        e.flat_fn.seed(t, flat[k * samples:(k + 1) * samples])  # type: ignore[attr-defined]
 
 
 def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:

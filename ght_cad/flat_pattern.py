@@ -64,6 +64,8 @@ _MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
 SVG_STROKE_MM = 0.25
 
 _ROMBERG_N = 128
+#: relative |R2 - R| below which the outline samples' Romberg length is accepted (BoundaryEdge.measure)
+_ROMBERG_ACCEPT = 1e-10
 
 #: 3-D arc-length fractions of the edge-mark ticks (double tick near the start)
 MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
@@ -83,10 +85,16 @@ def romberg_length(points: np.ndarray) -> float:
     p = np.asarray(points, dtype=float)
     if (p.shape[0] - 1) % 4:
         raise GHTError(f"romberg_length needs 4N+1 samples; got {p.shape[0]}")
+    return _romberg_pair(p)[0]
+
+
+def _romberg_pair(p: np.ndarray) -> tuple[float, float]:
+    """``(R, R2)``: the Romberg length of :func:`romberg_length` and its O(h⁴) value
+    ``R2 = (4 ℓ_4N - ℓ_2N) / 3`` (``|R2 - R|`` estimates R2's error)."""
     l1, l2, l4 = _chords(p[::4]), _chords(p[::2]), _chords(p)
     r1 = (4 * l2 - l1) / 3
     r2 = (4 * l4 - l2) / 3
-    return (16 * r2 - r1) / 15
+    return (16 * r2 - r1) / 15, r2
 
 
 def _dxf_ascii(text: str) -> str:
@@ -135,15 +143,37 @@ class BoundaryEdge:
     dense_flat: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def measure(self) -> None:
-        n = 4 * _ROMBERG_N + 1
-        t = np.linspace(0.0, 1.0, n)
-        self.dense_flat = np.asarray(self.flat_fn(t), dtype=float)
-        self.length_flat = romberg_length(self.dense_flat)
-        if self.length_3d is None:
-            self.length_3d = romberg_length(np.asarray(self.xyz_fn(t), dtype=float))
+        """Sample the edge and measure its flat length (Romberg, :func:`romberg_length`).
+
+        The ``samples`` outline points serve the length when they are ``4N + 1`` with
+        ``N >= _ROMBERG_N / 2`` and Romberg's own estimate accepts them: the h⁴ value ``R2`` and
+        the h⁶ value ``R`` agree to ``|R2 - R| <= _ROMBERG_ACCEPT · R`` (R's error is then smaller
+        by about h², far below round-off for a smooth edge); otherwise (a tight circle, a short
+        ``samples``) the edge is sampled at ``4 _ROMBERG_N + 1`` points as before.
+        """
         ts = np.linspace(0.0, 1.0, self.samples)
         self.flat = np.asarray(self.flat_fn(ts), dtype=float)
+        m = self.samples - 1
+        length = None
+        if m % 4 == 0 and 2 * _ROMBERG_N <= m <= 4 * _ROMBERG_N:
+            length, r2 = _romberg_pair(self.flat)
+            if not (math.isfinite(length) and abs(r2 - length) <= _ROMBERG_ACCEPT * abs(length)):
+                length = None
+        if length is None:
+            self.densify()
+        else:
+            self.dense_flat = self.flat
+            self.length_flat = length
+        if self.length_3d is None:
+            t = np.linspace(0.0, 1.0, 4 * _ROMBERG_N + 1)
+            self.length_3d = romberg_length(np.asarray(self.xyz_fn(t), dtype=float))
         self.xyz = np.asarray(self.xyz_fn(ts), dtype=float)
+
+    def densify(self) -> None:
+        """Flat samples at ``4 _ROMBERG_N + 1`` points (``dense_flat``) and the length from them."""
+        t = np.linspace(0.0, 1.0, 4 * _ROMBERG_N + 1)
+        self.dense_flat = np.asarray(self.flat_fn(t), dtype=float)
+        self.length_flat = romberg_length(self.dense_flat)
 
 
 @dataclass
@@ -366,18 +396,26 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
             names.append(f"{panel.label}:{'outer' if li == 0 else f'hole{li}'}:{e.name}")
             L3 = float(e.length_3d)
             rel.append(abs(e.length_flat - L3) / L3 if L3 > 0 else abs(e.length_flat))
-    # Romberg on the shoelace area: every edge at N, 2N, 4N segments
-    areas = []
-    for step in (4, 2, 1):
-        tot = 0.0
-        for li, loop in enumerate(panel.loops):
-            pts = np.concatenate([e.dense_flat[::step][:-1] for e in loop], axis=0)
-            a = abs(_shoelace(pts))
-            tot += a if li == 0 else -a
-        areas.append(tot)
-    r1 = (4 * areas[1] - areas[0]) / 3
-    r2 = (4 * areas[2] - areas[1]) / 3
-    panel.area_flat = (16 * r2 - r1) / 15
+    # Romberg on the shoelace area: every edge at N, 2N, 4N segments (an edge's N is its own: the
+    # shoelace error still expands in even powers of the common refinement factor); when the
+    # O(h⁴) and O(h⁶) values disagree by more than _ROMBERG_ACCEPT, every edge is densified
+    for attempt in range(2):
+        areas = []
+        for step in (4, 2, 1):
+            tot = 0.0
+            for li, loop in enumerate(panel.loops):
+                pts = np.concatenate([e.dense_flat[::step][:-1] for e in loop], axis=0)
+                a = abs(_shoelace(pts))
+                tot += a if li == 0 else -a
+            areas.append(tot)
+        r1 = (4 * areas[1] - areas[0]) / 3
+        r2 = (4 * areas[2] - areas[1]) / 3
+        panel.area_flat = (16 * r2 - r1) / 15
+        coarse = [e for loop in panel.loops for e in loop if e.dense_flat.shape[0] < 4 * _ROMBERG_N + 1]
+        if attempt or not coarse or abs(r2 - panel.area_flat) <= _ROMBERG_ACCEPT * abs(panel.area_flat):
+            break
+        for e in coarse:
+            e.densify()
     area_rel = abs(panel.area_flat - panel.area_3d) / panel.area_3d
     g3, gf = panel.ruling_lengths_3d, panel.ruling_lengths_flat
     ruling_rel = np.abs(gf - g3) / np.where(g3 > 0, g3, 1.0)
