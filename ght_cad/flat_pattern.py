@@ -373,13 +373,17 @@ def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
     crossing = sel.any(axis=1)
     out: list[tuple[int, np.ndarray]] = []  # (segment index, piece): keeps the input order
     plain = np.nonzero(~crossing)[0]
-    if plain.size:
-        keep = _inside(P[plain] + 0.5 * R[plain], loops)
-        out.extend((int(i), segments[i]) for i in plain[keep])
-    for i in np.nonzero(crossing)[0]:
-        ts = np.unique(np.concatenate([[0.0, 1.0], t[i, sel[i]]]))
-        mids = P[i] + (0.5 * (ts[:-1] + ts[1:]))[:, None] * R[i]
-        keep = _inside(mids, loops)
+    # the pieces' mid points of all segments (whole plain segments, split crossing ones) in one
+    # inside test
+    cuts = [np.unique(np.concatenate([[0.0, 1.0], t[i, sel[i]]])) for i in np.nonzero(crossing)[0]]
+    mids = [P[plain] + 0.5 * R[plain]]
+    mids += [P[i] + (0.5 * (ts[:-1] + ts[1:]))[:, None] * R[i] for i, ts in zip(np.nonzero(crossing)[0], cuts)]
+    keep_all = _inside(np.concatenate(mids, axis=0), loops)
+    keep, start = keep_all[:plain.size], plain.size
+    out.extend((int(i), segments[i]) for i in plain[keep])
+    for i, ts in zip(np.nonzero(crossing)[0], cuts):
+        keep = keep_all[start:start + ts.size - 1]
+        start += ts.size - 1
         for j in np.nonzero(keep)[0]:
             if ts[j + 1] - ts[j] > 1e-9:
                 out.append((int(i), np.array([P[i] + ts[j] * R[i], P[i] + ts[j + 1] * R[i]])))
