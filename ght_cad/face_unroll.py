@@ -39,7 +39,7 @@ import numpy as np
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, measure_panel
 from .ruled import RuledSurface
-from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles
+from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles, metric_stencil
 
 __all__ = [
     "SurfaceAdapter",
@@ -661,14 +661,51 @@ def chain_loop(
     return out
 
 
-def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds) -> dict[str, np.ndarray]:
-    """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
+def _metric_grid(bounds: Bounds) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The 12 x 5 grid ``(U, V)`` of :func:`_metric` and its difference steps ``hu, hv``."""
     u0, u1, v0, v1 = bounds
     uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
     vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
     U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
+    return U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0)
+
+
+def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds) -> dict[str, np.ndarray]:
+    """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
+    U, V, hu, hv = _metric_grid(bounds)
     d = ev.d1(U, V)
-    return metric_angles(d[0], d[1], fmap, U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0))
+    return metric_angles(d[0], d[1], fmap, U, V, hu, hv)
+
+
+class _MapBatch:
+    """A pointwise map evaluated once on several requested point sets (one call, the per-call
+    overhead paid once); a later call with exactly one of those sets is answered from the batch
+    (the same values), any other call goes to the map."""
+
+    def __init__(self, fmap: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                 requests: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        self.fmap = fmap
+        reqs = [tuple(np.ravel(x) for x in broadcast_uv(u, v)) for u, v in requests]
+        reqs = [r for r in reqs if r[0].size]
+        self.done: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        if reqs:
+            F = np.asarray(fmap(np.concatenate([r[0] for r in reqs]), np.concatenate([r[1] for r in reqs])), dtype=float)
+            i = 0
+            for u, v in reqs:
+                self.done.append((u, v, F[i:i + u.size]))
+                i += u.size
+
+    def result(self, k: int) -> np.ndarray:
+        """The k-th (non-empty) request's values."""
+        return self.done[k][2].copy()
+
+    def __call__(self, u: Any, v: Any) -> np.ndarray:
+        uu, vv = broadcast_uv(u, v)
+        if uu.ndim == 1:
+            for bu, bv, F in self.done:
+                if bu.size == uu.size and np.array_equal(bu, uu) and np.array_equal(bv, vv):
+                    return F.copy()
+        return self.fmap(uu, vv)
 
 
 class ClosedFormMap:
@@ -828,7 +865,6 @@ def unroll_face_data(
             loops_uv.append(loop_uv)
     # the outer loop first: an adapter's "outer wire" is not always right (FreeCAD 0.20's
     # Face.OuterWire hands out a hole of a drilled cylinder), the outer loop encloses the others
-    _seed_edge_samples(loops, loops_uv, dmap, samples)
     k_out = outer_loop_index(loops_uv)
     if k_out:
         loops.insert(0, loops.pop(k_out))
@@ -856,7 +892,17 @@ def unroll_face_data(
         p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
         g3 = np.linalg.norm(p3[:n] - p3[n:], axis=1)
         ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
-        pf = dmap.map(np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
+        ruling_uv = (np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
+    # the map's points in one call (it is pointwise; its per-call overhead dominated): the
+    # edges' outline samples, the ruling ends and bend lines, the metric's stencil
+    mU, mV, mhu, mhv = _metric_grid(bounds)
+    sampled, ts, edge_uv = _edge_sample_uv(loops, loops_uv, samples)
+    fmap = _MapBatch(dmap.map, [metric_stencil(mU, mV, mhu, mhv)] + ([ruling_uv] if ruled_dir is not None else [])
+                     + [edge_uv])
+    if sampled:
+        _seed_edge_samples(sampled, ts, fmap(*edge_uv))
+    if ruled_dir is not None:
+        pf = fmap(*ruling_uv)
         gf = np.linalg.norm(pf[:n] - pf[n:2 * n], axis=1)
         if rulings:
             k = tb.size
@@ -869,7 +915,7 @@ def unroll_face_data(
         ruling_lengths_3d=g3,
         ruling_lengths_flat=gf,
         area_3d=area_3d,
-        metric=_metric(ev, dmap.map, bounds),
+        metric=_metric(ev, fmap, bounds),
         info=info,
         development=dmap,
     )
@@ -908,22 +954,28 @@ def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarr
     return f
 
 
-def _seed_edge_samples(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[Callable, Callable]]],
-                       dmap: Any, samples: int) -> None:
-    """Map every edge's ``samples`` outline parameters ``t_i = i / (samples - 1)`` in one
-    ``dmap.map`` call and seed the edges' memos with the results (the same pointwise values as
-    one call per edge, without the per-call overhead)."""
+def _edge_sample_uv(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[Callable, Callable]]],
+                    samples: int) -> tuple[list[BoundaryEdge], np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """The edges with memos, their ``samples`` outline parameters ``t_i = i / (samples - 1)`` and
+    all edges' (u, v) there, concatenated (edge by edge)."""
     edges = [(e, uvf) for loop, luv in zip(loops, loops_uv) for e, (uvf, _) in zip(loop, luv)
              if hasattr(e.flat_fn, "seed")]
-    if not edges or samples < 2:
-        return
     t = np.linspace(0.0, 1.0, samples)
+    if not edges or samples < 2:
+        return [], t, (np.zeros(0), np.zeros(0))
     uvs = [uvf(t) for _, uvf in edges]
     us = [np.broadcast_to(np.asarray(u, dtype=float), t.shape) for u, _ in uvs]
     vs = [np.broadcast_to(np.asarray(v, dtype=float), t.shape) for _, v in uvs]
-    flat = np.asarray(dmap.map(np.concatenate(us), np.concatenate(vs)), dtype=float)
-    for k, (e, _) in enumerate(edges):
-        e.flat_fn.seed(t, flat[k * samples:(k + 1) * samples])  # type: ignore[attr-defined]
+    return [e for e, _ in edges], t, (np.concatenate(us), np.concatenate(vs))
+
+
+def _seed_edge_samples(edges: list[BoundaryEdge], t: np.ndarray, flat: np.ndarray) -> None:
+    """Seed the edges' memos with their outline samples' flat points ``flat`` (edge by edge, as
+    from :func:`_edge_sample_uv`): the same pointwise values as one map call per edge, without
+    the per-call overhead."""
+    n = t.size
+    for k, e in enumerate(edges):
+        e.flat_fn.seed(t, flat[k * n:(k + 1) * n])  # type: ignore[attr-defined]
 
 
 def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:

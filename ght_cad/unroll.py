@@ -345,6 +345,13 @@ def _fd5(fun: Callable[[float], np.ndarray], h: float) -> np.ndarray:
     return (-fun(2 * h) + 8 * fun(h) - 8 * fun(-h) + fun(-2 * h)) / (12 * h)
 
 
+def metric_stencil(u: np.ndarray, v: np.ndarray, hu: float, hv: float) -> tuple[np.ndarray, np.ndarray]:
+    """The (u, v) points of :func:`metric_angles`' two 5-point differences, concatenated:
+    ``u + 2hu, u + hu, u - hu, u - 2hu`` (at v), then ``v + 2hv ... v - 2hv`` (at u)."""
+    return (np.concatenate([u + s for s in (2 * hu, hu, -hu, -2 * hu)] + [u] * 4),
+            np.concatenate([v] * 4 + [v + s for s in (2 * hv, hv, -hv, -2 * hv)]))
+
+
 def metric_angles(
     xu: np.ndarray, xv: np.ndarray, flat_map: Callable[[np.ndarray, np.ndarray], np.ndarray],
     u: np.ndarray, v: np.ndarray, hu: float, hv: float,
@@ -366,9 +373,7 @@ def metric_angles(
     """
     # the eight stencil points of both differences in one call of the map (it is pointwise)
     n = u.size
-    steps = (2 * hu, hu, -hu, -2 * hu)
-    F = np.asarray(flat_map(np.concatenate([u + s for s in steps] + [u] * 4),
-                            np.concatenate([v] * 4 + [v + s for s in (2 * hv, hv, -hv, -2 * hv)])), dtype=float)
+    F = np.asarray(flat_map(*metric_stencil(u, v, hu, hv)), dtype=float)
     F = F.reshape(8, n, 2)
     yu = (-F[0] + 8 * F[1] - 8 * F[2] + F[3]) / (12 * hu)
     yv = (-F[4] + 8 * F[5] - 8 * F[6] + F[7]) / (12 * hv)
