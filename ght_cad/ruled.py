@@ -239,8 +239,12 @@ class RuledSurface(ABC):
                 "Gauss–Legendre nodes"
             )
         t, w = gauss_legendre(nodes)
-        _, theta_rms, dd, R = developability_from_jets(self.a(t), self.a(t, 1), self.b(t), self.b(t, 1), w)
         uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
+        # the quadrature nodes are the first entries of uu: one evaluation of a, a', b, b' serves
+        # the integrals, θ and the residual (a face's boundary jets are kept per parameter array)
+        n = t.size
+        _, theta_rms, dd, R = developability_from_jets(self.a(uu)[:n], self.a(uu, 1)[:n], self.b(uu)[:n],
+                                                       self.b(uu, 1)[:n], w)
         th = self.theta(uu)
         theta_max = float(np.nanmax(th)) if np.isfinite(th).any() else math.nan  # undefined normals skipped
         res = float(np.max(np.abs(self.developability_residual(uu))))

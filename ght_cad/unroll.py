@@ -53,6 +53,14 @@ _K = np.arange(_N + 1)
 _X = np.cos(np.pi * (_K + 0.5) / (_N + 1))  # first-kind nodes on [-1, 1]
 _V = np.polynomial.chebyshev.chebvander(_X, _N)  # (N+1, N+1)
 _VI = np.polynomial.chebyshev.chebvander(_X, _N + 1)  # for evaluating integrated series at nodes
+#: Chebyshev integration as a matrix: ``_INT @ c`` = ``chebint(c, lbnd=-1)`` (the integral from -1,
+#: degree N + 1), the same linear map without chebint's per-call overhead
+_INT = np.polynomial.chebyshev.chebint(np.eye(_N + 1), lbnd=-1, axis=0)  # (N+2, N+1)
+
+
+def _chebint(c: np.ndarray) -> np.ndarray:
+    """``∫_{-1}^x`` of the series ``c`` (P, N+1, m) along axis 1: (P, N+2, m)."""
+    return np.einsum("ij,pjm->pim", _INT, c)
 
 
 def _coefficients(f: np.ndarray) -> np.ndarray:
@@ -193,7 +201,7 @@ class RuledDevelopment:
             stage1 = np.stack([fr["w"], fr["p"], fr["q"]], axis=-1).reshape(P, _N + 1, 3)
             c1 = _coefficients(stage1)
             # φ at the nodes: integrate w spectrally, panel offsets by cumulative sums
-            cw = np.polynomial.chebyshev.chebint(c1[:, :, :1] * h[:, None, None], lbnd=-1, axis=1)
+            cw = _chebint(c1[:, :, :1] * h[:, None, None])
             tot_w = np.einsum("pjm,j->pm", cw, np.ones(_N + 2))  # value at x = +1 (T_j(1) = 1)
             off_w = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1]
             phi = np.einsum("kj,pjm->pkm", _VI, cw)[:, :, 0] + off_w[:, None]
@@ -215,7 +223,7 @@ class RuledDevelopment:
         self.quadrature_error_estimate = float(err.max() / size) if size > 0 else 0.0
         #: max over the final nodes of |d'·n| L (0 on a developable: d' lies in the tangent plane)
         self.normal_turning_max = float(np.max(np.abs(fr["wn"]) * fr["L"]))
-        cA = np.polynomial.chebyshev.chebint(c2 * h[:, None, None], lbnd=-1, axis=1)
+        cA = _chebint(c2 * h[:, None, None])
         totA = np.einsum("pjm,j->pm", cA, np.ones(_N + 2))
         offA = np.concatenate([np.zeros((1, 2)), np.cumsum(totA, axis=0)])[:-1]
         offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
@@ -235,7 +243,12 @@ class RuledDevelopment:
         ca, sa = math.cos(ang), math.sin(ang)
         self._R = np.array([[ca, -sa], [sa, ca]])
         uu = np.linspace(0, 1, 257)
-        pts = self.map(np.concatenate([uu, uu]), np.concatenate([np.zeros_like(uu), np.ones_like(uu)]))
+        # map(u, 0) and map(u, 1) (A and A + L D) from one evaluation of the series and lengths at uu
+        L = self.surface.ruling_lengths(uu)
+        r = self._phiA(uu)
+        ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
+        A = r[:, 1:3] @ self._R.T + self._t
+        pts = np.concatenate([A, A + L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)])
         self._t = -pts.min(axis=0)
 
     # -- raw (unplaced) series ---------------------------------------------------------
