@@ -215,12 +215,17 @@ class FaceRuledSurface(RuledSurface):
         key = t.tobytes()
         if key in self._jets:
             return self.ev.value(u, v)
-        ue, ve = self.uv(np.concatenate([t, t]), np.concatenate([np.zeros(t.size), np.ones(t.size)]))
+        # the ends at the distinct t only (points along one ruling share them: a ruling edge's
+        # samples, the metric stencil's v steps, the bend lines' two ends)
+        tu, inv = np.unique(t, return_inverse=True)
+        m = tu.size
+        ue, ve = self.uv(np.concatenate([tu, tu]), np.concatenate([np.zeros(m), np.ones(m)]))
         n = np.size(u)
         p = self.ev.value(np.concatenate([np.ravel(u), ue]), np.concatenate([np.ravel(v), ve]))
         if len(self._jets) >= 8:
             self._jets.pop(next(iter(self._jets)))
-        self._jets[key] = (0, [p[n:]])
+        inv = np.ravel(inv)
+        self._jets[key] = (0, [np.concatenate([p[n:n + m][inv], p[n + m:][inv]])])
         return p[:n]
 
     def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:

@@ -433,8 +433,8 @@ class _Nurbs:
         patch of (u, v), ``H = Σ_e Σ_f T_e(x) T_f(y) P_ef`` with ``x = (u - c_u) / h_u``,
         ``y = (v - c_v) / h_v`` (the end patches continued outside the knot range)."""
         starts_u, cu, hu, starts_v, cv, hv, pt = self.patches  # type: ignore[misc]
-        iu = np.clip(np.searchsorted(starts_u, u, side="right") - 1, 0, starts_u.size - 1)
-        iv = np.clip(np.searchsorted(starts_v, v, side="right") - 1, 0, starts_v.size - 1)
+        iu = np.minimum(np.maximum(np.searchsorted(starts_u, u, side="right") - 1, 0), starts_u.size - 1)
+        iv = np.minimum(np.maximum(np.searchsorted(starts_v, v, side="right") - 1, 0), starts_v.size - 1)
         Tu = _cheb_t((u - cu[iu]) / hu[iu], self.pu, order, hu[iu])
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, order, hv[iv])
         nsu, nsv, A, B = starts_u.size, starts_v.size, self.pu + 1, self.pv + 1
@@ -537,7 +537,7 @@ def _basis(U: np.ndarray, p: int, x: np.ndarray, kmax: int) -> tuple[np.ndarray,
     the non-zero basis functions of degree ``p - k`` there, ``N_{i-p+k .. i, p-k}(x)`` (n, p-k+1);
     None where ``k > p`` (Cox–de Boor triangle, NURBS book A2.2, vectorized over x)."""
     m = U.size - p - 1
-    span = np.clip(np.searchsorted(U, x, side="right") - 1, p, m - 1)
+    span = np.minimum(np.maximum(np.searchsorted(U, x, side="right") - 1, p), m - 1)
     levels = [np.ones((x.size, 1))]
     if p == 0:
         return span, [levels[0]] + [None] * kmax
