@@ -31,7 +31,6 @@ This module imports numpy and scipy only; matplotlib is imported inside :func:`p
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
@@ -1640,15 +1639,6 @@ def _det6(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", x, _cross3(y, z))
 
 
-@functools.lru_cache(maxsize=8)
-def _gl(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Cached :func:`ght_cad.curve.gauss_legendre` on [0, 1]."""
-    t, w = gauss_legendre(n)
-    t.setflags(write=False)
-    w.setflags(write=False)
-    return t, w
-
-
 class _LoftJets:
     r"""Along the loft at path parameters ``lam`` of one segment: the rails' jets, the path
     ``t, s, t_λ, s_λ`` and their total derivatives with respect to the six shape parameters
@@ -1732,7 +1722,7 @@ class _LoftJets:
     def area(self) -> tuple[np.ndarray, np.ndarray]:
         r"""``ρ = Σ_v w_v |(a_λ + v g_λ) × g|`` (16-node Gauss–Legendre in v, as :func:`ght_cad.unroll.ruled_area`)
         and ``∂ρ = Σ_v w_v c_v·∂c_v / |c_v|``."""
-        tv, wv = _gl(16)
+        tv, wv = gauss_legendre(16)
         ca_, cg_ = _cross3(self.al, self.g), _cross3(self.gl, self.g)  # c_v = ca + v cg
         dca = _cross3(self.dal, self.g) + _cross3(self.al, self.dg)
         dcg = _cross3(self.dgl, self.g) + _cross3(self.gl, self.dg)
@@ -1852,8 +1842,8 @@ def loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve,
 
 def _loft_measures_and_gradients(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve, margin: float, nodes: int,
                                  area_nodes: int) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    x, w = _gl(nodes)
-    xa, wa = _gl(area_nodes)
+    x, w = gauss_legendre(nodes)
+    xa, wa = gauss_legendre(area_nodes)
     (t0, s0), (t1, s1) = lf._branch.start, lf._branch.end
     shift = {"start": _side_shift(lf, ca, cb, t0, s0, "start"), "end": _side_shift(lf, ca, cb, t1, s1, "end")}
     zero = np.zeros(6)
