@@ -76,12 +76,17 @@ class SurfaceAdapter:
         semi_angle: cone semi-angle α in radians (cone only).
         ruled_hint: "v" or "u" when the surface is structurally ruled in that direction (a B-spline
             or Bézier of degree 1 with 2 poles across), else None.
+        affine_ruled: the surface is affine along its rulings, ``S(u, v) = S(u, v0) + (v - v0) /
+            (v1 - v0) (S(u, v1) - S(u, v0))`` (rulings along v; u likewise): an extrusion, a
+            degree-1 B-spline/Bézier with equal weights across. Then a point's ruling parameter is
+            its own (v - v0) / (v1 - v0) and the map needs no projection onto the ruling.
     """
 
     kind: str = "other"
     radius: float = 0.0
     semi_angle: float = 0.0
     ruled_hint: str | None = None
+    affine_ruled: bool = False
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Points ``S(u, v)``, shape (n, 3)."""
@@ -320,17 +325,20 @@ def ruling_direction(surface: SurfaceAdapter, bounds: Bounds) -> tuple[str | Non
         likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v``,
         ``openness_u``, ``openness_v`` and ``end_length_u``, ``end_length_v``
         (:func:`end_isoline_length`). Planes, cylinders, cones and extrusions return ``"v"``,
-        a structurally ruled B-spline/Bézier its ``ruled_hint``.
+        a structurally ruled B-spline/Bézier its ``ruled_hint``, without measuring: their ``info``
+        holds only the ruled direction's ``deviation`` (0) and ``openness`` (1) and
+        ``ruled_by: "structure"``.
     """
+    hint = "v" if surface.kind in RULED_KINDS else surface.ruled_hint
+    if hint in ("u", "v"):
+        # ruled by construction (an extrusion; a B-spline/Bézier of degree 1 with 2 poles across:
+        # for fixed u, a rational-linear function of v is a straight segment), nothing to measure
+        return hint, {f"deviation_{hint}": 0.0, f"openness_{hint}": 1.0, "ruled_by": "structure"}
     pts = _isoline_points(surface, bounds, ("v", "u"))
     dv, ov = isoline_stats(surface, bounds, "v", pts["v"])
     du, ou = isoline_stats(surface, bounds, "u", pts["u"])
     info = {"deviation_v": dv, "deviation_u": du, "openness_v": ov, "openness_u": ou}
     info.update({f"end_length_{d}": end_isoline_length(surface, bounds, d, pts[d]) for d in ("u", "v")})
-    if surface.kind in RULED_KINDS:
-        return "v", info
-    if surface.ruled_hint in ("u", "v"):
-        return surface.ruled_hint, info
     if dv <= 1e-9 and dv <= du:
         return "v", info
     if du <= 1e-9:
@@ -844,7 +852,10 @@ def unroll_face_data(
         info["method"] = "quadrature along rulings (adaptive Chebyshev panels)"
         info["panels"] = dev.panels
         info["quadrature_error_estimate"] = dev.quadrature_error_estimate
-        dmap = _RuledFaceMap(rs, dev, ev, min(info["deviation_u"], info["deviation_v"]) <= 1e-9)
+        # an exactly ruled face is mapped by projecting its true point onto the ruling, unless it
+        # is affine along the rulings (then the ruling parameter is s itself)
+        exact = min(info.get("deviation_u", math.inf), info.get("deviation_v", math.inf)) <= 1e-9
+        dmap = _RuledFaceMap(rs, dev, ev, exact and not getattr(ev, "affine_ruled", False))
     # boundary loops
     loops = []
     loops_uv = []

@@ -72,7 +72,8 @@ MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
 
 
 def _chords(p: np.ndarray) -> float:
-    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
+    d = p[1:] - p[:-1]
+    return float(np.sum(np.sqrt(np.einsum("ij,ij->i", d, d))))
 
 
 def romberg_length(points: np.ndarray) -> float:
@@ -115,9 +116,18 @@ def _dxf_ascii(text: str) -> str:
     return "".join(out)
 
 
+def _next(loop: np.ndarray) -> np.ndarray:
+    """The vertices of a closed polyline shifted by one: ``loop[i + 1]``, the last one wrapping to
+    ``loop[0]`` (``np.roll(loop, -1, axis=0)`` without its axis handling)."""
+    return np.concatenate([loop[1:], loop[:1]])
+
+
 def _shoelace(loop: np.ndarray) -> float:
-    x, y = loop[:, 0], loop[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+    """Signed area of a closed polyline, ``½ Σ_i (x_i y_{i+1} - x_{i+1} y_i)`` (indices mod n), with
+    the coordinates taken relative to the first vertex (the terms touching it vanish; less
+    cancellation than in absolute coordinates)."""
+    x, y = loop[1:, 0] - loop[0, 0], loop[1:, 1] - loop[0, 1]
+    return 0.5 * float(np.sum(x[:-1] * y[1:] - x[1:] * y[:-1]))
 
 
 @dataclass
@@ -315,7 +325,8 @@ def _point_in_polygon(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
         return np.concatenate([_point_in_polygon(pts[i : i + step], poly) for i in range(0, len(pts), step)])
     x, y = pts[:, 0][:, None], pts[:, 1][:, None]
     x0, y0 = poly[:, 0][None, :], poly[:, 1][None, :]
-    x1, y1 = np.roll(poly[:, 0], -1)[None, :], np.roll(poly[:, 1], -1)[None, :]
+    nxt = _next(poly)
+    x1, y1 = nxt[:, 0][None, :], nxt[:, 1][None, :]
     cond = (y0 > y) != (y1 > y)
     with np.errstate(divide="ignore", invalid="ignore"):
         xi = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
@@ -332,7 +343,7 @@ def _inside(pts: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
 def _sagitta(loop: np.ndarray) -> float:
     """Largest chord-to-curve deviation estimate of a closed polyline at its smooth vertices
     (turning < 10 degrees): a quarter of the vertex's distance from its neighbours' chord."""
-    a, b, c = np.roll(loop, 1, axis=0), loop, np.roll(loop, -1, axis=0)
+    a, b, c = np.concatenate([loop[-1:], loop[:-1]]), loop, _next(loop)
     ac = c - a
     n = np.linalg.norm(ac, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -358,17 +369,18 @@ def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
         parts = [clip_segments(segments[i : i + step], loops) for i in range(0, segments.shape[0], step)]
         return np.concatenate(parts, axis=0)
     A = np.concatenate(loops, axis=0)
-    B = np.concatenate([np.roll(lp, -1, axis=0) for lp in loops], axis=0)
-    S = B - A  # (m, 2)
+    S = np.concatenate([_next(lp) for lp in loops], axis=0) - A  # (m, 2) polygon edges
     P, Q = segments[:, 0], segments[:, 1]
     R = Q - P  # (k, 2)
     sag = max(_sagitta(lp) for lp in loops)
-    dt = np.minimum(1e-3, 8.0 * sag / np.maximum(np.linalg.norm(R, axis=1), 1e-300))[:, None]
-    den = R[:, 0:1] * S[None, :, 1] - R[:, 1:2] * S[None, :, 0]  # (k, m)
-    AP = A[None, :, :] - P[:, None, :]
+    dt = np.minimum(1e-3, 8.0 * sag / np.maximum(np.sqrt(np.einsum("ij,ij->i", R, R)), 1e-300))[:, None]
+    # P + t R = A + w S: with 2-D cross products x × y = x_0 y_1 - x_1 y_0 (as matrix products)
+    Sp = np.stack([S[:, 1], -S[:, 0]])  # (2, m): x @ Sp = x × S
+    Rp = np.stack([R[:, 1], -R[:, 0]])  # (2, k)
+    den = R @ Sp  # R × S, (k, m)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = (AP[..., 0] * S[None, :, 1] - AP[..., 1] * S[None, :, 0]) / den
-        w = (AP[..., 0] * R[:, 1:2] - AP[..., 1] * R[:, 0:1]) / den
+        t = (np.einsum("ij,ji->i", A, Sp)[None, :] - P @ Sp) / den  # ((A - P) × S) / (R × S)
+        w = ((A @ Rp).T - np.einsum("ij,ji->i", P, Rp)[:, None]) / den  # ((A - P) × R) / (R × S)
     sel = (np.abs(den) > 1e-300) & (t > dt) & (t < 1 - dt) & (w >= 0) & (w <= 1)
     crossing = sel.any(axis=1)
     out: list[tuple[int, np.ndarray]] = []  # (segment index, piece): keeps the input order
@@ -450,11 +462,13 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
 
 def _centroid(poly: np.ndarray) -> np.ndarray:
     x, y = poly[:, 0], poly[:, 1]
-    cr = x * np.roll(y, -1) - np.roll(x, -1) * y
+    nxt = _next(poly)
+    x1, y1 = nxt[:, 0], nxt[:, 1]
+    cr = x * y1 - x1 * y
     a = 0.5 * cr.sum()
     if abs(a) < 1e-300:
         return poly.mean(axis=0)
-    c = np.array([np.sum((x + np.roll(x, -1)) * cr), np.sum((y + np.roll(y, -1)) * cr)]) / (6 * a)
+    c = np.array([(x + x1) @ cr, (y + y1) @ cr]) / (6 * a)
     if not _inside(c[None, :], [poly])[0]:
         return poly.mean(axis=0)
     return c

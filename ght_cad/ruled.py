@@ -19,6 +19,9 @@ from typing import Any, Callable
 import numpy as np
 
 from ._validate import as_parameter_array
+from ._vec import cross as _cross
+from ._vec import dot as _dot
+from ._vec import norm as _norm
 from .curve import GHTCurve, gauss_legendre
 from .errors import GHTError
 
@@ -83,33 +86,45 @@ def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, n
     |a'||g|``, both tangents vanish, or a zero ruling) θ and the dot product are NaN; callers
     ignore those parameters.
     """
-    gl = np.linalg.norm(g, axis=-1)
+    gl = _norm(g)
     g1 = b1 - a1
-    a1l = np.linalg.norm(a1, axis=-1)
-    b1l = np.linalg.norm(b1, axis=-1)
-    lim = np.cross(g1, g)
-    a_sing = (a1l <= SINGULAR_NORMAL_TOL * gl)[..., None]
-    b_sing = (b1l <= SINGULAR_NORMAL_TOL * gl)[..., None]
-    ca = np.where(a_sing, lim, np.cross(a1, g))
-    cb = np.where(b_sing, -lim, np.cross(b1, g))
-    la, lb = np.linalg.norm(ca, axis=-1), np.linalg.norm(cb, axis=-1)
-    ta = np.where(a_sing[..., 0], np.linalg.norm(g1, axis=-1), a1l)
-    tb = np.where(b_sing[..., 0], np.linalg.norm(g1, axis=-1), b1l)
-    g1_ok = np.linalg.norm(g1, axis=-1) > SINGULAR_NORMAL_TOL * gl  # the limit needs a turning ruling
+    g1l = _norm(g1)
+    a1l = _norm(a1)
+    b1l = _norm(b1)
+    a_sing = a1l <= SINGULAR_NORMAL_TOL * gl
+    b_sing = b1l <= SINGULAR_NORMAL_TOL * gl
+    ca = _cross(a1, g)
+    cb = _cross(b1, g)
+    if a_sing.any() or b_sing.any():  # the limit normal g' × g where a tangent vanishes
+        lim = _cross(g1, g)
+        ca = np.where(a_sing[..., None], lim, ca)
+        cb = np.where(b_sing[..., None], -lim, cb)
+    la, lb = _norm(ca), _norm(cb)
+    ta = np.where(a_sing, g1l, a1l)
+    tb = np.where(b_sing, g1l, b1l)
+    g1_ok = g1l > SINGULAR_NORMAL_TOL * gl  # the limit needs a turning ruling
     ok = (
         (la > SINGULAR_NORMAL_TOL * ta * gl)
         & (lb > SINGULAR_NORMAL_TOL * tb * gl)
-        & ~((a_sing[..., 0] | b_sing[..., 0]) & ~g1_ok)
+        & ~((a_sing | b_sing) & ~g1_ok)
         & (gl > 0)
     )
     with np.errstate(divide="ignore", invalid="ignore"):
         na = ca / la[..., None]
         nb = cb / lb[..., None]
-        dot = np.clip(np.sum(na * nb, axis=-1), -1.0, 1.0)
+        dot = np.clip(_dot(na, nb), -1.0, 1.0)
         # atan2 of |na × nb| and na·nb is accurate near 0 where arccos is not
-        cr = np.linalg.norm(np.cross(na, nb), axis=-1)
+        cr = _norm(_cross(na, nb))
         th = np.degrees(np.arctan2(cr, dot))
     return np.where(ok, th, np.nan), np.where(ok, dot, np.nan)
+
+
+def _residual(a1: np.ndarray, g: np.ndarray, g1: np.ndarray) -> np.ndarray:
+    r"""``det(a', g, g') / (|a'| |g| |g'|)`` row-wise (0 where the scale vanishes)."""
+    det = _dot(a1, _cross(g, g1))
+    scale = _norm(a1) * _norm(g) * _norm(g1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(scale > 0, det / np.where(scale > 0, scale, 1.0), 0.0)
 
 
 def regression_v(a1: np.ndarray, g: np.ndarray, g1: np.ndarray) -> np.ndarray:
@@ -129,8 +144,14 @@ def developability_from_jets(
     a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray, weights: np.ndarray
 ) -> tuple[float, float, float, float]:
     """θ_rms, DD, R and θ_max from directrix values/derivatives at quadrature nodes."""
-    g = b0 - a0
-    th, dot = _theta(a1, b1, g)
+    th, dot = _theta(a1, b1, b0 - a0)
+    return _integrals(th, dot, weights)
+
+
+def _integrals(th: np.ndarray, dot: np.ndarray, weights: np.ndarray) -> tuple[float, float, float, float]:
+    """``(θ_max, θ_rms, DD, R)`` from θ and ``n_a·n_b`` at quadrature nodes with ``weights``:
+    ``θ_rms = sqrt(Σ w θ² / Σ w)``, ``DD = Σ w cos θ / Σ w``, ``R = Σ w (1 - n_a·n_b) / Σ w`` over the
+    nodes where the normals are defined (NaN everywhere when they are nowhere)."""
     ok = np.isfinite(th)
     if not ok.any():  # no normal anywhere (e.g. both edges collapsed to points): undefined, NaN
         return math.nan, math.nan, math.nan, math.nan
@@ -211,13 +232,7 @@ class RuledSurface(ABC):
     def developability_residual(self, u: Any) -> np.ndarray:
         r"""Scale-free residual ``det(a', g, g') / (|a'| |g| |g'|)`` (0 on a developable)."""
         uu, _ = as_parameter_array(u, "u")
-        a1 = self.a(uu, 1)
-        g = self.ruling(uu)
-        g1 = self.ruling(uu, 1)
-        det = np.einsum("ij,ij->i", a1, np.cross(g, g1))
-        scale = np.linalg.norm(a1, axis=1) * np.linalg.norm(g, axis=1) * np.linalg.norm(g1, axis=1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(scale > 0, det / np.where(scale > 0, scale, 1.0), 0.0)
+        return _residual(self.a(uu, 1), self.ruling(uu), self.ruling(uu, 1))
 
     def theta(self, u: Any) -> np.ndarray:
         """Angle θ(u) in degrees between the normals at the two ends of the ruling at u."""
@@ -240,14 +255,16 @@ class RuledSurface(ABC):
             )
         t, w = gauss_legendre(nodes)
         uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
-        # the quadrature nodes are the first entries of uu: one evaluation of a, a', b, b' serves
-        # the integrals, θ and the residual (a face's boundary jets are kept per parameter array)
+        # the quadrature nodes are the first entries of uu: one evaluation of a', b', g (a face's
+        # boundary jets are kept per parameter array) and one of θ serve the integrals, θ_max and
+        # the residual
         n = t.size
-        _, theta_rms, dd, R = developability_from_jets(self.a(uu)[:n], self.a(uu, 1)[:n], self.b(uu)[:n],
-                                                       self.b(uu, 1)[:n], w)
-        th = self.theta(uu)
+        a1, g = self.a(uu, 1), self.ruling(uu)
+        b1 = self.b(uu, 1)
+        th, dot = _theta(a1, b1, g)
+        _, theta_rms, dd, R = _integrals(th[:n], dot[:n], w)
         theta_max = float(np.nanmax(th)) if np.isfinite(th).any() else math.nan  # undefined normals skipped
-        res = float(np.max(np.abs(self.developability_residual(uu))))
+        res = float(np.max(np.abs(_residual(a1, g, b1 - a1))))
         return Developability(theta_max, theta_rms, dd, R, res)
 
     def ruling_lengths(self, u: Any) -> np.ndarray:

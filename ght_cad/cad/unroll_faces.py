@@ -150,6 +150,11 @@ class _SurfEval(SurfaceAdapter):
             self._nurbs = _Nurbs.of(adaptor)
             if self._nurbs is not None and not self._agrees():
                 self._nurbs = None  # pragma: no cover - a representation we do not read right: use OCCT
+            if self._nurbs is not None and self.ruled_hint is not None:
+                w = self._nurbs.cw[..., 3]  # equal weights across the rulings: affine along them
+                self.affine_ruled = bool(np.all(w[:, 0] == w[:, 1]) if self.ruled_hint == "v" else np.all(w[0] == w[1]))
+        elif kind == GeomAbs_SurfaceOfExtrusion:
+            self.affine_ruled = True  # C(u) + v D
 
     _nurbs: "_Nurbs | None" = None
 
