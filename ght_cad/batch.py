@@ -584,6 +584,7 @@ def _portable(panels: list[Any]) -> list[Any]:
         panel.development = None
         for loop in panel.loops:
             for e in loop:
+                _ = e.xyz  # the 3-D samples travel, their function does not
                 e.flat_fn = e.xyz_fn = None
     return panels
 

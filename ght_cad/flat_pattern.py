@@ -140,6 +140,8 @@ class BoundaryEdge:
         xyz_fn: t -> (n, 3) points on the 3-D surface.
         length_3d: exact 3-D length if known (else measured by Romberg chord sums).
         samples: number of output polyline points.
+        xyz: the 3-D points at the ``samples`` outline parameters, ``xyz_fn`` evaluated on first
+            access (a single panel needs none; shared-edge marks and exports ask for them).
     """
 
     name: str
@@ -148,9 +150,10 @@ class BoundaryEdge:
     length_3d: float | None = None
     samples: int = 257
     flat: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    xyz: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    xyz: np.ndarray | None = None  # a property below: evaluated on first access
     length_flat: float = float("nan")
     dense_flat: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    _xyz: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
     def measure(self) -> None:
         """Sample the edge and measure its flat length (Romberg, :func:`romberg_length`).
@@ -176,14 +179,33 @@ class BoundaryEdge:
             self.length_flat = length
         if self.length_3d is None:
             t = np.linspace(0.0, 1.0, 4 * _ROMBERG_N + 1)
-            self.length_3d = romberg_length(np.asarray(self.xyz_fn(t), dtype=float))
-        self.xyz = np.asarray(self.xyz_fn(ts), dtype=float)
+            dense = np.asarray(self.xyz_fn(t), dtype=float)
+            self.length_3d = romberg_length(dense)
+            if (4 * _ROMBERG_N) % max(self.samples - 1, 1) == 0:  # the outline's points are among them
+                self._xyz = dense[::4 * _ROMBERG_N // max(self.samples - 1, 1)].copy()
 
     def densify(self) -> None:
         """Flat samples at ``4 _ROMBERG_N + 1`` points (``dense_flat``) and the length from them."""
         t = np.linspace(0.0, 1.0, 4 * _ROMBERG_N + 1)
         self.dense_flat = np.asarray(self.flat_fn(t), dtype=float)
         self.length_flat = romberg_length(self.dense_flat)
+
+
+def _get_xyz(self: BoundaryEdge) -> np.ndarray:
+    if self._xyz is None:
+        if self.xyz_fn is None:
+            return np.zeros((0, 3))
+        self._xyz = np.asarray(self.xyz_fn(np.linspace(0.0, 1.0, self.samples)), dtype=float)
+    return self._xyz
+
+
+def _set_xyz(self: BoundaryEdge, value: Any) -> None:
+    if isinstance(value, property):  # the dataclass default (the property itself): not set
+        value = None
+    self._xyz = None if value is None else np.asarray(value, dtype=float)
+
+
+BoundaryEdge.xyz = property(_get_xyz, _set_xyz, doc="3-D points at the outline parameters, (samples, 3) (evaluated on first access).")  # type: ignore[assignment]
 
 
 @dataclass

@@ -298,6 +298,9 @@ class _Nurbs:
         self.U, self.V = np.asarray(uknots, dtype=float), np.asarray(vknots, dtype=float)
         self.pu, self.pv = int(pu), int(pv)
         self.cw = cw  # (nu, nv, 4)
+        w = cw[..., 3]
+        #: the common weight when all weights are equal (a polynomial surface), else None
+        self.weight: float | None = float(w.flat[0]) if np.all(w == w.flat[0]) else None
         self.nets: dict[tuple[int, int], np.ndarray] = {(0, 0): cw}
         # (target, source, axis, k): ∂_u, ∂_uu, ∂_v, ∂_vv, then ∂_u of the ∂_v net
         for tgt, src, axis, k in (((1, 0), (0, 0), 0, 1), ((2, 0), (1, 0), 0, 2), ((0, 1), (0, 0), 1, 1),
@@ -406,32 +409,42 @@ class _Nurbs:
             return None
         starts_u, cu, hu, starts_v, cv, hv, pt = self.patches
         A, B = self.pu + 1, self.pv + 1
-        iu = np.clip(np.searchsorted(starts_u, s, side="right") - 1, 0, starts_u.size - 1)
-        iv = np.clip(np.searchsorted(starts_v, v, side="right") - 1, 0, starts_v.size - 1)
+        iu = np.minimum(np.maximum(np.searchsorted(starts_u, s, side="right") - 1, 0), starts_u.size - 1)
+        iv = np.minimum(np.maximum(np.searchsorted(starts_v, v, side="right") - 1, 0), starts_v.size - 1)
         Tu = _cheb_t((s - cu[iu]) / hu[iu], self.pu, 1, hu[iu])
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, 1, hv[iv])
-        P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu]  # (i, v-span, e, f, k)
+        # equal weights: S_u = A_u / w, S_v = A_v / w, the density needs neither S nor W
+        K = 3 if self.weight is not None else 4
+        P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu][..., :K]  # (i, v-span, e, f, k)
         G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
         ms, mv = s.size, v.size
-        keys = ((0, 0), (1, 0), (0, 1))
+        keys = ((1, 0), (0, 1)) if K == 3 else ((0, 0), (1, 0), (0, 1))
         spans = np.unique(iv)
         if spans.size == 1:  # one v-span: (k i, f) @ (f, j) is already component-major
             sv = int(spans[0])
-            H = {(ku, kv): (G[ku][sv].reshape(4 * ms, B) @ Tv[kv].T).reshape(4, ms, mv) for ku, kv in keys}
+            H = {(ku, kv): (G[ku][sv].reshape(K * ms, B) @ Tv[kv].T).reshape(K, ms, mv) for ku, kv in keys}
         else:
-            H = {key: np.empty((4, ms, mv)) for key in keys}
+            H = {key: np.empty((K, ms, mv)) for key in keys}
             for sv in spans.tolist():
                 sel = np.nonzero(iv == sv)[0]
                 for (ku, kv), out in H.items():
-                    out[:, :, sel] = (G[ku][sv].reshape(4 * ms, B) @ Tv[kv][sel].T).reshape(4, ms, sel.size)
-        W = H[(0, 0)][3]
-        S = H[(0, 0)][:3] / W
-        Su = (H[(1, 0)][:3] - H[(1, 0)][3] * S) / W
-        Sv = (H[(0, 1)][:3] - H[(0, 1)][3] * S) / W
+                    out[:, :, sel] = (G[ku][sv].reshape(K * ms, B) @ Tv[kv][sel].T).reshape(K, ms, sel.size)
+        if K == 3:
+            Su, Sv = H[(1, 0)], H[(0, 1)]
+            scale = 1.0 / (self.weight * self.weight)
+        else:
+            W = H[(0, 0)][3]
+            S = H[(0, 0)][:3] / W
+            Su = (H[(1, 0)][:3] - H[(1, 0)][3] * S) / W
+            Sv = (H[(0, 1)][:3] - H[(0, 1)][3] * S) / W
+            scale = 1.0
         cx = Su[1] * Sv[2] - Su[2] * Sv[1]
         cy = Su[2] * Sv[0] - Su[0] * Sv[2]
         cz = Su[0] * Sv[1] - Su[1] * Sv[0]
-        return np.sqrt(cx * cx + cy * cy + cz * cz)
+        r = cx * cx + cy * cy + cz * cz
+        if scale != 1.0:
+            r *= scale
+        return np.sqrt(r, out=r)
 
     def _patch_hom(self, u: np.ndarray, v: np.ndarray, order: int) -> dict[tuple[int, int], np.ndarray]:
         """``∂^ku_u ∂^kv_v H`` for ku + kv <= order from the Chebyshev patches: on the knot-span
@@ -778,13 +791,15 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     q0, q1 = c3.FirstParameter(), c3.LastParameter()
     if reversed_:
         q0, q1 = q1, q0
-    f3 = _curve_eval(c3, 3)
+    f3: list[Any] = []  # the 3-D curve's evaluator, read on first use (a single panel needs none)
 
     @_memo
     def xyz(t: np.ndarray) -> np.ndarray:
+        if not f3:
+            f3.append(_curve_eval(c3, 3))
         q = q0 + t * (q1 - q0)
-        if f3 is not None:
-            return f3(q)
+        if f3[0] is not None:
+            return f3[0](q)
         return np.array([c3.Value(x).Coord() for x in q.tolist()], dtype=float).reshape(-1, 3)
 
     tbreaks = np.zeros(0)
