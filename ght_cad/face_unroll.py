@@ -848,7 +848,7 @@ def unroll_face_data(
         rs = FaceRuledSurface(ev, ruled_dir, bounds)
         dd = _check_developable(rs, tol_deg, best_effort, f"face {label!r}")
         info["developability"] = dd.as_dict()
-        dev = RuledDevelopment(rs, breakpoints=rs.breakpoints)
+        dev = RuledDevelopment(rs, breakpoints=rs.breakpoints, place=False)  # the panel is placed below
         info["method"] = "quadrature along rulings (adaptive Chebyshev panels)"
         info["panels"] = dev.panels
         info["quadrature_error_estimate"] = dev.quadrature_error_estimate

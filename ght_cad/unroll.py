@@ -33,6 +33,9 @@ import numpy as np
 
 from .curve import gauss_legendre, integrate
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ._vec import cross as _cross
+from ._vec import dot as _dot
+from ._vec import norm as _norm
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from .ruled import RuledSurface
 
@@ -111,7 +114,7 @@ class _PanelSeries:
             for p in np.nonzero(counts)[0].tolist():
                 sel = order[start:start + counts[p]]
                 start += counts[p]
-                out[sel] = np.einsum("jn,jm->nm", T[:, sel], self.coefs[p])
+                out[sel] = T[:, sel].T @ self.coefs[p]
         else:
             step = 8192
             for s in range(0, u.size, step):
@@ -127,25 +130,26 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
     a1 = surface.a(u, 1)
     g = surface.ruling(u)
     g1 = surface.ruling(u, 1)
-    L = np.linalg.norm(g, axis=1)
+    L = _norm(g)
     if not np.all(L > 0):
         i = int(np.argmin(L))
         raise DegenerateGeometryError(
             f"ruling length |b(u) - a(u)| = {L[i]:.3g} at u={u[i]:.6g}: the rulings must have positive length"
         )
     d = g / L[:, None]
-    L1 = np.einsum("ij,ij->i", d, g1)
+    L1 = _dot(d, g1)
     d1 = (g1 - d * L1[:, None]) / L[:, None]
-    c = np.cross(a1, d)
-    scale = np.linalg.norm(a1, axis=1)
+    c = _cross(a1, d)
+    scale = _norm(a1)
     # a stationary directrix (the apex of a cone, e.g. a loft's fan with apex on rail a): the
     # tangent plane along the ruling is spanned by d and b' (X_u × X_v = v b' × g there)
     b1 = a1 + g1
-    apex = scale <= 1e-12 * np.linalg.norm(b1, axis=1)
+    b1l = _norm(b1)
+    apex = scale <= 1e-12 * b1l
     if apex.any():
-        c = np.where(apex[:, None], np.cross(b1, d), c)
-        scale = np.where(apex, np.linalg.norm(b1, axis=1), scale)
-    cn = np.linalg.norm(c, axis=1)
+        c = np.where(apex[:, None], _cross(b1, d), c)
+        scale = np.where(apex, b1l, scale)
+    cn = _norm(c)
     if not np.all(cn > 1e-12 * np.maximum(scale, 1e-300)):
         i = int(np.argmin(cn / np.maximum(scale, 1e-300)))
         raise DegenerateGeometryError(
@@ -153,17 +157,17 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
             "a' must be transversal to the rulings"
         )
     n = c / cn[:, None]
-    e = np.cross(n, d)
+    e = _cross(n, d)
     return {
         "L": L,
         "L1": L1,
         "d": d,
         "e": e,
         "n": n,
-        "p": np.einsum("ij,ij->i", a1, d),
-        "q": np.einsum("ij,ij->i", a1, e),
-        "w": np.einsum("ij,ij->i", d1, e),
-        "wn": np.einsum("ij,ij->i", d1, n),
+        "p": _dot(a1, d),
+        "q": _dot(a1, e),
+        "w": _dot(d1, e),
+        "wn": _dot(d1, n),
     }
 
 
@@ -176,6 +180,9 @@ class RuledDevelopment:
             start there.
         tol: relative tolerance of the spectral integration (w.r.t. the pattern size).
         max_panels: cap on the number of Chebyshev panels.
+        place: translate the map so that the bounding box of the boundaries ``Y(u, 0)``,
+            ``Y(u, 1)`` (257 samples) sits at the origin; False: ``A(0)`` stays at the origin (a
+            caller that places the panel itself, as the face unrolling does, skips the samples).
 
     Raises:
         DegenerateGeometryError: zero-length rulings or a directrix tangent to a ruling.
@@ -188,6 +195,7 @@ class RuledDevelopment:
         breakpoints: Sequence[float] = (),
         tol: float = 1e-13,
         max_panels: int = 2048,
+        place: bool = True,
     ) -> None:
         self.surface = surface
         bp = np.asarray([b for b in breakpoints if 1e-12 < b < 1 - 1e-12], dtype=float)
@@ -234,14 +242,15 @@ class RuledDevelopment:
         # rigid placement: a-edge chord along +x, bounding box at the origin (applied in .map)
         self._R = np.eye(2)
         self._t = np.zeros(2)
-        A01 = self._raw_A(np.array([0.0, 1.0]))
-        chord = A01[1] - A01[0]
+        chord = totA.sum(axis=0)  # A(1) - A(0): the panels' integrals (A(0) = 0)
         if np.linalg.norm(chord) > 1e-9 * max(size, 1e-300):
             ang = -math.atan2(chord[1], chord[0])
         else:
             ang = math.pi / 2 - float(self._phi(np.array([0.0]))[0, 0])
         ca, sa = math.cos(ang), math.sin(ang)
         self._R = np.array([[ca, -sa], [sa, ca]])
+        if not place:
+            return
         uu = np.linspace(0, 1, 257)
         # map(u, 0) and map(u, 1) (A and A + L D) from one evaluation of the series and lengths at uu
         L = self.surface.ruling_lengths(uu)
@@ -273,11 +282,19 @@ class RuledDevelopment:
     def map(self, u: Any, v: Any) -> np.ndarray:
         """Flat image ``Y(u, v) = A(u) + v L(u) D(u)`` of ``X(u, v)``; u, v broadcast, shape (n, 2)."""
         uu, vv = broadcast_uv(u, v)
-        L = self.surface.ruling_lengths(uu)
-        r = self._phiA(uu)  # the same values as phi(uu), directrix(uu)
+        uu, vv = uu.ravel(), vv.ravel()
+        # L, φ and A depend on u only: evaluated once per distinct u (points along one ruling, a
+        # ruling edge's samples or a difference stencil's v steps, share them)
+        tu, inv = np.unique(uu, return_inverse=True) if uu.size > 64 else (uu, None)
+        L = self.surface.ruling_lengths(tu)
+        r = self._phiA(tu)  # the same values as phi(tu), directrix(tu)
         ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
         A = r[:, 1:3] @ self._R.T + self._t
-        return A + (vv * L)[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)
+        LD = L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)
+        if inv is not None:
+            inv = inv.ravel()
+            A, LD = A[inv], LD[inv]
+        return A + vv[:, None] * LD
 
     def map_points(self, u: Any, points: np.ndarray) -> np.ndarray:
         """Flat image of 3-D points lying on the rulings at ``u`` (projected onto the ruling)."""
