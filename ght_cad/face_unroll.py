@@ -459,11 +459,9 @@ def face_area(
     parts = []  # (loop, outer weights dv * tw, u, v) per edge
     for k, loop in enumerate(edges_uv):
         for uvf, duv in loop:
-            te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
-            tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
-            tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
+            tn, tw = _edge_nodes(getattr(duv, "breaks", None))
             dv = duv(tn)[:, 1]
-            if np.max(np.abs(dv)) == 0.0:
+            if not dv.any():
                 continue
             u, v = uvf(tn)
             parts.append((k, dv * tw, np.asarray(u, dtype=float), np.asarray(v, dtype=float)))
@@ -484,7 +482,8 @@ def face_area(
         for _, _, uu, vv in parts if grid is not None else ():
             m = uu.size
             if m and np.all(uu == uu[0]):  # an edge along v (u constant): its inner nodes are shared
-                s_n, _, w_n, _ = _inner_nodes(uu[:1], vv[:1], u_lo, u_breaks, u_span, xg, wg)
+                # (none on u = u_lo, where P = 0)
+                s_n, _, w_n, _ = _inner_nodes(uu[:1], vv[:1], u_lo, u_breaks, u_span, xg, wg) if uu[0] != u_lo else (np.zeros(0),) * 4
                 if s_n.size:
                     f = grid(s_n, vv)
                     P[i:i + m] = np.einsum("k,kj->j", w_n, f)
@@ -502,6 +501,29 @@ def face_area(
         i += uu.size
     totals = [abs(t) for t in totals]
     return totals[0] - sum(totals[1:]) if totals else 0.0
+
+
+@functools.lru_cache(maxsize=1)
+def _edge_nodes_plain() -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_edge_nodes` without breaks (computed once; read-only arrays)."""
+    out = _edge_nodes_at(np.linspace(0.0, 1.0, 17))
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
+def _edge_nodes_at(te: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    xg, wg = _gauss12()
+    h = 0.5 * np.diff(te)
+    return ((0.5 * (te[:-1] + te[1:])[:, None] + h[:, None] * xg[None, :]).ravel(), (h[:, None] * wg[None, :]).ravel())
+
+
+def _edge_nodes(breaks: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights along an edge, t ∈ [0, 1]: 16 equal panels, also cut at
+    the pcurve's ``breaks``, 12 points each."""
+    if breaks is None or not len(breaks):
+        return _edge_nodes_plain()
+    return _edge_nodes_at(np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), breaks])))
 
 
 def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: float, u_breaks: np.ndarray, u_span: float | None,
@@ -554,12 +576,9 @@ def loop_uv_area(loop: list[tuple[Callable, Callable]]) -> float:
     Returns:
         The signed (u, v)-area (positive counter-clockwise).
     """
-    xg, wg = _gauss12()
     total = 0.0
     for uvf, duv in loop:
-        te = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), getattr(duv, "breaks", np.zeros(0))]))
-        tn = (0.5 * (te[:-1] + te[1:])[:, None] + 0.5 * np.diff(te)[:, None] * xg[None, :]).ravel()
-        tw = (0.5 * np.diff(te)[:, None] * wg[None, :]).ravel()
+        tn, tw = _edge_nodes(getattr(duv, "breaks", None))
         u, _ = uvf(tn)
         total += float(np.sum(np.asarray(u, dtype=float) * duv(tn)[:, 1] * tw))
     return total

@@ -341,18 +341,18 @@ class FlatPanel:
 
 
 def _point_in_polygon(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Even-odd ray casting, vectorized over points (in chunks of ~2e6 point-edge pairs)."""
+    """Even-odd ray casting, vectorized over points (in chunks of ~2e6 point-edge pairs): a ray
+    from each point towards +x crosses the edges whose end points lie on either side of its
+    height, at ``x0 + (y - y0)(x1 - x0)/(y1 - y0)``; only those pairs are evaluated."""
     step = max(1, int(2e6 // max(len(poly), 1)))
     if len(pts) > step:
         return np.concatenate([_point_in_polygon(pts[i : i + step], poly) for i in range(0, len(pts), step)])
-    x, y = pts[:, 0][:, None], pts[:, 1][:, None]
-    x0, y0 = poly[:, 0][None, :], poly[:, 1][None, :]
     nxt = _next(poly)
-    x1, y1 = nxt[:, 0][None, :], nxt[:, 1][None, :]
-    cond = (y0 > y) != (y1 > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xi = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
-    return (np.sum(cond & (x < xi), axis=1) % 2) == 1
+    y = pts[:, 1][:, None]
+    i, j = np.nonzero((poly[:, 1][None, :] > y) != (nxt[:, 1][None, :] > y))
+    x0, y0, x1, y1 = poly[j, 0], poly[j, 1], nxt[j, 0], nxt[j, 1]
+    xi = x0 + (pts[i, 1] - y0) * (x1 - x0) / (y1 - y0)
+    return (np.bincount(i[pts[i, 0] < xi], minlength=len(pts)) % 2) == 1
 
 
 def _inside(pts: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:

@@ -167,10 +167,22 @@ class _SurfEval(SurfaceAdapter):
                 np.array([lo[1], 0.6 * lo[1] + 0.4 * hi[1], hi[1], 0.2 * lo[1] + 0.8 * hi[1]]))
 
     def _agrees(self) -> bool:
-        """The numpy evaluation matches ``BRepAdaptor_Surface.D2`` at four points to 1e-12 of the size
-        (first derivatives and second derivatives relative to their own size)."""
+        """The numpy evaluation matches OCCT at four points to 1e-12 of the size (derivatives
+        relative to their own size): an analytic surface's ``D2``; a B-spline's values and first
+        derivatives (``D1``), which check the poles, weights and knots as read (its second
+        derivatives come from the same data through the difference nets)."""
         uu, vv = self._probe()
-        ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
+        if self._nurbs is not None:
+            ours = self._nurbs.eval(uu, vv, 1)
+            p, (du, dv) = self._p, self._v[:2]
+            rows = []
+            for u, v in zip(uu.tolist(), vv.tolist()):
+                self.ad.D1(u, v, p, du, dv)
+                rows.append(p.Coord() + du.Coord() + dv.Coord())
+            a = np.array(rows, dtype=float)
+            theirs = [a[:, 0:3], a[:, 3:6], a[:, 6:9]]
+        else:
+            ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
         for a, b in zip(ours, theirs):
             scale = max(1.0, float(np.abs(b).max()), self.radius)
             if not float(np.abs(a - b).max()) <= 1e-12 * scale:
@@ -301,12 +313,7 @@ class _Nurbs:
         w = cw[..., 3]
         #: the common weight when all weights are equal (a polynomial surface), else None
         self.weight: float | None = float(w.flat[0]) if np.all(w == w.flat[0]) else None
-        self.nets: dict[tuple[int, int], np.ndarray] = {(0, 0): cw}
-        # (target, source, axis, k): ∂_u, ∂_uu, ∂_v, ∂_vv, then ∂_u of the ∂_v net
-        for tgt, src, axis, k in (((1, 0), (0, 0), 0, 1), ((2, 0), (1, 0), 0, 2), ((0, 1), (0, 0), 1, 1),
-                                  ((0, 2), (0, 1), 1, 2), ((1, 1), (0, 1), 0, 1)):
-            if k <= (self.pu, self.pv)[axis] and src in self.nets:
-                self.nets[tgt] = _diff_net(self.nets[src], (self.U, self.V)[axis], (self.pu, self.pv)[axis], k, axis)
+        self._nets: dict[tuple[int, int], np.ndarray] | None = None  # built on first use (:attr:`nets`)
         self.patches: tuple[np.ndarray, ...] | None = None
         su, sv = _spans(self.U, self.pu), _spans(self.V, self.pv)
         if su.size * sv.size * (self.pu + 1) * (self.pv + 1) <= 2_000_000 and max(self.pu, self.pv) <= 25:
@@ -322,6 +329,20 @@ class _Nurbs:
                             np.ascontiguousarray(pt.reshape(su.size * sv.size, -1)))
             #: the patches as a (u-span, e) x (v-span, f, k) matrix (:meth:`_patch_hom`)
             self.patches_u = np.ascontiguousarray(np.moveaxis(pt, 2, 1).reshape(su.size * (self.pu + 1), -1))
+
+    @property
+    def nets(self) -> dict[tuple[int, int], np.ndarray]:
+        """The difference nets ``{(ku, kv): C^(ku, kv)}`` of the derivatives up to order 2 (class
+        doc), made on first use: values and first derivatives come from the patches."""
+        if self._nets is None:
+            nets = {(0, 0): self.cw}
+            # (target, source, axis, k): ∂_u, ∂_uu, ∂_v, ∂_vv, then ∂_u of the ∂_v net
+            for tgt, src, axis, k in (((1, 0), (0, 0), 0, 1), ((2, 0), (1, 0), 0, 2), ((0, 1), (0, 0), 1, 1),
+                                      ((0, 2), (0, 1), 1, 2), ((1, 1), (0, 1), 0, 1)):
+                if k <= (self.pu, self.pv)[axis] and src in nets:
+                    nets[tgt] = _diff_net(nets[src], (self.U, self.V)[axis], (self.pu, self.pv)[axis], k, axis)
+            self._nets = nets
+        return self._nets
 
     @classmethod
     def of(cls, ad: BRepAdaptor_Surface) -> "_Nurbs | None":
