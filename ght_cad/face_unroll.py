@@ -52,6 +52,7 @@ __all__ = [
     "best_effort_direction",
     "end_isoline_length",
     "face_area",
+    "clip_rulings_uv",
     "fd_derivative",
     "chain_loop",
     "loop_uv_area",
@@ -926,12 +927,30 @@ def unroll_face_data(
         n = tt.size
         p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
         g3 = np.linalg.norm(p3[:n] - p3[n:], axis=1)
-        ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
-        ruling_uv = (np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
     # the map's points in one call (it is pointwise; its per-call overhead dominated): the
     # edges' outline samples, the ruling ends and bend lines, the metric's stencil
     mU, mV, mhu, mhv = _metric_grid(bounds)
     sampled, ts, edge_uv = _edge_sample_uv(loops, loops_uv, samples)
+    clipped = None
+    if ruled_dir is not None:
+        # bend lines: rulings clipped to the loops in (u, v), where they are straight lines
+        ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
+        if rulings and len(sampled) == sum(len(lp) for lp in loops):
+            m = ts.size
+            pts = np.stack(edge_uv, axis=1).reshape(len(sampled), m, 2)
+            if ruled_dir == "u":
+                pts = pts[..., ::-1]
+            first = np.cumsum([0] + [len(lp) for lp in loops])
+            polys = [pts[i:j, :-1].reshape(-1, 2) for i, j in zip(first[:-1], first[1:])]
+            lo_, hi_ = (v0, v1) if ruled_dir == "v" else (u0, u1)
+            clipped = clip_rulings_uv(polys, ca if ruled_dir == "v" else cva, lo_, hi_)
+            if clipped is not None:
+                kk, y0, y1 = clipped
+                if ruled_dir == "v":
+                    ca, cva, cb, cvb = ca[kk], y0, cb[kk], y1
+                else:
+                    ca, cva, cb, cvb = y0, cva[kk], y1, cvb[kk]
+        ruling_uv = (np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
     fmap = _MapBatch(dmap.map, [metric_stencil(mU, mV, mhu, mhv)] + ([ruling_uv] if ruled_dir is not None else [])
                      + [edge_uv])
     if sampled:
@@ -940,13 +959,13 @@ def unroll_face_data(
         pf = fmap(*ruling_uv)
         gf = np.linalg.norm(pf[:n] - pf[n:2 * n], axis=1)
         if rulings:
-            k = tb.size
+            k = ca.size
             bends = np.stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
     area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"), u1 - u0)
     panel = FlatPanel(
         label=label,
         loops=loops,
-        bend_lines=bends,
+        bend_lines=bends if clipped is None else np.zeros((0, 2, 2)),  # measure_panel clips in the plane
         ruling_lengths_3d=g3,
         ruling_lengths_flat=gf,
         area_3d=area_3d,
@@ -955,6 +974,8 @@ def unroll_face_data(
         development=dmap,
     )
     measure_panel(panel)
+    if clipped is not None:
+        panel.bend_lines = bends  # clipped in (u, v) already
     if fsheet is not None:
         wires = [w for w in face.wires if w]  # the loops' order: outer (k_out) first
         fsheet.finish(panel, dmap, rulings, [wires[k_out]] + wires[:k_out] + wires[k_out + 1:])
@@ -962,6 +983,39 @@ def unroll_face_data(
     lo, _ = panel.bbox()
     panel.translate(-lo)
     return FlatPattern([panel], units=units)
+
+
+def clip_rulings_uv(polygons: Sequence[np.ndarray], c: np.ndarray, lo: float, hi: float
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    r"""Clip the rulings ``x = c_k``, ``y ∈ [lo, hi]`` of the parameter plane to a face's loops.
+
+    A face's rulings are straight in its parameters (rulings along v: the lines u = c_k), so
+    bend lines are clipped where they are exact: every loop edge ``A → B`` of the (u, v)
+    polygons with ``(A_x <= c) != (B_x <= c)`` (half-open: a vertex on the line counts once)
+    crosses at ``y = A_y + (c - A_x)(B_y - A_y) / (B_x - A_x)``; sorted along each ruling the
+    crossings pair up into the inside intervals (even–odd over all loops: holes cut them), each
+    clamped to [lo, hi].
+
+    Args:
+        polygons: the loops as closed (m, 2) polylines (x across the rulings, y along them).
+        c: the rulings' positions, (k,).
+        lo, hi: the rulings' extent along y.
+
+    Returns:
+        ``(ruling index, y0, y1)`` per inside interval, in ruling order then along y; None when
+        some ruling crosses the loops an odd number of times (a polyline that is not closed).
+    """
+    A = np.concatenate(polygons)
+    B = np.concatenate([np.concatenate([p[1:], p[:1]]) for p in polygons])
+    k, j = np.nonzero((A[:, 0][None, :] <= c[:, None]) != (B[:, 0][None, :] <= c[:, None]))
+    y = A[j, 1] + (c[k] - A[j, 0]) * (B[j, 1] - A[j, 1]) / (B[j, 0] - A[j, 0])
+    order = np.lexsort((y, k))
+    k, y = k[order], y[order]
+    if np.any(np.bincount(k, minlength=c.size) % 2):
+        return None
+    k, y0, y1 = k[::2], np.maximum(y[::2], lo), np.minimum(y[1::2], hi)
+    keep = y1 - y0 > 1e-12 * (hi - lo)
+    return k[keep], y0[keep], y1[keep]
 
 
 def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:

@@ -22,6 +22,7 @@ from ght_cad.face_unroll import (
     FaceData,
     SurfaceAdapter,
     chain_loop,
+    clip_rulings_uv,
     fd_derivative,
     isoline_stats,
     ruling_direction,
@@ -463,3 +464,31 @@ def test_fd_derivative_respects_breaks() -> None:
     bad = fd_derivative(g, np.array([0.30001]), [], h=1e-3)
     good = fd_derivative(g, np.array([0.30001]), [0.3], h=1e-3)
     assert abs(good[0, 0] - 1.0) < 1e-9 < abs(bad[0, 0] - 1.0)
+
+
+def test_clip_rulings_uv_square_with_hole() -> None:
+    """Rulings x = c of the unit square with a square hole [0.4, 0.6] x [0.3, 0.7]: outside the
+    hole's shadow one whole interval, across it two; a ruling through polygon vertices (the hole's
+    corners at x = 0.4) is split exactly once at each of them (half-open crossing rule)."""
+    outer = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    hole = np.array([[0.4, 0.3], [0.4, 0.7], [0.6, 0.7], [0.6, 0.3]], float)
+    k, y0, y1 = clip_rulings_uv([outer, hole], np.array([0.25, 0.5, 0.4]), 0.0, 1.0)
+    assert k.tolist() == [0, 1, 1, 2, 2]
+    np.testing.assert_allclose(y0, [0.0, 0.0, 0.7, 0.0, 0.7], atol=1e-15)
+    np.testing.assert_allclose(y1, [1.0, 0.3, 1.0, 0.3, 1.0], atol=1e-15)
+
+
+@given(c=st.floats(0.01, 0.99), lo=st.floats(-0.5, 0.2), hi=st.floats(0.8, 1.5))
+@settings(max_examples=60, deadline=None)
+def test_clip_rulings_uv_disc_chord(c: float, lo: float, hi: float) -> None:
+    """A ruling x = c across a finely sampled disc of radius 1/2 about (1/2, 1/2): one interval,
+    the chord y = 1/2 ± sqrt(1/4 - (c - 1/2)²) to the polyline's sagitta R (1 - cos(π/1024))
+    ≈ 2.4e-6, magnified along y by R / half-chord where the ruling meets the circle at a slant,
+    clamped to [lo, hi]."""
+    th = np.linspace(0.0, 2 * np.pi, 1025)[:-1]
+    disc = 0.5 + 0.5 * np.stack([np.cos(th), np.sin(th)], axis=1)
+    k, y0, y1 = clip_rulings_uv([disc], np.array([c]), lo, hi)
+    half = math.sqrt(0.25 - (c - 0.5) ** 2)
+    assert k.tolist() == [0]
+    tol = 0.5 * (1 - math.cos(math.pi / 1024)) * 0.5 / half * 1.01
+    assert abs(y0[0] - max(0.5 - half, lo)) <= tol and abs(y1[0] - min(0.5 + half, hi)) <= tol

@@ -164,6 +164,15 @@ def test_holes_and_planar_face_output() -> None:
     assert pat.errors["max"] < 1e-9
     # bend lines are clipped by the hole: some rulings are split in two
     assert len(pat.bend_lines) > 20
+    # clipped in (u, v): every end lies on the outline (outer boundary or hole); the cylinder's
+    # development (R u, v) is linear, so the (u, v) polyline maps onto the flat one exactly
+    ends = pat.bend_lines.reshape(-1, 2)
+    d = np.full(len(ends), np.inf)
+    for poly in pat.panels[0].loop_polylines():
+        a, b = poly, np.roll(poly, -1, axis=0)
+        s = np.clip(np.einsum("pkj,kj->pk", ends[:, None, :] - a[None], b - a) / np.einsum("kj,kj->k", b - a, b - a), 0, 1)
+        d = np.minimum(d, np.linalg.norm(a[None] + s[..., None] * (b - a)[None] - ends[:, None, :], axis=2).min(axis=1))
+    assert d.max() < 1e-12 * 50
     flat = pat.to_face()
     assert isinstance(flat, bd.Face) and len(flat.inner_wires()) == 1
     assert flat.area == pytest.approx(pat.area, rel=1e-7)
