@@ -13,11 +13,12 @@ Gauss–Legendre quadrature (``ght_cad.cad.unroll_faces.face_area``).
 
 Times: ours = ``unroll(face)`` (including the distortion report); FreeCAD = meshing and
 unwrapping measured inside the FreeCAD process (process start-up excluded, printed separately).
+Both sides count the fastest of ``GHT_BENCH_REPS`` calls per face (default 5: the first call pays
+one-off costs on either side, e.g. imports; on a loaded machine single calls can be 2-3x slower).
 
 Run: ``/tmp/venv/bin/python bench/flatmesh_compare.py [--deflection 1e-3]``. Environment:
-``GHT_BENCH_REPS`` calls of ``unroll`` per face, the best counted (default 2: the first call
-pays one-off imports; on a loaded machine the next ones can still be slow, use 5);
-``GHT_BENCH_TRACE=1`` prints every call's time to stderr.
+``GHT_BENCH_REPS`` calls per face on each side; ``GHT_BENCH_TRACE=1`` prints every call of ours
+to stderr.
 """
 
 from __future__ import annotations
@@ -87,7 +88,8 @@ def run_flatmesh(faces: dict[str, Any], rel_deflection: float, workdir: str | os
         write_step(face, step)
         bb = face.bounding_box()
         size = float(bb.diagonal)
-        specs.append({"name": name, "step": str(step), "deflection": rel_deflection * size, "angular": 0.1})
+        specs.append({"name": name, "step": str(step), "deflection": rel_deflection * size, "angular": 0.1,
+                      "reps": _reps()})
     job = work / "job.json"
     out = work / "result.json"
     job.write_text(json.dumps({"faces": specs, "out": str(out)}))
@@ -106,12 +108,17 @@ def run_flatmesh(faces: dict[str, Any], rel_deflection: float, workdir: str | os
     return {"results": res, "process_overhead": wall - inside}
 
 
+def _reps() -> int:
+    """Calls per face on each side, the fastest counted (``GHT_BENCH_REPS``, default 5)."""
+    return max(1, int(os.environ.get("GHT_BENCH_REPS", "5")))
+
+
 def ours(face: Any) -> dict[str, float]:
     """Unroll with ght_cad and return time, boundary and area errors (and exact references)."""
     from ght_cad.unroll import unroll
 
     dt = float("inf")
-    for _ in range(int(os.environ.get("GHT_BENCH_REPS", "2"))):  # best of two: the first call also pays one-off imports
+    for _ in range(_reps()):  # the fastest call: the first one also pays one-off imports
         t0 = time.perf_counter()
         pat = unroll(face, rulings=16)
         dt = min(dt, time.perf_counter() - t0)
@@ -197,7 +204,8 @@ def main(argv: list[str] | None = None) -> int:
         print("freecadcmd not found: install Debian's freecad-python3", file=sys.stderr)
         return 2
     faces = default_faces()
-    print("relative errors against the exact face (boundary length, area); times in seconds")
+    print(f"relative errors against the exact face (boundary length, area); times in seconds, the fastest of "
+          f"{_reps()} calls per face on each side; load average {os.getloadavg()[0]:.1f}")
     hdr = (f"{'face':22s} {'defl':>7s} | {'ours err':>9s} {'ours t':>7s} | {'fm err':>9s} {'fm intr':>9s} "
            f"{'fm edge':>9s} {'nodes':>6s} {'fm t':>7s} | {'err ratio':>9s} {'t ratio':>7s} {'ours/fm':>7s}")
     print(hdr)

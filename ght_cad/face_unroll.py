@@ -703,9 +703,11 @@ def _metric_grid(bounds: Bounds) -> tuple[np.ndarray, np.ndarray, float, float]:
     return U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0)
 
 
-def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds) -> dict[str, np.ndarray]:
-    """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`)."""
-    U, V, hu, hv = _metric_grid(bounds)
+def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds,
+            grid: tuple[np.ndarray, np.ndarray, float, float] | None = None) -> dict[str, np.ndarray]:
+    """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`;
+    ``grid``: :func:`_metric_grid` of ``bounds`` when already made)."""
+    U, V, hu, hv = grid if grid is not None else _metric_grid(bounds)
     d = ev.d1(U, V)
     return metric_angles(d[0], d[1], fmap, U, V, hu, hv)
 
@@ -969,7 +971,7 @@ def unroll_face_data(
         ruling_lengths_3d=g3,
         ruling_lengths_flat=gf,
         area_3d=area_3d,
-        metric=_metric(ev, fmap, bounds),
+        metric=_metric(ev, fmap, bounds, (mU, mV, mhu, mhv)),
         info=info,
         development=dmap,
     )

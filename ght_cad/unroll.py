@@ -407,9 +407,9 @@ def metric_angles(
     F = F.reshape(8, n, 2)
     yu = (-F[0] + 8 * F[1] - 8 * F[2] + F[3]) / (12 * hu)
     yv = (-F[4] + 8 * F[5] - 8 * F[6] + F[7]) / (12 * hv)
-    a3 = np.arctan2(np.linalg.norm(np.cross(xu, xv), axis=1), np.einsum("ij,ij->i", xu, xv))
-    a2 = np.arctan2(np.abs(yu[:, 0] * yv[:, 1] - yu[:, 1] * yv[:, 0]), np.einsum("ij,ij->i", yu, yv))
-    return {"angle_3d": a3, "angle_flat": a2, "xu_len": np.linalg.norm(xu, axis=1), "yu_len": np.linalg.norm(yu, axis=1)}
+    a3 = np.arctan2(_norm(_cross(xu, xv)), _dot(xu, xv))
+    a2 = np.arctan2(np.abs(yu[:, 0] * yv[:, 1] - yu[:, 1] * yv[:, 0]), _dot(yu, yv))
+    return {"angle_3d": a3, "angle_flat": a2, "xu_len": _norm(xu), "yu_len": _norm(yu)}
 
 
 def _metric_samples(surface: RuledSurface, dev: RuledDevelopment, n: int = 24) -> dict[str, np.ndarray]:

@@ -27,6 +27,7 @@ from ``BRepAdaptor_Curve2d``, 3-D lengths from ``GCPnts_AbscissaPoint``).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any, Callable
 
@@ -317,7 +318,7 @@ class _Nurbs:
         self.patches: tuple[np.ndarray, ...] | None = None
         su, sv = _spans(self.U, self.pu), _spans(self.V, self.pv)
         if su.size * sv.size * (self.pu + 1) * (self.pv + 1) <= 2_000_000 and max(self.pu, self.pv) <= 25:
-            Mu, Mv = _cheb_basis(self.U, self.pu, su), _cheb_basis(self.V, self.pv, sv)
+            Mu, Mv = _cheb_basis_of(self.U, self.pu), _cheb_basis_of(self.V, self.pv)
             rows = su[:, None] - self.pu + np.arange(self.pu + 1)[None, :]  # (nsu, a)
             cols = sv[:, None] - self.pv + np.arange(self.pv + 1)[None, :]  # (nsv, b)
             win = cw[rows[:, None, :, None], cols[None, :, None, :]]  # (nsu, nsv, a, b, 4)
@@ -329,6 +330,11 @@ class _Nurbs:
                             np.ascontiguousarray(pt.reshape(su.size * sv.size, -1)))
             #: the patches as a (u-span, e) x (v-span, f, k) matrix (:meth:`_patch_hom`)
             self.patches_u = np.ascontiguousarray(np.moveaxis(pt, 2, 1).reshape(su.size * (self.pu + 1), -1))
+            if su.size == 1 and sv.size == 1 and self.weight is not None:
+                #: one polynomial patch: ``S = Σ_ef T_e(x) T_f(y) Q_ef`` with ``Q = P / w`` as an
+                #: ((e, f), xyz) matrix, and the patch's centre and half-widths (:meth:`_poly_patch`)
+                self.poly_patch = (np.ascontiguousarray(pt[0, 0, :, :, :3].reshape(-1, 3) / self.weight),
+                                   float(cu[0]), float(hu[0]), float(cv[0]), float(hv[0]))
 
     @property
     def nets(self) -> dict[tuple[int, int], np.ndarray]:
@@ -398,7 +404,11 @@ class _Nurbs:
         parts = [self._eval(u[i:i + step], v[i:i + step], order) for i in range(0, u.size, step)]
         return [np.concatenate([p[k] for p in parts]) for k in range(len(parts[0]))]
 
+    poly_patch: tuple[np.ndarray, float, float, float, float] | None = None
+
     def _eval(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        if self.poly_patch is not None and order <= 1:
+            return self._poly_patch(u, v, order)
         if self.patches is not None and order <= 1:
             return _rational(self._patch_hom(u, v, order), order)
         su, Nu = _basis(self.U, self.pu, u, order)
@@ -421,6 +431,23 @@ class _Nurbs:
         Suv = (Huv[:, :3] - Hu[:, 3:4] * Sv - Hv[:, 3:4] * Su - Huv[:, 3:4] * S) / W
         return [S, Su, Sv, Suu, Svv, Suv]
 
+
+    def _poly_patch(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        """``[S]`` or ``[S, S_u, S_v]`` of one polynomial patch (:attr:`poly_patch`): the tensor
+        Chebyshev rows ``T_e(x) T_f(y)`` (and ``T'_e T_f / h_u``, ``T_e T'_f / h_v``) of all points
+        stacked into one matrix product with ``Q`` (continued polynomially outside the patch)."""
+        Q, cu, hu, cv, hv = self.poly_patch  # type: ignore[misc]
+        Tu = _cheb_rows((u - cu) / hu, self.pu, order, hu)
+        Tv = _cheb_rows((v - cv) / hv, self.pv, order, hv)
+        A, B, n = self.pu + 1, self.pv + 1, u.size
+        if order == 0:
+            return [((Tu[0][:, None, :] * Tv[0][None, :, :]).reshape(A * B, n)).T @ Q]
+        K = np.empty((A, B, 3, n))
+        np.multiply(Tu[0][:, None, :], Tv[0][None, :, :], out=K[:, :, 0])
+        np.multiply(Tu[1][:, None, :], Tv[0][None, :, :], out=K[:, :, 1])
+        np.multiply(Tu[0][:, None, :], Tv[1][None, :, :], out=K[:, :, 2])
+        R = K.reshape(A * B, 3 * n).T @ Q  # (3n, 3): S, S_u, S_v
+        return [R[:n], R[n:2 * n], R[2 * n:]]
 
     def density_grid(self, s: np.ndarray, v: np.ndarray) -> np.ndarray | None:
         """Area density ``|S_u × S_v|`` on the grid ``s × v``, shape (len(s), len(v)), from the
@@ -523,6 +550,20 @@ def _spans(U: np.ndarray, p: int) -> np.ndarray:
     return i[U[i + 1] > U[i]]
 
 
+def _cheb_basis_of(U: np.ndarray, p: int) -> np.ndarray:
+    """:func:`_cheb_basis` on all non-empty spans of the knot vector ``U``, remembered for the
+    last 64 knot vectors (a pure function of them; faces share a few, e.g. Bézier knots)."""
+    return _cheb_basis_cached(np.asarray(U, dtype=float).tobytes(), int(p))
+
+
+@functools.lru_cache(maxsize=64)
+def _cheb_basis_cached(key: bytes, p: int) -> np.ndarray:
+    U = np.frombuffer(key, dtype=float)
+    M = _cheb_basis(U, p, _spans(U, p))
+    M.flags.writeable = False
+    return M
+
+
 def _cheb_basis(U: np.ndarray, p: int, spans: np.ndarray) -> np.ndarray:
     """Chebyshev coefficients ``M[s, e, a]`` of the non-zero basis functions ``N_{i-p+a, p}`` on each
     span ``i = spans[s]`` in the local variable ``x = (u - c) / h`` ∈ [-1, 1]: interpolation at the
@@ -537,6 +578,29 @@ def _cheb_basis(U: np.ndarray, p: int, spans: np.ndarray) -> np.ndarray:
     M = (2.0 / (p + 1)) * np.einsum("ek,ska->sea", T, N)
     M[:, 0, :] *= 0.5
     return M
+
+
+def _cheb_rows(x: np.ndarray, p: int, order: int, h: float) -> list[np.ndarray]:
+    """``[T_e(x)]`` and, for ``order`` 1, ``[d/du T_e]`` (``x = (u - c) / h``, h one number), each
+    (p+1, n) with one row per e: the recurrences of :func:`_cheb_t` along contiguous rows."""
+    T = np.empty((p + 1, x.size))
+    T[0] = 1.0
+    if p >= 1:
+        T[1] = x
+    x2 = 2.0 * x
+    for e in range(1, p):
+        np.multiply(x2, T[e], out=T[e + 1])
+        T[e + 1] -= T[e - 1]
+    if order < 1:
+        return [T]
+    D = np.empty_like(T)
+    D[0] = 0.0
+    if p >= 1:
+        D[1] = 1.0
+    for e in range(1, p):
+        D[e + 1] = 2.0 * T[e] + x2 * D[e] - D[e - 1]
+    D *= 1.0 / h
+    return [T, D]
 
 
 def _cheb_t(x: np.ndarray, p: int, order: int, h: np.ndarray) -> list[np.ndarray]:
