@@ -16,6 +16,8 @@ from typing import Any, Sequence
 import FreeCAD as App
 import Part
 
+from ght_cad.errors import GHTError
+
 from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only, tolerance_property
 from .convert import DEFAULT_TOL, curve_data, edge_from_data
 from .ght_curve import core_curve
@@ -29,19 +31,19 @@ def joined_curves(obj: Any) -> list:
 
     segs = list(obj.Segments)
     if len(segs) < 2:
-        raise ValueError(f"a composite curve needs >= 2 segments; {obj.Label} has {len(segs)}")
+        raise GHTError(f"a composite curve needs >= 2 segments; {obj.Label} has {len(segs)}")
     for i, seg in enumerate(segs):
         if getattr(getattr(seg, "Proxy", None), "Type", "") != "GHT::Curve":
-            raise ValueError(f"{obj.Label}.Segments[{i}] = {seg.Label} is not a GHT curve; link GHT curve features only")
+            raise GHTError(f"{obj.Label}.Segments[{i}] = {seg.Label} is not a GHT curve; link GHT curve features only")
         if seg in segs[:i]:
-            raise ValueError(f"{obj.Label}.Segments[{i}] = {seg.Label} is already Segments[{segs.index(seg)}]; "
+            raise GHTError(f"{obj.Label}.Segments[{i}] = {seg.Label} is already Segments[{segs.index(seg)}]; "
                              "allowed: each curve once (copy the curve to repeat its shape)")
     n = len(segs) - 1
     conts = list(obj.Continuity)
     ks = [float(x) for x in obj.K] or [1.0] * n
     for name, vals in (("Continuity", conts), ("K", ks)):
         if len(vals) != n:
-            raise ValueError(
+            raise GHTError(
                 f"{obj.Label}.{name} has {len(vals)} value{'s' if len(vals) != 1 else ''} for {n} joint{'s' if n != 1 else ''}; "
                 f"give exactly one per joint (segments - 1){' or none for k = 1' if name == 'K' else ''}"
             )
@@ -121,7 +123,7 @@ def make_composite_curve(
     n = len(segments) - 1
     conts = [continuity] * n if isinstance(continuity, str) else list(continuity)
     if len(conts) != n:
-        raise ValueError(f"{len(conts)} continuity values for {n} joints")
+        raise GHTError(f"{len(conts)} continuity values for {n} joints")
     conts = [Continuity.parse(c).value for c in conts]
     obj = new_feature(doc or segments[0].Document, name, CompositeCurveFeature, ViewProviderCompositeCurve)
     obj.Segments = list(segments)

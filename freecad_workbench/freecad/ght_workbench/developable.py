@@ -17,6 +17,8 @@ import numpy as np
 import FreeCAD as App
 import Part
 
+from ght_cad.errors import GHTError
+
 from ._base import (
     BaseCommand,
     FeatureProxy,
@@ -52,9 +54,9 @@ def plane_from_link(obj: Any, sub: str = "") -> np.ndarray:
     elif hasattr(obj, "Shape") and len(obj.Shape.Faces) == 1:
         face = obj.Shape.Faces[0]
     else:
-        raise ValueError(f"{obj.Label}{'.' + sub if sub else ''} is not a plane feature or a single planar face")
+        raise GHTError(f"{obj.Label}{'.' + sub if sub else ''} is not a plane feature or a single planar face")
     if not isinstance(face, Part.Face) or not isinstance(face.Surface, Part.Plane):
-        raise ValueError(f"{obj.Label}.{sub or 'Face1'} is not planar ({type(getattr(face, 'Surface', None)).__name__})")
+        raise GHTError(f"{obj.Label}.{sub or 'Face1'} is not planar ({type(getattr(face, 'Surface', None)).__name__})")
     u0, u1, v0, v1 = face.ParameterRange
     n = face.normalAt(0.5 * (u0 + u1), 0.5 * (v0 + v1))
     p = face.valueAt(0.5 * (u0 + u1), 0.5 * (v0 + v1))
@@ -71,9 +73,9 @@ def _planes(links: Sequence[Any], coords: Sequence[float], what: str) -> np.ndar
     arr = np.asarray(list(coords), dtype=float)
     if arr.size == 0:
         link = "BoundaryPlanes" if what.startswith("Boundary") else "Planes"
-        raise ValueError(f"no planes: {link} links nothing (deleted?) and {what} is empty; link planes or give 4 numbers (u0, u1, u2, u3) per plane")
+        raise GHTError(f"no planes: {link} links nothing (deleted?) and {what} is empty; link planes or give 4 numbers (u0, u1, u2, u3) per plane")
     if arr.size % 4:
-        raise ValueError(f"{what} has {arr.size} numbers; give 4 per plane (u0, u1, u2, u3)")
+        raise GHTError(f"{what} has {arr.size} numbers; give 4 per plane (u0, u1, u2, u3)")
     return arr.reshape(-1, 4)
 
 
@@ -124,17 +126,17 @@ class DevelopableFeature(SurfaceOutputs, FeatureProxy):
         """(control planes (m+1, 4), boundary planes (2, 4)) from links or coordinates."""
         planes = _planes(obj.Planes, obj.PlaneCoordinates, "PlaneCoordinates")
         if len(obj.PlaneWeights) and not obj.Planes:
-            raise ValueError(
+            raise GHTError(
                 f"{obj.Label}.PlaneWeights scales linked Planes only; with PlaneCoordinates scale the 4 numbers of a "
                 "plane instead and clear PlaneWeights"
             )
         if obj.Planes and len(obj.PlaneWeights):
             w = np.asarray(list(obj.PlaneWeights), dtype=float)
             if w.size != planes.shape[0]:
-                raise ValueError(f"PlaneWeights has {w.size} values for {planes.shape[0]} planes")
+                raise GHTError(f"PlaneWeights has {w.size} values for {planes.shape[0]} planes")
             for i, x in enumerate(w):
                 if not np.isfinite(x) or x == 0.0:
-                    raise ValueError(f"{obj.Label}.PlaneWeights[{i}]={x!r} is not allowed; weights must be finite and non-zero")
+                    raise GHTError(f"{obj.Label}.PlaneWeights[{i}]={x!r} is not allowed; weights must be finite and non-zero")
             planes = planes * w[:, None]
         boundary = _planes(obj.BoundaryPlanes, obj.BoundaryCoordinates, "BoundaryCoordinates")
         return planes, boundary

@@ -25,6 +25,8 @@ import numpy as np
 import FreeCAD as App
 import Part
 
+from ght_cad.errors import GHTError
+
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only, tolerance_property
 from .convert import face_from_data
 
@@ -42,15 +44,15 @@ class PartEdgeRail:
     Reversed: the rail runs from the edge's start vertex to its end vertex).
 
     Raises:
-        ValueError: a degenerated edge or an unbounded parameter range.
+        GHTError: a degenerated edge or an unbounded parameter range.
     """
 
     def __init__(self, edge: "Part.Edge", name: str = "rail") -> None:
         if edge.Degenerated:
-            raise ValueError(f"{name} is a degenerated edge (a point); a rail must be a curve")
+            raise GHTError(f"{name} is a degenerated edge (a point); a rail must be a curve")
         p0, p1 = (float(x) for x in edge.ParameterRange)
         if not (np.isfinite(p0) and np.isfinite(p1) and p1 > p0):
-            raise ValueError(f"{name} has the parameter range [{p0:g}, {p1:g}]; a rail needs a bounded edge")
+            raise GHTError(f"{name} has the parameter range [{p0:g}, {p1:g}]; a rail needs a bounded edge")
         self.edge, self.name = edge, name
         self.p_range = (p0, p1)
         self.reversed = edge.Orientation == "Reversed"
@@ -59,7 +61,6 @@ class PartEdgeRail:
     def derivative(self, t: Any, order: int = 1) -> np.ndarray:
         """``r^(order)(t)``, shape (n, 3), order 0..3."""
         from ght_cad._validate import as_parameter_array
-        from ght_cad.errors import GHTError
 
         if isinstance(order, bool) or order not in (0, 1, 2, 3):
             raise GHTError(f"order={order!r} is not allowed; an edge rail gives derivatives of order 0..3")
@@ -84,12 +85,12 @@ def rail_from_link(link: Any, what: str) -> Any:
     feature (placed), else :class:`PartEdgeRail` of the named edge (or of the object's only edge).
 
     Raises:
-        ValueError: no link, a sub-element that is not an edge or no longer exists, or an object
+        GHTError: no link, a sub-element that is not an edge or no longer exists, or an object
             with several edges and none named.
     """
     obj, subs = link if link else (None, [])
     if obj is None:
-        raise ValueError(f"{what} is not linked; select two edges (of sketches, GHT curves or any Part feature)")
+        raise GHTError(f"{what} is not linked; select two edges (of sketches, GHT curves or any Part feature)")
     subs = [s for s in (subs or []) if s]
     edges = obj.Shape.Edges if hasattr(obj, "Shape") else []
     if _is_ght_curve(obj) and (not subs or subs[0] == "Edge1"):
@@ -101,10 +102,10 @@ def rail_from_link(link: Any, what: str) -> Any:
         sub = subs[0]
         k = sub[4:] if sub.startswith("Edge") else ""
         if not k.isdigit() or not 1 <= int(k) <= len(edges):
-            raise ValueError(f"{what} = {obj.Label}.{sub} is not an edge of it ({names}); select the edge again")
+            raise GHTError(f"{what} = {obj.Label}.{sub} is not an edge of it ({names}); select the edge again")
         return PartEdgeRail(edges[int(k) - 1], f"{what} ({obj.Label}.{sub})")
     if len(edges) != 1:
-        raise ValueError(f"{what} = {obj.Label} has {names}; link one edge ({obj.Label}.EdgeN)")
+        raise GHTError(f"{what} = {obj.Label} has {names}; link one edge ({obj.Label}.EdgeN)")
     return PartEdgeRail(edges[0], f"{what} ({obj.Label})")
 
 
@@ -118,18 +119,18 @@ def _sewn(faces: list, tol: float, closed: bool) -> "Part.Shape":
     if len(faces) == 1:
         face = comp.Faces[0] if len(comp.Faces) == 1 else None
         if face is None or not face.isValid():
-            raise ValueError("sewing the closed one-segment loft did not give one valid face")
+            raise GHTError("sewing the closed one-segment loft did not give one valid face")
         return face
     shells = [comp] if comp.ShapeType == "Shell" else comp.Shells
     expected = len(faces) - 1 + (1 if closed else 0)
     if len(shells) != 1 or len(shells[0].Faces) != len(faces):
-        raise ValueError(f"sewing the {len(faces)} loft faces gave {len(shells)} shells; expected one")
+        raise GHTError(f"sewing the {len(faces)} loft faces gave {len(shells)} shells; expected one")
     shell = shells[0]
     shared = sum(1 for e in shell.Edges if len([f for f in shell.Faces if any(e.isSame(g) for g in f.Edges)]) == 2)
     if shared != expected:
-        raise ValueError(f"the sewn loft shell has {shared} shared edges; {expected} joint rulings expected")
+        raise GHTError(f"the sewn loft shell has {shared} shared edges; {expected} joint rulings expected")
     if not shell.isValid():
-        raise ValueError("the sewn loft shell is not valid")
+        raise GHTError("the sewn loft shell is not valid")
     return shell
 
 
@@ -169,9 +170,9 @@ class DevelopableLoftFeature(FeatureProxy):
         from ght_cad.loft import developable_loft
 
         if obj.Orientation not in ORIENTATIONS:
-            raise ValueError(f"{obj.Label}.Orientation={obj.Orientation!r} is not allowed; use one of {ORIENTATIONS}")
+            raise GHTError(f"{obj.Label}.Orientation={obj.Orientation!r} is not allowed; use one of {ORIENTATIONS}")
         if int(obj.Branch) < -1:
-            raise ValueError(f"{obj.Label}.Branch={obj.Branch} is not allowed; use -1 (automatic) or a candidate index >= 0")
+            raise GHTError(f"{obj.Label}.Branch={obj.Branch} is not allowed; use -1 (automatic) or a candidate index >= 0")
         branch = "auto" if int(obj.Branch) == -1 else int(obj.Branch)
         a, b = self.rails(obj)
         return developable_loft(a, b, orientation=str(obj.Orientation), branch=branch)
@@ -183,7 +184,7 @@ class DevelopableLoftFeature(FeatureProxy):
         faces = [face_from_data(d) for d in datas]
         for i, f in enumerate(faces):
             if not f.isValid():
-                raise ValueError(f"the B-spline face of loft segment {i} ({loft.segments[i].kind}) is not valid")
+                raise GHTError(f"the B-spline face of loft segment {i} ({loft.segments[i].kind}) is not valid")
         u = np.array([0.0, 1.0])
         A, B = loft.a(u), loft.b(u)
         pts = np.vstack([loft.a(np.linspace(0, 1, 65)), loft.b(np.linspace(0, 1, 65))])
@@ -287,7 +288,7 @@ def make_developable_loft(rail_a: Any, rail_b: Any, *, orientation: str = "auto"
         developable joins the rails).
     """
     if orientation not in ORIENTATIONS:
-        raise ValueError(f"orientation={orientation!r} is not allowed; use one of {ORIENTATIONS}")
+        raise GHTError(f"orientation={orientation!r} is not allowed; use one of {ORIENTATIONS}")
 
     def link(r: Any) -> tuple:
         if isinstance(r, tuple):

@@ -33,6 +33,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
+from ght_cad.errors import GHTError
 from ght_cad.face_unroll import EdgeData, FaceData, SurfaceAdapter, chain_loop, fd_derivative, unroll_face_data
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
@@ -125,7 +126,7 @@ class _Edge:
     def __init__(self, face: "Part.Face", edge: "Part.Edge", surface: FreeCADSurface) -> None:
         cs = face.curveOnSurface(edge)
         if not cs:
-            raise ValueError("an edge of the face has no curve on its surface (pcurve); cannot unroll it")
+            raise GHTError("an edge of the face has no curve on its surface (pcurve); cannot unroll it")
         self.c2, p0, p1 = cs[0], float(cs[1]), float(cs[2])
         self.p = (p0, p1)
         self.degenerated = bool(edge.Degenerated)
@@ -181,7 +182,7 @@ def face_data(face: "Part.Face") -> FaceData:
     (:func:`ght_cad.face_unroll.chain_loop`) and lies in ``face.ParameterRange``.
 
     Raises:
-        ValueError: an edge without a pcurve.
+        GHTError: an edge without a pcurve.
     """
     surf = FreeCADSurface(face)
     u0, u1, v0, v1 = (float(x) for x in face.ParameterRange)
@@ -218,30 +219,30 @@ def face_of_source(obj: Any) -> "Part.Face | None":
     or None when the Source is a developable feature of this workbench (its core surface is used).
 
     Raises:
-        ValueError: no Source; a Source without faces; a sub-element that is not a face or no
+        GHTError: no Source; a Source without faces; a sub-element that is not a face or no
             longer exists (the Source's topology changed); several faces and none selected.
     """
     src, subs = obj.Source if obj.Source else (None, [])
     if src is None:
-        raise ValueError(f"{obj.Label}: no Source linked")
+        raise GHTError(f"{obj.Label}: no Source linked")
     subs = [s for s in (subs or []) if s]
     if not subs and hasattr(getattr(src, "Proxy", None), "surface"):
         return None
     faces = src.Shape.Faces
     if not faces:
-        raise ValueError(f"{src.Label} has no faces to unroll; allowed: a face or a developable feature of this workbench")
+        raise GHTError(f"{src.Label} has no faces to unroll; allowed: a face or a developable feature of this workbench")
     names = f"Face1..Face{len(faces)}"
     if subs:
         sub = subs[0]
         if not sub.startswith("Face"):
-            raise ValueError(f"{src.Label}.{sub} is not a face; allowed: a face ({names})")
+            raise GHTError(f"{src.Label}.{sub} is not a face; allowed: a face ({names})")
         k = sub[4:]
         if not k.isdigit() or not 1 <= int(k) <= len(faces):
-            raise ValueError(f"{src.Label} has no {sub}; allowed: {names} (did the source's topology change? select the face again)")
+            raise GHTError(f"{src.Label} has no {sub}; allowed: {names} (did the source's topology change? select the face again)")
         return faces[int(k) - 1]
     if len(faces) == 1:
         return faces[0]
-    raise ValueError(f"{src.Label} has {len(faces)} faces; select one face ({names})")
+    raise GHTError(f"{src.Label} has {len(faces)} faces; select one face ({names})")
 
 
 def surface_of_source(obj: Any) -> Any:
@@ -249,10 +250,10 @@ def surface_of_source(obj: Any) -> Any:
     (``Source.Proxy.surface``).
 
     Raises:
-        ValueError: the Source is a face, not a developable feature (see :func:`face_of_source`).
+        GHTError: the Source is a face, not a developable feature (see :func:`face_of_source`).
     """
     if face_of_source(obj) is not None:
-        raise ValueError(f"{obj.Label}: the Source is a face, not a developable feature; use face_data(face)")
+        raise GHTError(f"{obj.Label}: the Source is a face, not a developable feature; use face_data(face)")
     return obj.Source[0].Proxy.surface(obj.Source[0])
 
 
@@ -382,7 +383,7 @@ class FlatPatternFeature(FeatureProxy):
         from ght_cad import unroll
 
         if int(obj.BendLines) < 0:
-            raise ValueError(f"{obj.Label}: BendLines={int(obj.BendLines)} is not allowed; allowed: 0 or more bend lines")
+            raise GHTError(f"{obj.Label}: BendLines={int(obj.BendLines)} is not allowed; allowed: 0 or more bend lines")
         opts = dict(rulings=int(obj.BendLines), best_effort=bool(obj.BestEffort), samples=65)
         self._sheet_properties(obj)
         face = face_of_source(obj)

@@ -44,10 +44,10 @@ def points_from_links(links: Sequence[tuple[Any, Sequence[str]]]) -> list["App.V
             nv = len(obj.Shape.Vertexes)
             for s in subs:
                 if s.startswith("Vertex") and s[6:].isdigit() and not 1 <= int(s[6:]) <= nv:
-                    raise ValueError(f"Source: {obj.Label} has no {s} (it has {nv} vertices); link existing vertices, a sketch or a shape")
+                    raise GHTError(f"Source: {obj.Label} has no {s} (it has {nv} vertices); link existing vertices, a sketch or a shape")
                 el = obj.Shape.getElement(s)
                 if not isinstance(el, Part.Vertex):
-                    raise ValueError(f"{obj.Label}.{s} is a {type(el).__name__}; select vertices or a sketch")
+                    raise GHTError(f"{obj.Label}.{s} is a {type(el).__name__}; select vertices or a sketch")
                 pts.append(App.Vector(el.Point))
             continue
         if obj.isDerivedFrom("Sketcher::SketchObject"):

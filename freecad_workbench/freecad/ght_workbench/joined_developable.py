@@ -30,6 +30,8 @@ import numpy as np
 import FreeCAD as App
 import Part
 
+from ght_cad.errors import GHTError
+
 from ._base import (
     BaseCommand,
     FeatureProxy,
@@ -56,7 +58,7 @@ OUTPUTS = ("Degree", "JointOrder", "JointResiduals", "PlaneAngle", "ThetaMax", "
 def _order(continuity: str) -> int:
     s = str(continuity).upper().strip()
     if s not in CONTINUITIES:
-        raise ValueError(f"Continuity={continuity!r} is not allowed; use one of {CONTINUITIES}")
+        raise GHTError(f"Continuity={continuity!r} is not allowed; use one of {CONTINUITIES}")
     return int(s[1])
 
 
@@ -65,11 +67,11 @@ def _surface_of(prev: Any) -> Any:
     from ght_cad.developable import EnvelopeDevelopable
 
     if prev is None:
-        raise ValueError("Previous is not set; link a developable (from planes) or a joined developable")
+        raise GHTError("Previous is not set; link a developable (from planes) or a joined developable")
     proxy = getattr(prev, "Proxy", None)
     surf = proxy.surface(prev) if hasattr(proxy, "surface") else None
     if not isinstance(surf, EnvelopeDevelopable):
-        raise ValueError(
+        raise GHTError(
             f"Previous={prev.Label} is a {getattr(proxy, 'Type', prev.TypeId)}; a developable join needs an "
             "enveloping developable (GHT 'Developable from planes' or another 'Joined developable')"
         )
@@ -131,13 +133,13 @@ class JoinedDevelopableFeature(FeatureProxy):
         r = _order(obj.Continuity)
         free = np.asarray(list(obj.PlaneCoordinates), dtype=float)
         if free.size == 0 or free.size % 4:
-            raise ValueError(f"PlaneCoordinates has {free.size} numbers; give 4 per free control plane (at least one plane)")
+            raise GHTError(f"PlaneCoordinates has {free.size} numbers; give 4 per free control plane (at least one plane)")
         free = free.reshape(-1, 4)
         # rows 0..r are overwritten by the join; any valid plane serves as placeholder
         planes = np.vstack([np.tile(free[0], (r + 1, 1)), free])
         bc = np.asarray(list(obj.BoundaryCoordinates), dtype=float)
         if bc.size not in (0, 8):
-            raise ValueError(f"BoundaryCoordinates has {bc.size} numbers; give 8 (E_a, E_b) or none (those of Previous)")
+            raise GHTError(f"BoundaryCoordinates has {bc.size} numbers; give 8 (E_a, E_b) or none (those of Previous)")
         return planes, (bc.reshape(2, 4) if bc.size else None)
 
     def surface(self, obj: Any) -> Any:
@@ -181,7 +183,7 @@ class JoinedDevelopableFeature(FeatureProxy):
             if len(shells) == 1 and (len(shells[0].Faces) != len(obj.Previous.Shape.Faces) + 1 or len(shells[0].Edges) != expected_edges):
                 shells = []
             if len(shells) != 1:
-                raise ValueError("sewing with Previous did not give one shell in which the new face shares its start ruling edge; the strips do not share their joint ruling segment (own BoundaryCoordinates?) — set Fuse to False")
+                raise GHTError("sewing with Previous did not give one shell in which the new face shares its start ruling edge; the strips do not share their joint ruling segment (own BoundaryCoordinates?) — set Fuse to False")
             obj.Shape = shells[0]
         else:
             obj.Shape = face
@@ -227,14 +229,14 @@ def make_joined_developable(
         The recomputed feature (``JointOrder`` is the measured order).
 
     Raises:
-        ValueError: bad continuity, shape parameter or k (ShapeParameterError for μ, ν, γ).
+        GHTError: bad continuity, shape parameter or k (ShapeParameterError for μ, ν, γ).
     """
     _order(continuity)
     if gamma is None:
         gamma = float(getattr(previous, "Gamma", 0.0))
     check_shape(mu, nu, gamma)
     if not (float(k) > 0):
-        raise ValueError(f"k={k!r} must be > 0")
+        raise GHTError(f"k={k!r} must be > 0")
     obj = new_feature(doc or previous.Document, name, JoinedDevelopableFeature, ViewProviderJoinedDevelopable)
     obj.Previous = previous
     obj.Continuity = str(continuity).upper().strip()

@@ -26,6 +26,8 @@ from typing import Any, Callable
 
 import FreeCAD as App
 
+from ght_cad.errors import GHTError
+
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 
 __all__ = ["OptimizationFeature", "make_optimization", "run_optimization", "PROBLEMS", "METHODS"]
@@ -104,14 +106,14 @@ class OptimizationFeature(FeatureProxy):
         free = [s.strip() for s in obj.Free if s.strip()] or None
         if obj.Problem == "Developability":
             if len(targets) != 2 or any(_kind(t) != "GHT::Curve" for t in targets):
-                raise ValueError(f"{obj.Label}: Developability needs exactly two GHT curve targets (the strip's boundaries)")
+                raise GHTError(f"{obj.Label}: Developability needs exactly two GHT curve targets (the strip's boundaries)")
             prob = StripProblem(core_curve(targets[0], placed=True), core_curve(targets[1], placed=True), free=free)
             mapping = [(targets[i], p, f"{s}.{p.lower()}") for i, s in enumerate("ab") for p in ("Mu", "Nu", "Gamma")]
             return prob, mapping
         if obj.Problem == "Loft":
             return self.loft_problem(obj, targets, free)
         if len(targets) != 1:
-            raise ValueError(f"{obj.Label}: Fairness needs exactly one target (a GHT curve or a developable), got {len(targets)}")
+            raise GHTError(f"{obj.Label}: Fairness needs exactly one target (a GHT curve or a developable), got {len(targets)}")
         weights = {"AL": float(obj.WeightAL), "En": float(obj.WeightEn), "CVEn": float(obj.WeightCVEn)}
         t = targets[0]
         if _kind(t) == "GHT::Curve":
@@ -120,7 +122,7 @@ class OptimizationFeature(FeatureProxy):
             planes, boundary = t.Proxy.control_planes(t)
             prob = DualCurveFairnessProblem(planes, boundary, objective=weights, free=free, mu=float(t.Mu), nu=float(t.Nu), gamma=float(t.Gamma))
         else:
-            raise ValueError(f"{t.Label} is a {_kind(t) or t.TypeId}; Fairness drives a GHT curve or a developable from planes")
+            raise GHTError(f"{t.Label} is a {_kind(t) or t.TypeId}; Fairness drives a GHT curve or a developable from planes")
         return prob, [(t, p, p.lower()) for p in ("Mu", "Nu", "Gamma")]
 
     def loft_problem(self, obj: Any, targets: list, free: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
@@ -130,12 +132,12 @@ class OptimizationFeature(FeatureProxy):
         from .ght_curve import core_curve
 
         if len(targets) != 1 or _kind(targets[0]) != "GHT::DevelopableLoft":
-            raise ValueError(f"{obj.Label}: Loft needs exactly one Developable loft target, got {[t.Label for t in targets]}")
+            raise GHTError(f"{obj.Label}: Loft needs exactly one Developable loft target, got {[t.Label for t in targets]}")
         loft = targets[0]
         rails = [getattr(loft, n)[0] if getattr(loft, n) else None for n in ("RailA", "RailB")]
         for n, r in zip(("RailA", "RailB"), rails):
             if r is None or _kind(r) != "GHT::Curve":
-                raise ValueError(
+                raise GHTError(
                     f"{obj.Label}: {loft.Label}.{n} is {'not linked' if r is None else r.Label + ', not a GHT curve'}; "
                     "Loft optimizes the shape parameters of GHT curve rails"
                 )
@@ -149,12 +151,12 @@ class OptimizationFeature(FeatureProxy):
         """Refuse optimizer settings the core would refuse, naming the property.
 
         Raises:
-            ValueError: ``MaxIterations`` < 0 or ``PopulationSize`` < 4.
+            GHTError: ``MaxIterations`` < 0 or ``PopulationSize`` < 4.
         """
         if int(obj.MaxIterations) < 0:
-            raise ValueError(f"{obj.Label}.MaxIterations={obj.MaxIterations} is not allowed; use an integer >= 0")
+            raise GHTError(f"{obj.Label}.MaxIterations={obj.MaxIterations} is not allowed; use an integer >= 0")
         if int(obj.PopulationSize) < 4:
-            raise ValueError(f"{obj.Label}.PopulationSize={obj.PopulationSize} is not allowed; use an integer >= 4")
+            raise GHTError(f"{obj.Label}.PopulationSize={obj.PopulationSize} is not allowed; use an integer >= 4")
 
     def compute(self, obj: Any) -> None:
         self.check_settings(obj)
@@ -216,7 +218,7 @@ class ViewProviderOptimization(ViewProviderBase):
 def make_optimization(targets: list, problem: str = "Fairness", *, method: str = "hybrid", doc: Any = None, name: str = "Optimization", **props: Any) -> Any:
     """Create an optimization feature driving ``targets`` (see module doc); ``props`` set properties."""
     if problem not in PROBLEMS:
-        raise ValueError(f"problem={problem!r} is not allowed; use one of {PROBLEMS}")
+        raise GHTError(f"problem={problem!r} is not allowed; use one of {PROBLEMS}")
     obj = new_feature(doc or targets[0].Document, name, OptimizationFeature, ViewProviderOptimization, "App::FeaturePython")
     obj.Targets = list(targets)
     obj.Problem = problem

@@ -16,6 +16,8 @@ import numpy as np
 
 import FreeCAD as App
 
+from ght_cad.errors import GHTError
+
 from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only
 from .developable import SurfaceOutputs
 from .ght_curve import core_curve
@@ -47,13 +49,13 @@ class SpineDevelopableFeature(SurfaceOutputs, FeatureProxy):
         from ght_cad.developable import RectifyingDevelopable, TangentDevelopable
 
         if obj.Curve is None:
-            raise ValueError(f"{obj.Label}: no Curve linked")
+            raise GHTError(f"{obj.Label}: no Curve linked")
         if getattr(getattr(obj.Curve, "Proxy", None), "Type", "") != "GHT::Curve":
-            raise ValueError(f"{obj.Label}.Curve = {obj.Curve.Label} is not a GHT curve; link a GHT curve feature")
+            raise GHTError(f"{obj.Label}.Curve = {obj.Curve.Label} is not a GHT curve; link a GHT curve feature")
         curve = core_curve(obj.Curve, placed=True)
         v0, v1 = float(obj.V0.Value), float(obj.V1.Value)
         if not (np.isfinite(v0) and np.isfinite(v1) and v0 < v1):
-            raise ValueError(f"{obj.Label}: V0={v0:g} mm and V1={v1:g} mm are not allowed; they must be finite with V0 smaller than V1")
+            raise GHTError(f"{obj.Label}: V0={v0:g} mm and V1={v1:g} mm are not allowed; they must be finite with V0 smaller than V1")
         cls = TangentDevelopable if obj.Kind == "Spine" else RectifyingDevelopable
         return cls(curve, v0, v1)
 
@@ -82,7 +84,7 @@ ViewProviderSpineDevelopable.panel_factory = staticmethod(_panel)
 def make_spine_developable(curve_obj: Any, kind: str = "Spine", v0: float = 2.0, v1: float = 10.0, *, doc: Any = None, name: str = "SpineDevelopable") -> Any:
     """Create a spine (``kind="Spine"``) or geodesic (``kind="Geodesic"``) developable of a GHT curve feature."""
     if kind not in KINDS:
-        raise ValueError(f"kind={kind!r} is not allowed; use one of {KINDS}")
+        raise GHTError(f"kind={kind!r} is not allowed; use one of {KINDS}")
     obj = new_feature(doc or curve_obj.Document, name, SpineDevelopableFeature, ViewProviderSpineDevelopable)
     obj.Curve = curve_obj
     obj.Kind = kind
