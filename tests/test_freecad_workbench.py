@@ -122,6 +122,11 @@ def _gui_exe() -> str:
     return exe
 
 
+def _report_lines(step: dict) -> list[str]:
+    """The error lines a GUI check step left in the Report view, without source tag and time stamp."""
+    return [re.sub(r"^\d\d:\d\d:\d\d\s+", "", l.split(": ", 1)[1]) for l in step["report_errors"] if l.startswith("report view: ")]
+
+
 def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     exe = _gui_exe()
     env = freecad_env(tmp_path, pythonpath=False)
@@ -140,13 +145,18 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
         dest = Path(os.environ["ARTIFACTS_DIR"])
         dest.mkdir(parents=True, exist_ok=True)
         shutil.copy(shot, dest / "freecad_ght_workbench.png")
-        for extra in ("window", "unset_link"):  # the main window; a spine with no curve double-clicked
+        # the main window; a spine with no curve double-clicked; the tree and Report view after the
+        # features with unset links failed
+        for extra in ("window", "unset_link", "failed"):
             if (tmp_path / f"ght_workbench_{extra}.png").exists():
                 shutil.copy(tmp_path / f"ght_workbench_{extra}.png", dest / f"freecad_ght_workbench_{extra}.png")
     assert not res["errors"], res["errors"]
     # nothing went wrong behind the steps' backs: no error or traceback line in FreeCAD's Report
     # view, the Python console, sys.excepthook or stderr other than the ones a step provokes
     assert not res["unexpected_errors"], "\n".join(res["unexpected_errors"])
+    # refused input is one clean line per feature: no traceback anywhere in the Report view
+    assert res["traceback_lines"] == [], "\n".join(res["traceback_lines"])
+    assert "Traceback" not in res["report_view"], res["report_view"][-3000:]
     assert res["workbenches"] and res["active_workbench"] == "GHTWorkbench"
     expected = {
         "GHT_Curve", "GHT_CompositeCurve", "GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern",
@@ -167,8 +177,12 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert "Tolerance=-1.0 is not allowed" in c["error_shown"] and c["error_cleared"], c
     v = steps["GHT_Curve from vertices"]["value"]
     assert v["degree"] == 3 and v["source"] == ["Vertex1", "Vertex2", "Vertex3", "Vertex4"], v
-    # the error the curve step provokes on purpose is seen in the Report view (the watch works)
-    assert any("Tolerance=-1.0 is not allowed" in l for l in steps["GHT_Curve"]["report_errors"]), steps["GHT_Curve"]
+    # the error the curve step provokes on purpose is seen in the Report view (the watch works):
+    # one line naming the feature and the property, FreeCAD's "Recompute failed!", no traceback
+    curve_lines = _report_lines(steps["GHT_Curve"])
+    assert set(curve_lines) == {"GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0",
+                                "Recompute failed! Please check report view."}, curve_lines
+    assert not steps["GHT_Curve"]["tracebacks"], steps["GHT_Curve"]
     # double-click on every feature: a task panel opens (the flat pattern and the optimization
     # have no shape parameters of their own: a panel that says what to edit instead)
     clicked = steps["double-click every feature"]["value"]
@@ -179,17 +193,40 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     for kind in ("GHT::Curve", "GHT::CompositeCurve", "GHT::Developable", "GHT::SpineDevelopable"):
         assert clicked[kind]["panel"] == "ShapeParameterPanel", (kind, clicked[kind])
     # features whose links are unset: their recompute fails with a clear message, and a
-    # double-click opens a panel showing that message (no traceback: see unexpected_errors)
+    # double-click opens a panel showing that message. The feature is in FreeCAD's error state
+    # (State Invalid, the tree's red error mark, the message as status string) and the Report
+    # view shows one line per feature plus FreeCAD's "Recompute failed!", no traceback.
     unset = steps["features with unset links: recompute"]["value"]
     assert all(unset["valid_before"].values()), unset
+    status = {  # the exact status string of each feature
+        "GHT::SpineDevelopable": "OrphanSpine: no Curve linked",
+        "GHT::CompositeCurve": "a composite curve needs >= 2 segments; OrphanComposite has 0",
+        "GHT::JoinedDevelopable": "Previous is not set; link a developable (from planes) or a joined developable",
+        "GHT::FlatPattern": "OrphanFlat: no Source linked",
+    }
+    lines = {  # the one Report view line each prints (its Label first, not repeated)
+        "OrphanSpine: no Curve linked",
+        "OrphanComposite: a composite curve needs >= 2 segments; OrphanComposite has 0",
+        "OrphanJoined: Previous is not set; link a developable (from planes) or a joined developable",
+        "OrphanFlat: no Source linked",
+    }
+    for name in ("features with unset links: recompute", "features with unset links: double-click"):
+        got = _report_lines(steps[name])
+        assert sorted(got) == sorted(lines | {"Recompute failed! Please check report view."}), (name, got)
+        assert not steps[name]["tracebacks"], (name, steps[name]["tracebacks"])
+    for kind, msg in status.items():
+        assert unset["failed"][kind] and "Invalid" in unset["states"][kind], (kind, unset)
+        assert unset["status"][kind] == msg, (kind, unset["status"][kind])
+        label = unset["labels"][kind]  # FreeCAD's error mark on the tree icon
+        before, after = unset["icons_before"][label]["red_pixels"], unset["icons_after"][label]["red_pixels"]
+        assert after >= before + 10, (kind, before, after)
+    assert not unset["failed"]["GHT::Optimization"], unset  # its recompute does nothing; it fails only when run
     orphans = steps["features with unset links: double-click"]["value"]
     expected_msg = {"GHT::SpineDevelopable": "Curve", "GHT::CompositeCurve": "Segments", "GHT::JoinedDevelopable": "Previous",
                     "GHT::FlatPattern": "Source", "GHT::Optimization": "Targets"}
     assert set(orphans) == set(expected_msg), orphans
     for kind, prop in expected_msg.items():
         info = orphans[kind]
-        if kind != "GHT::Optimization":  # its recompute does nothing; it fails only when run
-            assert "Invalid" in unset["states"][kind] and prop.lower() in unset["status"][kind].lower(), (kind, unset)
         # a panel on the feature itself (the joined strip's own μ, ν, γ) shows the error in its status line
         panel = "ShapeParameterPanel" if kind == "GHT::JoinedDevelopable" else "MessagePanel"
         assert info["handled"] and info["dialog"] and info["panel"] == panel, (kind, info)

@@ -4,16 +4,26 @@ Every feature module (``ght_curve``, ``composite_curve``, ...) holds its Proxy, 
 Command, CurvesWB style, built on these bases. Proxies persist through ``__getstate__`` /
 ``__setstate__`` (FreeCAD 0.20) and ``dumps`` / ``loads`` (newer FreeCAD). View providers and task
 panels are only created when ``FreeCAD.GuiUp``.
+
+Failed recomputes. A feature whose input is refused (an unset link, a
+:class:`ght_cad.errors.GHTError` such as a shape parameter outside [-1, 1], a negative tolerance, a
+non-developable face; :data:`EXPECTED_ERRORS`) prints one line ``"<Label>: <message>"`` in the
+Report view and goes to FreeCAD's error state (``State`` ``Invalid``, the tree's error mark,
+``getStatusString()`` = the message, dependants skipped, the old shape kept), without a Python
+traceback: :meth:`FeatureProxy.execute` raises :class:`RecomputeError` the way FreeCAD passes its
+own C++ errors through Python (:func:`raise_reported`). Any other exception is a bug and keeps its
+traceback. :func:`failed` is the one test for "the last recompute failed" (exports, task panels);
+:func:`failed_input` finds a failed object a feature depends on.
 """
 
 from __future__ import annotations
 
-import traceback
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, NoReturn, Sequence
 
 import FreeCAD as App
 
 from . import icon
+from ght_cad.errors import GHTError
 
 __all__ = [
     "SHAPE_PARAMETERS",
@@ -22,6 +32,12 @@ __all__ = [
     "ShapeParameterPanel",
     "MessagePanel",
     "MissingInput",
+    "RecomputeError",
+    "EXPECTED_ERRORS",
+    "failed",
+    "failed_input",
+    "report_failure",
+    "raise_reported",
     "require_links",
     "info_panel",
     "BaseCommand",
@@ -131,15 +147,36 @@ class FeatureProxy:
 
     # -- FreeCAD hooks --------------------------------------------------------------------
     def execute(self, obj: Any) -> None:
+        """FreeCAD's recompute hook: :meth:`compute`, with refused input reported without traceback.
+
+        An expected error (:data:`EXPECTED_ERRORS`) or a failed input (:func:`failed_input`) prints
+        one line and puts the feature in FreeCAD's error state (:func:`report_failure`); any other
+        exception propagates with its traceback, after a line naming the feature.
+        """
+        message = self.recompute_message(obj)
+        if message is not None:  # outside any try block: see raise_reported
+            report_failure(obj, message)
+
+    def recompute_message(self, obj: Any) -> str | None:
+        """Run :meth:`compute`; the message of a refused input, or None when the shape was built.
+
+        Raises:
+            Exception: anything but :data:`EXPECTED_ERRORS` from :meth:`compute` (a bug).
+        """
+        bad = failed_input(obj)
+        if bad is not None:  # e.g. obj.recompute() alone: never build on a stale input shape
+            return f"its input {bad.Label} failed to recompute ({bad.getStatusString()}); fix that first"
         placement = obj.Placement if hasattr(obj, "Placement") else None
         try:
             self.compute(obj)
-            if placement is not None:  # a new Shape carries an identity placement: keep the user's
-                obj.Placement = placement
-        except Exception as exc:  # report on the console, keep the old shape, mark the object
+        except EXPECTED_ERRORS as exc:
+            return str(exc) or type(exc).__name__
+        except Exception as exc:  # a bug: FreeCAD prints the traceback; say which feature first
             App.Console.PrintError(f"{obj.Label}: {type(exc).__name__}: {exc}\n")
-            App.Console.PrintLog(traceback.format_exc() + "\n")
             raise
+        if placement is not None:  # a new Shape carries an identity placement: keep the user's
+            obj.Placement = placement
+        return None
 
     def onDocumentRestored(self, obj: Any) -> None:
         restore_constraints(obj)
@@ -165,6 +202,109 @@ class FeatureProxy:
 
 class MissingInput(Exception):
     """A task panel cannot edit its feature: a link it needs is unset (the message says which)."""
+
+
+#: Exceptions a feature's :meth:`FeatureProxy.compute` raises for input it refuses (an expected
+#: error, reported as one line without traceback); anything else is a bug.
+EXPECTED_ERRORS: tuple[type[BaseException], ...] = (GHTError, MissingInput)
+
+#: False: :func:`raise_reported` raises plainly (FreeCAD then prints a traceback); for tests.
+QUIET_ERRORS = True
+
+
+class RecomputeError(GHTError):
+    """Raised by :meth:`FeatureProxy.execute` for refused input; FreeCAD's status string is its message.
+
+    Its one argument is FreeCAD's exception dictionary ``{"swhat": message, "breported": True}``
+    (see :func:`raise_reported`); ``str()`` gives the message either way.
+    """
+
+    def __str__(self) -> str:
+        arg = self.args[0] if len(self.args) == 1 else None
+        if isinstance(arg, dict):
+            return str(arg.get("swhat", ""))
+        return super().__str__()
+
+
+def _c_api() -> tuple[Any, Any] | None:
+    """``(PyErr_Restore, Py_IncRef)`` of the running interpreter through ctypes, or None."""
+    try:
+        import ctypes
+
+        restore = ctypes.PYFUNCTYPE(None, ctypes.py_object, ctypes.py_object, ctypes.c_void_p)(("PyErr_Restore", ctypes.pythonapi))
+        incref = ctypes.PYFUNCTYPE(None, ctypes.py_object)(("Py_IncRef", ctypes.pythonapi))
+    except Exception:  # noqa: BLE001 - no ctypes / not CPython: plain raise
+        return None
+    return restore, incref
+
+
+_C_API = _c_api()
+
+
+def raise_reported(message: str) -> NoReturn:
+    """Raise :class:`RecomputeError` so that FreeCAD marks the feature failed without a traceback.
+
+    FreeCAD 0.20 has no Python call that puts a ``FeaturePython`` in the error state: ``State`` is
+    read-only, and ``execute`` returning False or raising ``NotImplementedError`` counts as success.
+    Any other exception out of ``execute`` marks the object ``Invalid`` with the exception text as
+    its status string, and ``Base::PyException::ReportException`` prints the Python traceback
+    unless the exception is flagged as already reported. The flag is read from FreeCAD's exception
+    dictionary (the form in which FreeCAD passes its C++ exceptions through Python): an exception
+    whose value is a ``dict`` with ``"swhat"`` (the message) and ``"breported": True``. Python code
+    cannot raise a bare dict as the exception value, so the error indicator is set with the C API
+    ``PyErr_Restore`` (``ctypes.pythonapi``). Call this only outside ``try`` / ``with`` blocks in
+    ``execute``: a handler on the way normalizes the value into an exception object.
+
+    Where that does not hold (a tracer such as a debugger normalizes every exception; Python >= 3.12
+    always does; no ctypes; :data:`QUIET_ERRORS` False) FreeCAD prints the traceback as for any
+    exception, and the state and status string are the same.
+
+    Args:
+        message: the status string, e.g. ``"Flat: no Source linked"``.
+
+    Raises:
+        RecomputeError: always.
+    """
+    value = {"swhat": str(message), "breported": True}
+    if QUIET_ERRORS and _C_API is not None:
+        restore, incref = _C_API
+        incref(RecomputeError)  # PyErr_Restore steals both references
+        incref(value)
+        restore(RecomputeError, value, None)  # the error indicator is set: the ctypes call raises it
+    raise RecomputeError(value)
+
+
+def report_failure(obj: Any, message: str) -> NoReturn:
+    """One error line ``"<Label>: <message>"`` in the Report view, then :func:`raise_reported`.
+
+    The label is not repeated when the message already starts with it (``"Flat: no Source
+    linked"``). FreeCAD then adds its own "Recompute failed! Please check report view." line.
+
+    Raises:
+        RecomputeError: always (FreeCAD marks ``obj`` Invalid with ``message`` as status string).
+    """
+    label = str(obj.Label)
+    line = message if message.startswith((label + ":", label + ".")) else f"{label}: {message}"
+    App.Console.PrintError(line.replace("\n", " ") + "\n")
+    raise_reported(message)
+
+
+def failed(obj: Any) -> bool:
+    """True when the last recompute of ``obj`` failed (FreeCAD state ``Invalid`` or ``Error``).
+
+    FreeCAD keeps the old shape of such an object and skips what depends on it; the shape must not
+    be exported or built on. ``obj.getStatusString()`` is the reason.
+    """
+    state = getattr(obj, "State", None) or ()
+    return "Invalid" in state or "Error" in state
+
+
+def failed_input(obj: Any) -> Any | None:
+    """The first object ``obj`` depends on (``OutListRecursive``) whose last recompute failed, or None."""
+    for dep in getattr(obj, "OutListRecursive", None) or ():
+        if failed(dep):
+            return dep
+    return None
 
 
 def _link_empty(value: Any) -> bool:
@@ -201,8 +341,7 @@ def info_panel(obj: Any, links: Sequence[str], hint: str) -> "MessagePanel":
         MissingInput: one of ``links`` is unset (see :func:`require_links`).
     """
     require_links(obj, *links)
-    bad = "Invalid" in obj.State or "Error" in obj.State
-    state = f"last recompute failed: {obj.getStatusString()}" if bad else "up to date" if "Touched" not in obj.State else "not yet recomputed"
+    state = f"last recompute failed: {obj.getStatusString()}" if failed(obj) else "up to date" if "Touched" not in obj.State else "not yet recomputed"
     return MessagePanel(obj, f"{obj.Label}: {state}.\n{hint}")
 
 
@@ -366,10 +505,10 @@ class ShapeParameterPanel:
         """Status messages of the feature and its dependants whose recompute failed ("" if none).
 
         A failing ``execute`` does not make ``Document.recompute()`` raise: FreeCAD marks the
-        object Invalid and keeps its old shape, so the panel has to look at the states.
+        object Invalid and keeps its old shape, so the panel has to look at the states (:func:`failed`).
         """
         objs = [self.obj] + list(getattr(self.obj, "InListRecursive", []))
-        bad = [o for o in objs if "Invalid" in o.State or "Error" in o.State]
+        bad = [o for o in objs if failed(o)]
         return "\n".join(f"{o.Label}: {o.getStatusString()}" for o in bad)
 
     def accept(self) -> bool:

@@ -27,7 +27,7 @@ import Part
 
 from ght_cad.errors import GHTError
 
-from ._base import BaseCommand, FeatureProxy, ViewProviderBase, new_feature, register_command, set_read_only, tolerance_property
+from ._base import BaseCommand, FeatureProxy, ViewProviderBase, failed, new_feature, register_command, set_read_only, tolerance_property
 from .convert import face_from_data
 
 __all__ = ["DevelopableLoftFeature", "PartEdgeRail", "make_developable_loft", "rail_from_link", "ORIENTATIONS", "OUTPUTS"]
@@ -240,7 +240,7 @@ class LoftPanel:
                 "Set them in the property editor (Input → RailA, RailB: an edge of a sketch, a GHT curve or any "
                 "Part feature), or select two edges and run 'Developable loft' again."
             )
-        if "Invalid" in obj.State or "Error" in obj.State:
+        if failed(obj):
             return f"{obj.Label}: the last recompute failed: {obj.getStatusString()}"
         rails = ", ".join(f"{n} = {getattr(obj, n)[0].Label}.{(getattr(obj, n)[1] or [''])[0]}".rstrip(".") for n in ("RailA", "RailB"))
         return (
@@ -331,10 +331,8 @@ class CommandDevelopableLoft(BaseCommand):
             return
         doc = App.ActiveDocument
         doc.openTransaction("Developable loft")
-        obj = make_developable_loft(links[0], links[1], doc=doc)
+        make_developable_loft(links[0], links[1], doc=doc)  # a failure is reported by the feature itself
         doc.commitTransaction()
-        if "Invalid" in obj.State:
-            App.Console.PrintWarning(f"Developable loft: {obj.Label} failed: {obj.getStatusString()}\n")
 
 
 register_command(CommandDevelopableLoft())

@@ -16,7 +16,7 @@ import FreeCAD as App
 import Part
 
 from . import _ensure_core  # noqa: F401
-from ._base import BaseCommand, register_command
+from ._base import BaseCommand, failed, failed_input, register_command
 from ght_cad.errors import GHTError
 from ght_cad.io import atomic_path, write_text_atomic
 from ght_cad.outdir import lock_target
@@ -32,16 +32,12 @@ __all__ = [
 ]
 
 
-def _bad_states(obj: Any) -> list[str]:
-    return [s for s in getattr(obj, "State", []) if s in ("Invalid", "Error")]
-
-
 def stale_reason(obj: Any) -> str | None:
     """Why the shape of ``obj`` may not match its inputs, or None if it is current.
 
-    FreeCAD keeps the old shape of a feature whose recompute failed, and does not recompute the
-    features that depend on a failed one (they keep their old shape and look fine); a feature
-    with pending changes (state ``Touched``) has not been rebuilt yet either.
+    FreeCAD keeps the old shape of a feature whose recompute failed (:func:`._base.failed`), and
+    does not recompute the features that depend on a failed one (they keep their old shape and
+    look fine); a feature with pending changes (state ``Touched``) has not been rebuilt yet either.
 
     Args:
         obj: a document object; its ``State`` and those of its ``OutListRecursive`` are read.
@@ -49,12 +45,11 @@ def stale_reason(obj: Any) -> str | None:
     Returns:
         A sentence for an error message (the failed object and its status string), or None.
     """
-    bad = _bad_states(obj)
-    if bad:
-        return f"its last recompute failed (state {', '.join(bad)}: {obj.getStatusString()}), so its shape is stale"
-    for dep in getattr(obj, "OutListRecursive", []):
-        if _bad_states(dep):
-            return f"its input {dep.Label} failed to recompute ({dep.getStatusString()}), so its shape is stale"
+    if failed(obj):
+        return f"its last recompute failed ({obj.getStatusString()}), so its shape is stale"
+    dep = failed_input(obj)
+    if dep is not None:
+        return f"its input {dep.Label} failed to recompute ({dep.getStatusString()}), so its shape is stale"
     if "Touched" in getattr(obj, "State", []) or any("Touched" in getattr(d, "State", []) for d in getattr(obj, "OutListRecursive", [])):
         return "it has changes not yet recomputed; recompute the document first"
     return None

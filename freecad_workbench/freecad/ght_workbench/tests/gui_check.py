@@ -19,9 +19,13 @@ Errors are watched during the whole scripted session, not only the steps' return
   ``sys.stderr`` are hooked;
 * the **Python console** widget is read for tracebacks.
 
-A step may declare the error lines it provokes on purpose (``allow=`` regular expressions, e.g.
-the recompute error of a feature given a negative tolerance); every other line lands in
-``RESULT["unexpected_errors"]``, and the pytest side fails on any.
+A step may declare the error lines it provokes on purpose (``allow=`` regular expressions of the
+whole line, e.g. the one-line recompute error of a feature given a negative tolerance); every other
+line lands in ``RESULT["unexpected_errors"]``, and the pytest side fails on any. A refused input
+is reported by the workbench as one line ``"<Label>: <message>"`` plus FreeCAD's "Recompute failed!"
+line, never with a Python traceback: ``RESULT["traceback_lines"]`` holds every line of the whole
+Report view that looks like part of a traceback (the pytest side wants none), and each step's
+``"tracebacks"`` those of the step.
 """
 
 import json
@@ -148,9 +152,10 @@ def _entries(lines):
 def step(name, fn, allow=()):
     """Run one step; record its value, its error lines, and those not matched by ``allow``.
 
-    ``allow`` holds regular expressions of error messages the step provokes on purpose; a
-    traceback is allowed only if its exception line matches one (the frames above it are
-    FreeCAD's report of a failed recompute), and FreeCAD's "Recompute failed!" line only in a
+    ``allow`` holds regular expressions (anchored: the whole message) of the error lines the step
+    provokes on purpose; a traceback is allowed only if its exception line matches one (no
+    pattern below matches the ``<class '...'>: `` prefix of such a line, so a recompute error
+    reported with a traceback fails the check), and FreeCAD's "Recompute failed!" line only in a
     step with an allowed error.
     """
     mark = WATCH.mark()
@@ -164,13 +169,22 @@ def step(name, fn, allow=()):
             Gui.Control.closeDialog()
     lines = WATCH.since(mark)
     entry["report_errors"] = lines
+    entry["tracebacks"] = [l for l in lines if TRACEBACK_RE.search(l.split(": ", 1)[-1])]
     patterns = list(allow) + ([r"^Recompute failed! Please check report view\.$"] if allow else [])
-    unexpected = [l for msg, block in _entries(lines) if not any(re.search(a, msg) for a in patterns) for l in block]
+    unexpected = [l for msg, block in _entries(lines) if not any(re.fullmatch(a, msg) for a in patterns) for l in block]
     entry["unexpected_errors"] = unexpected
     RESULT["unexpected_errors"].extend(f"{name}: {l}" for l in unexpected)
     RESULT["report_errors"].extend(f"{name}: {l}" for l in lines)
     RESULT["steps"].append(entry)
     return entry
+
+
+def wait(ms):
+    """Run the event loop for ``ms`` milliseconds (timers fire, widgets repaint)."""
+    timer = QtCore.QElapsedTimer()
+    timer.start()
+    while timer.elapsed() < ms:
+        QtWidgets.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
 
 
 def new_objects(doc, before):
@@ -234,7 +248,8 @@ def main():
         comp = [o for o in created if o.Proxy.Type == "GHT::CompositeCurve"][0]
         return {"created": len(created), "valid": ok, "joints": list(comp.JointOrders)}
 
-    step("GHT_Curve", curve, allow=[r"Tolerance=-1\.0 is not allowed"])
+    # the one line the refused tolerance gives (the Label is the command's default name)
+    step("GHT_Curve", curve, allow=[r"GHTCurve\d*\.Tolerance=-1\.0 is not allowed; it must be a finite number > 0"])
 
     def curve_from_vertices():
         import Part
@@ -444,12 +459,52 @@ def main():
 
     # features whose links are unset (the linked object was never set, or removed): their
     # recompute fails with a clear message, and a double-click shows that message in a panel
-    UNSET = {  # the recompute error each feature reports once its link is unset
+    UNSET = {  # the status string each feature reports once its link is unset
         "GHT::SpineDevelopable": "OrphanSpine: no Curve linked",
         "GHT::CompositeCurve": "a composite curve needs >= 2 segments; OrphanComposite has 0",
-        "GHT::JoinedDevelopable": "Previous is not set; link a developable",
+        "GHT::JoinedDevelopable": "Previous is not set; link a developable (from planes) or a joined developable",
         "GHT::FlatPattern": "OrphanFlat: no Source linked",
     }
+    # ... and the one Report view line each prints: "<Label>: <status>" (the Label not repeated)
+    UNSET_LINES = [
+        "OrphanSpine: no Curve linked",
+        "OrphanComposite: a composite curve needs >= 2 segments; OrphanComposite has 0",
+        "OrphanJoined: Previous is not set; link a developable (from planes) or a joined developable",
+        "OrphanFlat: no Source linked",
+    ]
+
+    def tree_items(labels):
+        """Per label: the tree item's tooltip and how many strongly red pixels its 16x16 icon has
+        (FreeCAD paints its error mark over the icon of a failed object in red)."""
+        from PySide2 import QtGui
+
+        wait(600)  # the tree refreshes the items' status on a timer
+        out = {}
+        for tree in Gui.getMainWindow().findChildren(QtWidgets.QTreeWidget):
+            it = QtWidgets.QTreeWidgetItemIterator(tree)
+            while it.value():
+                item = it.value()
+                if item.text(0) in labels:
+                    img = item.icon(0).pixmap(16, 16).toImage()
+                    red = 0
+                    for x in range(img.width()):
+                        for y in range(img.height()):
+                            c = QtGui.QColor.fromRgba(img.pixel(x, y))
+                            red += c.alpha() > 128 and c.red() > 180 and c.green() < 90 and c.blue() < 90
+                    out[item.text(0)] = {"red_pixels": red}
+                it += 1
+        return out
+
+    def show_tree(label):
+        """Give the Model tree most of the Combo View's height and scroll ``label`` into view."""
+        for tree in Gui.getMainWindow().findChildren(QtWidgets.QTreeWidget):
+            parent = tree.parent()
+            while parent is not None and not isinstance(parent, QtWidgets.QSplitter):
+                parent = parent.parent()
+            if parent is not None:
+                parent.setSizes([900, 80])
+            for item in tree.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive):
+                tree.scrollToItem(item, QtWidgets.QAbstractItemView.PositionAtBottom)
 
     def make_orphans():
         from freecad.ght_workbench import composite_curve, developable, flat_pattern, ght_curve, joined_developable, optimization, spine_developable
@@ -463,18 +518,37 @@ def main():
             flat_pattern.make_flat_pattern(ctx["developable"], doc=doc, name="OrphanFlat"),
             optimization.make_optimization([c1], doc=doc, name="OrphanOptimization"),
         ]
-        ok_before = {o.Proxy.Type: not ("Invalid" in o.State or "Error" in o.State) for o in orphans}
+        ok_before = {o.Proxy.Type: not _base.failed(o) for o in orphans}
+        labels = [o.Label for o in orphans]
+        mw = Gui.getMainWindow()
+        for tabs in mw.findChildren(QtWidgets.QTabWidget):  # the Model tree in front
+            for k in range(tabs.count()):
+                if tabs.tabText(k) == "Model":
+                    tabs.setCurrentIndex(k)
+        icons_before = tree_items(labels)
         for o in orphans:
             for prop, empty in (("Curve", None), ("Segments", []), ("Previous", None), ("Source", None), ("Targets", [])):
                 if prop in o.PropertiesList:
                     setattr(o, prop, empty)
         doc.recompute()
         ctx["orphans"] = orphans
+        # what a user sees: the Model tree (error marks) and the Report view
+        Gui.Selection.clearSelection()
+        icons_after = tree_items(labels)
+        mw = Gui.getMainWindow()
+        mw.resize(1280, 860)
+        show_tree(labels[-1])
+        wait(200)
+        shot = os.path.join(OUT, "ght_workbench_failed.png")
         return {"valid_before": ok_before,
+                "failed": {o.Proxy.Type: _base.failed(o) for o in orphans},
                 "states": {o.Proxy.Type: list(o.State) for o in orphans},
-                "status": {o.Proxy.Type: o.getStatusString() for o in orphans}}
+                "status": {o.Proxy.Type: o.getStatusString() for o in orphans},
+                "labels": {o.Proxy.Type: o.Label for o in orphans},
+                "icons_before": icons_before, "icons_after": icons_after,
+                "shot": shot if mw.grab().save(shot) else None}
 
-    step("features with unset links: recompute", make_orphans, allow=[re.escape(m) for m in UNSET.values()])
+    step("features with unset links: recompute", make_orphans, allow=[re.escape(m) for m in UNSET_LINES])
 
     def double_click_orphans():
         shots = {"GHT::SpineDevelopable": os.path.join(OUT, "ght_workbench_unset_link.png")}
@@ -487,7 +561,7 @@ def main():
         return out
 
     # the panels' Cancel recomputes the document: the orphans' recompute errors come again
-    step("features with unset links: double-click", double_click_orphans, allow=[re.escape(m) for m in UNSET.values()])
+    step("features with unset links: double-click", double_click_orphans, allow=[re.escape(m) for m in UNSET_LINES])
 
     def screenshot():
         Gui.Selection.clearSelection()
@@ -542,6 +616,7 @@ def finish():
             else:
                 RESULT["unexpected_errors"].append("outside the steps: " + line)
         RESULT["report_view"] = WATCH.report_text()
+        RESULT["traceback_lines"] = [l for l in RESULT["report_view"].splitlines() if TRACEBACK_RE.search(l)]
     except Exception:
         RESULT["errors"].append(traceback.format_exc())
     with open(os.path.join(OUT, "gui_result.json"), "w") as fh:
