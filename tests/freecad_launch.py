@@ -52,9 +52,17 @@ def summary(proc: subprocess.CompletedProcess) -> str:
     return "\n".join(lines[-80:])
 
 
+def assert_no_traceback(out: str) -> None:
+    """No Python traceback in a FreeCAD run's output: the workbench reports refused input (a failed
+    recompute) as one line, and a deliberately provoked one is captured inside the test."""
+    lines = [l for l in out.splitlines() if "Traceback (most recent call last)" in l or l.startswith("<class '")]
+    assert not lines, f"{len(lines)} traceback line(s) in FreeCAD's output:\n" + "\n".join(out.splitlines()[-80:])
+
+
 def run_fc_unittest(module: str, tmp_path: Path, min_tests: int, timeout: float = 120) -> str:
     """Run ``freecadcmd -t module`` and assert it ran at least ``min_tests`` tests, all OK and none
-    skipped; return its whole output (stdout + stderr)."""
+    skipped, and printed no Python traceback (:func:`assert_no_traceback`); return its whole output
+    (stdout + stderr)."""
     import re
 
     from conftest import freecadcmd_or_skip
@@ -67,4 +75,5 @@ def run_fc_unittest(module: str, tmp_path: Path, min_tests: int, timeout: float 
     assert ran and int(ran.group(1)) >= min_tests, summary(proc)
     assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
     assert "skipped=" not in out, summary(proc)
+    assert_no_traceback(out)
     return out

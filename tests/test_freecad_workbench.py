@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from conftest import freecadcmd_or_skip
-from freecad_launch import freecad_env, run_process, summary
+from freecad_launch import assert_no_traceback, freecad_env, run_process, summary
 
 REPO = Path(__file__).resolve().parents[1]
 WB = REPO / "freecad_workbench"
@@ -52,6 +52,7 @@ def test_features_inside_freecadcmd(tmp_path: Path) -> None:
     assert ran and int(ran.group(1)) >= 16, summary(proc)
     assert re.search(r"^OK\s*$", out, re.M) and not re.search(r"^FAILED \(", out, re.M), summary(proc)
     assert "skipped=" not in out, summary(proc)
+    assert_no_traceback(out)
     for f in ("curve.step", "composite.step", "developable.step", "flat.step", "flat.dxf", "flat.svg"):
         assert (tmp_path / f).stat().st_size > 0, f
     # the files FreeCAD wrote are read by the project's other tools: ezdxf (DXF) and OCP 7.9 (STEP)

@@ -1,8 +1,10 @@
 """Bad property values inside FreeCAD (headless), as a user types them into the property editor.
 
-Every case: set the value, recompute; the feature must be in error (``Invalid``) with a status
-message naming the property and what is allowed, never silently build a shape from a replaced
-value. Then the good value is restored and the feature recomputes to the very same geometry.
+Every case: set the value, recompute; the feature must be in FreeCAD's error state (``Invalid``)
+with exactly the expected status message naming the property and what is allowed, never silently
+build a shape from a replaced value; the console shows that message as one line and FreeCAD's
+"Recompute failed!" line, no Python traceback (:mod:`.refusal`). Then the good value is restored
+and the feature recomputes to the very same geometry, printing nothing.
 
 Run: ``PYTHONPATH=<repo>/freecad_workbench:<repo> freecadcmd -t freecad.ght_workbench.tests.fc_audit``
 """
@@ -17,17 +19,17 @@ import unittest
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import composite_curve, developable, ght_curve, joined_developable, optimization
+from freecad.ght_workbench import _base, composite_curve, developable, ght_curve, joined_developable, optimization
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_audit_")
 PTS = [(0, 0, 0), (10, 20, 0), (30, 20, 5), (40, 0, 0)]
 
 
-def _bad(obj) -> bool:
-    return "Invalid" in obj.State or "Error" in obj.State
+_bad = _base.failed
 
 
-class BadValueCase(unittest.TestCase):
+class BadValueCase(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("audit")
 
@@ -35,20 +37,15 @@ class BadValueCase(unittest.TestCase):
         for name in list(App.listDocuments()):
             App.closeDocument(name)
 
-    def assert_refused(self, obj, prop, value, *words, measure=lambda s: (s.Length, s.Area)):
-        """Setting ``prop`` to ``value`` puts ``obj`` in error with a message holding ``words``;
-        restoring the old value recomputes the same geometry."""
+    def assert_refused(self, obj, prop, value, message, measure=lambda s: (s.Length, s.Area)):
+        """Setting ``prop`` to ``value`` puts ``obj`` in error with exactly ``message`` (one console
+        line, no traceback); restoring the old value recomputes the same geometry."""
         good = getattr(obj, prop)
         before = measure(obj.Shape) if hasattr(obj, "Shape") else None
         setattr(obj, prop, value)
-        self.doc.recompute()
-        self.assertTrue(_bad(obj), f"{obj.Label}.{prop} = {value!r} was accepted (state {obj.State})")
-        msg = obj.getStatusString()
-        for w in words:
-            self.assertIn(w, msg, f"{obj.Label}.{prop} = {value!r}: message {msg!r} lacks {w!r}")
+        self.assert_recompute_refused(self.doc, obj, message)
         setattr(obj, prop, good)
-        self.doc.recompute()
-        self.assertFalse(_bad(obj), obj.getStatusString())
+        self.assert_recompute_clean(self.doc, obj)
         if before is not None:
             after = measure(obj.Shape)
             for a, b in zip(after, before):
@@ -60,22 +57,24 @@ class CurveBadValuesTest(BadValueCase):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
         for v in (-1.0, 0.0, float("nan"), float("inf")):
             with self.subTest(v):
-                self.assert_refused(c, "Tolerance", v, "Tolerance", "> 0")
+                self.assert_refused(c, "Tolerance", v, f"GHTCurve.Tolerance={v!r} is not allowed; it must be a finite number > 0")
 
     def test_coincident_control_points(self):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
-        self.assert_refused(c, "ControlPoints", [App.Vector(1, 2, 3)] * 3, "ControlPoints", "coincide")
+        self.assert_refused(c, "ControlPoints", [App.Vector(1, 2, 3)] * 3, "GHTCurve.ControlPoints: all 3 points coincide at "
+                            "(1.0, 2.0, 3.0); the curve would be a single point (at least two control points must differ)")
 
     def test_nan_shape_parameter_and_too_few_points(self):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
-        self.assert_refused(c, "Mu", float("nan"), "mu", "[-1, 1]")
-        self.assert_refused(c, "ControlPoints", [App.Vector(0, 0, 0), App.Vector(1, 0, 0)], "at least 3")
+        self.assert_refused(c, "Mu", float("nan"), "mu=nan is not finite; allowed range is [-1, 1]")
+        self.assert_refused(c, "ControlPoints", [App.Vector(0, 0, 0), App.Vector(1, 0, 0)], "control_points has 2 points; at least 3 are required")
 
     def test_source_vertex_out_of_range(self):
         poly = self.doc.addObject("Part::Feature", "Poly")
         poly.Shape = Part.makePolygon([App.Vector(*p) for p in PTS])
         c = ght_curve.make_ght_curve(source=[(poly, ["Vertex1", "Vertex2", "Vertex3", "Vertex4"])], doc=self.doc)
-        self.assert_refused(c, "Source", [(poly, ["Vertex1", "Vertex2", "Vertex9"])], "Source", "Vertex9", "4 vertices")
+        self.assert_refused(c, "Source", [(poly, ["Vertex1", "Vertex2", "Vertex9"])],
+                            "Source: Poly has no Vertex9 (it has 4 vertices); link existing vertices, a sketch or a shape")
 
 
 class CompositeBadValuesTest(BadValueCase):
@@ -88,11 +87,12 @@ class CompositeBadValuesTest(BadValueCase):
         self.assertFalse(_bad(self.cc))
 
     def test_one_value_per_joint(self):
-        self.assert_refused(self.cc, "Continuity", ["G1"], "Continuity", "1 value", "2 joints")
-        self.assert_refused(self.cc, "Continuity", ["G1", "G2", "C1"], "Continuity", "3 values", "2 joints")
-        self.assert_refused(self.cc, "K", [1.0], "K", "1 value", "2 joints")
-        self.assert_refused(self.cc, "K", [1.0, 2.0, 3.0], "K", "3 values", "2 joints")
-        self.assert_refused(self.cc, "K", [1.0, float("nan")], "k=nan")
+        per_joint = "give exactly one per joint (segments - 1)"
+        self.assert_refused(self.cc, "Continuity", ["G1"], f"CompositeCurve.Continuity has 1 value for 2 joints; {per_joint}")
+        self.assert_refused(self.cc, "Continuity", ["G1", "G2", "C1"], f"CompositeCurve.Continuity has 3 values for 2 joints; {per_joint}")
+        self.assert_refused(self.cc, "K", [1.0], f"CompositeCurve.K has 1 value for 2 joints; {per_joint} or none for k = 1")
+        self.assert_refused(self.cc, "K", [1.0, 2.0, 3.0], f"CompositeCurve.K has 3 values for 2 joints; {per_joint} or none for k = 1")
+        self.assert_refused(self.cc, "K", [1.0, float("nan")], "k=nan is not finite; it must be a finite real number")
 
     def test_empty_k_means_one_everywhere(self):
         self.cc.K = [1.0, 1.0]
@@ -105,10 +105,10 @@ class CompositeBadValuesTest(BadValueCase):
 
     def test_segment_must_be_a_ght_curve(self):
         box = self.doc.addObject("Part::Box", "Box")
-        self.assert_refused(self.cc, "Segments", [self.a, box], "Segments", "Box", "GHT curve")
+        self.assert_refused(self.cc, "Segments", [self.a, box], "CompositeCurve.Segments[1] = Box is not a GHT curve; link GHT curve features only")
 
     def test_tolerance(self):
-        self.assert_refused(self.cc, "Tolerance", -1e-6, "Tolerance", "> 0")
+        self.assert_refused(self.cc, "Tolerance", -1e-6, "CompositeCurve.Tolerance=-1e-06 is not allowed; it must be a finite number > 0")
 
 
 class SurfaceBadValuesTest(BadValueCase):
@@ -116,7 +116,8 @@ class SurfaceBadValuesTest(BadValueCase):
         d = developable.make_developable(gamma=-1.0, doc=self.doc)
         for v in (-1.0, float("nan")):
             with self.subTest(v):
-                self.assert_refused(d, "Tolerance", v, "Tolerance", ">= 0")
+                self.assert_refused(d, "Tolerance", v, f"Developable.Tolerance={v!r} is not allowed; it must be a finite number >= 0 "
+                                    "(0: 1e-7 of the surface size)")
         d.Tolerance = 0.0  # 0 = automatic, documented
         self.doc.recompute()
         self.assertFalse(_bad(d))
@@ -124,7 +125,7 @@ class SurfaceBadValuesTest(BadValueCase):
     def test_joined_joint_tolerance(self):
         d = developable.make_developable(gamma=-1.0, doc=self.doc)
         j = joined_developable.make_joined_developable(d, "G2", doc=self.doc)
-        self.assert_refused(j, "JointTolerance", -1.0, "JointTolerance", ">= 0")
+        self.assert_refused(j, "JointTolerance", -1.0, "JoinedDevelopable.JointTolerance=-1.0 is not allowed; it must be a finite number >= 0 (0: 1e-9)")
 
 
 class LinkedPlanesTest(BadValueCase):
@@ -156,31 +157,26 @@ class LinkedPlanesTest(BadValueCase):
         self.assertEqual(list(d.PlaneWeights), [1.0, math.sqrt(2), 1.0])
         # a deleted control plane: the link drops out, the feature says how many planes are left
         self.doc.removeObject("P1")
-        self.doc.recompute()
-        self.assertTrue(_bad(d))
-        self.assertIn("PlaneWeights has 3 values for 2 planes", d.getStatusString())
+        self.assert_recompute_refused(self.doc, d, "PlaneWeights has 3 values for 2 planes")
         d.PlaneWeights = []
-        self.doc.recompute()
-        self.assertTrue(_bad(d))
-        self.assertIn("at least 3", d.getStatusString())
+        self.assert_recompute_refused(self.doc, d, "planes has 2 planes; at least 3 are required")
         # every control plane deleted: no silent fall-back, the message names both inputs
         self.doc.removeObject("P0")
         self.doc.removeObject("P2")
-        self.doc.recompute()
-        self.assertTrue(_bad(d))
-        self.assertIn("Planes", d.getStatusString())
-        self.assertIn("PlaneCoordinates", d.getStatusString())
+        self.assert_recompute_refused(self.doc, d, "no planes: Planes links nothing (deleted?) and PlaneCoordinates is empty; link planes "
+                                      "or give 4 numbers (u0, u1, u2, u3) per plane")
         self.assertLessEqual(abs(d.Shape.Area - area), 1e-12 * area)  # the old shape stays, marked Invalid
 
 
 class PlaneWeightsTest(BadValueCase):
     def test_weights_named_and_not_silently_ignored(self):
         d, _ = LinkedPlanesTest._linked(self)
-        self.assert_refused(d, "PlaneWeights", [1.0, float("nan"), 1.0], "PlaneWeights[1]=nan", "finite and non-zero")
-        self.assert_refused(d, "PlaneWeights", [1.0, 0.0, 1.0], "PlaneWeights[1]=0", "finite and non-zero")
+        self.assert_refused(d, "PlaneWeights", [1.0, float("nan"), 1.0], "Developable.PlaneWeights[1]=nan is not allowed; weights must be finite and non-zero")
+        self.assert_refused(d, "PlaneWeights", [1.0, 0.0, 1.0], "Developable.PlaneWeights[1]=0.0 is not allowed; weights must be finite and non-zero")
         # weights only scale linked planes: with plane coordinates they would be ignored, so refuse
         c = developable.make_developable(gamma=-1.0, doc=self.doc, name="Coords")
-        self.assert_refused(c, "PlaneWeights", [1.0, 2.0, 1.0], "PlaneWeights", "linked Planes only")
+        self.assert_refused(c, "PlaneWeights", [1.0, 2.0, 1.0], "Coords.PlaneWeights scales linked Planes only; with PlaneCoordinates scale the "
+                            "4 numbers of a plane instead and clear PlaneWeights")
 
 
 class SpineBadValuesTest(BadValueCase):
@@ -192,9 +188,9 @@ class SpineBadValuesTest(BadValueCase):
         self.assertFalse(_bad(s), s.getStatusString())
         box = self.doc.addObject("Part::Box", "Box")
         self.doc.recompute()
-        self.assert_refused(s, "Curve", box, "Curve", "Box", "GHT curve")
-        self.assert_refused(s, "V1", 2.0, "V0", "V1", "smaller")
-        self.assert_refused(s, "Tolerance", -1.0, "Tolerance", ">= 0")
+        self.assert_refused(s, "Curve", box, "SpineDevelopable.Curve = Box is not a GHT curve; link a GHT curve feature")
+        self.assert_refused(s, "V1", 2.0, "SpineDevelopable: V0=2 mm and V1=2 mm are not allowed; they must be finite with V0 smaller than V1")
+        self.assert_refused(s, "Tolerance", -1.0, "SpineDevelopable.Tolerance=-1.0 is not allowed; it must be a finite number >= 0 (0: 1e-7 of the surface size)")
 
 
 class CurvePlacementTest(BadValueCase):
@@ -241,9 +237,9 @@ class OptimizationBadValuesTest(BadValueCase):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
         o = optimization.make_optimization([c], doc=self.doc)
         self.assertFalse(_bad(o))
-        self.assert_refused(o, "MaxIterations", -1, "MaxIterations", ">= 0")
-        self.assert_refused(o, "PopulationSize", 2, "PopulationSize", ">= 4")
-        self.assert_refused(o, "WeightEn", float("nan"), "En=nan")
+        self.assert_refused(o, "MaxIterations", -1, "Optimization.MaxIterations=-1 is not allowed; use an integer >= 0")
+        self.assert_refused(o, "PopulationSize", 2, "Optimization.PopulationSize=2 is not allowed; use an integer >= 4")
+        self.assert_refused(o, "WeightEn", float("nan"), "objective weight En=nan is not allowed; weights must be finite and >= 0")
         mu = (c.Mu, c.Nu, c.Gamma)
         o.MaxIterations = -1
         self.doc.recompute()
@@ -257,21 +253,86 @@ class ReopenInErrorTest(BadValueCase):
         c = ght_curve.make_ght_curve(PTS, doc=self.doc)
         good, name = c.Shape.Length, c.Name
         c.Tolerance = -1.0
-        self.doc.recompute()
-        self.assertTrue(_bad(c))
+        message = "GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0"
+        self.assert_recompute_refused(self.doc, c, message)
         path = os.path.join(OUT, "audit_error.FCStd")
         self.doc.saveAs(path)
         App.closeDocument(self.doc.Name)
         self.doc = App.openDocument(path)
         c2 = self.doc.getObject(name)
         c2.touch()
-        self.doc.recompute()
-        self.assertTrue(_bad(c2))
-        self.assertIn("Tolerance", c2.getStatusString())
+        self.assert_recompute_refused(self.doc, c2, message)
         c2.Tolerance = 1e-6
-        self.doc.recompute()
-        self.assertFalse(_bad(c2))
+        self.assert_recompute_clean(self.doc, c2)
         self.assertAlmostEqual(c2.Shape.Length, good, delta=1e-12 * good)
+
+
+class ErrorReportingTest(BadValueCase):
+    """How a failed recompute is reported: refused input without traceback, bugs with one."""
+
+    def test_dependants_never_build_on_a_failed_input(self):
+        """FreeCAD skips the dependants of a failed feature in a document recompute; recomputing a
+        dependant alone (``obj.recompute()``) is refused too, naming the failed input."""
+        from freecad.ght_workbench import spine_developable
+
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        s = spine_developable.make_spine_developable(c, doc=self.doc)
+        area = s.Shape.Area
+        c.Tolerance = -1.0
+        message = "GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0"
+        self.assert_recompute_refused(self.doc, c, message)
+        self.assertFalse(_bad(s))  # skipped by FreeCAD: not recomputed, its old shape kept
+        self.assertIs(_base.failed_input(s), c)
+        s.touch()
+        self.assert_recompute_refused(self.doc, s, f"its input GHTCurve failed to recompute ({message}); fix that first", recompute=s.recompute)
+        self.assertEqual(s.Shape.Area, area)
+        c.Tolerance = 1e-6
+        self.assert_recompute_clean(self.doc, c, s)
+        self.assertIsNone(_base.failed_input(s))
+
+    def test_a_bug_keeps_its_traceback(self):
+        """An exception that is not a refused input (a bug) is not hidden: FreeCAD prints its
+        traceback after the line naming the feature, and the feature is in error."""
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        proxy = c.Proxy
+
+        def broken(obj):
+            return 1 / 0
+
+        proxy.compute = broken
+        try:
+            c.touch()
+            _, text = self.console_output(self.doc.recompute)
+        finally:
+            del proxy.compute
+        self.assertTrue(_bad(c))
+        self.assertEqual(c.getStatusString(), "division by zero")
+        self.assertIn("GHTCurve: ZeroDivisionError: division by zero", text)
+        self.assertIn("Traceback (most recent call last)", text)
+        c.touch()
+        self.assert_recompute_clean(self.doc, c)
+
+    def test_plain_raise_fallback_gives_the_same_state(self):
+        """Where the quiet raise is unavailable (``QUIET_ERRORS`` off; a tracer; Python >= 3.12)
+        FreeCAD prints the traceback, and the state and status string are the same."""
+        c = ght_curve.make_ght_curve(PTS, doc=self.doc)
+        c.Tolerance = -1.0
+        _base.QUIET_ERRORS = False
+        try:
+            _, text = self.console_output(self.doc.recompute)
+        finally:
+            _base.QUIET_ERRORS = True
+        self.assertTrue(_bad(c))
+        self.assertEqual(c.getStatusString(), "GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0")
+        self.assertIn("Traceback (most recent call last)", text)
+        c.touch()
+        self.assert_recompute_refused(self.doc, c, "GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0")
+
+    @staticmethod
+    def console_output(fn):
+        from freecad.ght_workbench.tests.refusal import console_output
+
+        return console_output(fn)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,8 @@ import unittest
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import composite_curve, developable, export, flat_pattern, ght_curve, joined_developable
+from freecad.ght_workbench import _base, composite_curve, developable, export, flat_pattern, ght_curve, joined_developable
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_export_")
 REL = 1e-9
@@ -36,7 +37,7 @@ def _measures(shape: "Part.Shape") -> tuple:
     return (len(shape.Faces), len(shape.Edges), shape.Area, shape.Length, sum(s.Volume for s in shape.Solids))
 
 
-class NamedStepExportTest(unittest.TestCase):
+class NamedStepExportTest(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("ExportDoc")
         d = self.doc
@@ -56,7 +57,7 @@ class NamedStepExportTest(unittest.TestCase):
         self.joined.Label = "Naht Ø-Blech"
         d.recompute()
         self.objects = [self.curve, self.composite, self.dev, self.joined, self.flat, self.box]
-        bad = [o.Name for o in self.objects if "Invalid" in o.State or "Error" in o.State]
+        bad = [o.Name for o in self.objects if _base.failed(o)]
         self.assertEqual(bad, [])
 
     def tearDown(self):
@@ -163,12 +164,14 @@ class NamedStepExportTest(unittest.TestCase):
             export.export_step([self.box, empty], path)
         # 4. a feature whose last recompute failed keeps its old shape: refused, not exported stale
         self.curve.Tolerance = -1.0
-        self.doc.recompute()
-        self.assertIn("Invalid", self.curve.State)
-        with self.assertRaisesRegex(Exception, "Curve: its last recompute failed"):
+        message = "Curve.Tolerance=-1.0 is not allowed; it must be a finite number > 0"
+        self.assert_recompute_refused(self.doc, self.curve, message)
+        with self.assertRaises(Exception) as ctx:
             export.export_step([self.box, self.curve], path)
+        self.assertEqual(str(ctx.exception), f"Curve: its last recompute failed ({message}), so its shape is stale; fix it or leave "
+                                             "it out of the export")
         self.curve.Tolerance = 1e-6
-        self.doc.recompute()
+        self.assert_recompute_clean(self.doc, self.curve)
         # 5. nothing selected
         with self.assertRaisesRegex(Exception, "nothing to export"):
             export.export_step([], path)
@@ -232,12 +235,14 @@ class NamedStepExportTest(unittest.TestCase):
         with self.assertRaisesRegex(Exception, "Platte Ä: it has changes not yet recomputed"):
             ex.export_step([self.dev], step)
         self.dev.Tolerance = -1.0
-        self.doc.recompute()
-        self.assertIn("Invalid", self.dev.State)
-        self.assertNotIn("Invalid", self.flat.State)  # the flat pattern keeps the pattern of γ = -1
+        message = "Platte Ä.Tolerance=-1.0 is not allowed; it must be a finite number >= 0 (0: 1e-7 of the surface size)"
+        self.assert_recompute_refused(self.doc, self.dev, message)
+        self.assertFalse(_base.failed(self.flat))  # skipped: the flat pattern keeps the pattern of γ = -1
+        self.assertIs(_base.failed_input(self.flat), self.dev)
+        stale = f"its input Platte Ä failed to recompute ({message}), so its shape is stale"
         for fn, path in ((ex.export_step, step), (ex.export_flat_pattern_dxf, dxf), (ex.export_flat_pattern_svg, dxf)):
             with self.subTest(fn.__name__):
-                with self.assertRaisesRegex(Exception, "input Platte Ä failed to recompute"):
+                with self.assertRaisesRegex(Exception, re.escape(stale)):
                     fn([self.flat] if fn is ex.export_step else self.flat, path)
         self.assertEqual([open(f, "rb").read() for f in (step, dxf)], originals)
         self.dev.Tolerance = 0.0

@@ -27,9 +27,22 @@ def _sample(edge_or_wire, n: int = 41) -> np.ndarray:
 
 
 def _recompute(doc) -> list:
-    """Recompute ``doc``; return the names of objects left in error (their execute raised)."""
-    doc.recompute()
-    return [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in o.State]
+    """Recompute ``doc``; return the names of objects left in error (:func:`_base.failed`).
+
+    What the recompute prints is checked too: nothing when every object is fine, else exactly one
+    line ``"<Label>: <status>"`` per failed object and FreeCAD's "Recompute failed!" line, no
+    Python traceback.
+    """
+    from freecad.ght_workbench import _base
+    from freecad.ght_workbench.tests.refusal import RECOMPUTE_FAILED, console_lines, console_output, report_line
+
+    _, text = console_output(doc.recompute)
+    failed = [o for o in doc.Objects if _base.failed(o)]
+    expected = sorted(report_line(o, o.getStatusString()) for o in failed) + ([RECOMPUTE_FAILED] if failed else [])
+    lines = console_lines(text)
+    if sorted(lines[:-1]) + lines[-1:] != expected:
+        raise AssertionError(f"recompute printed {lines}, expected {expected}:\n{text}")
+    return [o.Name for o in failed]
 
 
 def _reopen(doc):
@@ -516,8 +529,10 @@ class ParameterBoxTest(unittest.TestCase):
             if gamma == -1.0 and -1.0 in (mu, nu):
                 # GBT with μ = -1 (ν = -1) has f0'(0) = 0 (f2'(1) = 0): U'(0) = 0 and the end ruling
                 # U ∩ U' is undefined: the feature reports the core's error or, if built, is valid
-                if failed:
+                if failed:  # one line naming the feature and the end (checked by _recompute)
                     self.assertEqual(failed, [obj.Name])
+                    self.assertRegex(obj.getStatusString(), r"^at u=([01]) \(t=\1\) the dual curve's plane U=.* vanishes .* so the ruling "
+                                     r"U ∩ U' is undefined; the planes' normals must keep turning")
                 else:
                     self.assertTrue(obj.Shape.isValid(), (mu, nu, gamma))
                 continue

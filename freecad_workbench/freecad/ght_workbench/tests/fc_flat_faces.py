@@ -23,8 +23,9 @@ from scipy.integrate import quad
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import export, flat_pattern
+from freecad.ght_workbench import _base, export, flat_pattern
 from freecad.ght_workbench.tests.fc_features import _reopen  # save, close, reopen, recompute (into $GHT_FC_OUT)
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 from ght_cad.errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from ght_cad.face_unroll import unroll_face_data
 
@@ -66,7 +67,7 @@ def _record(name: str, face, pat, fp=None) -> None:
         json.dump(data, fh, indent=1)
 
 
-class FlatFacesTest(unittest.TestCase):
+class FlatFacesTest(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("flat_faces")
 
@@ -282,7 +283,7 @@ class FlatFacesTest(unittest.TestCase):
             hole = quad(lambda z: 2 * R * math.asin(math.sqrt(r * r - z * z) / R), -r, r, epsabs=0, epsrel=1e-13, limit=200)[0]
             exact = 2 * math.pi * R * H - 4 * hole
             fp = flat_pattern.make_flat_pattern(obj, name, doc=self.doc)
-            self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+            self.assertFalse(_base.failed(fp), fp.getStatusString())
             self.assertTrue(fp.Shape.isValid())
             self.assertEqual(len(fp.Shape.Faces[0].Wires), 4, sc)
             pat = _pattern(fp)
@@ -376,20 +377,21 @@ class FlatFacesTest(unittest.TestCase):
         self.assertIn("(u-isolines)", msg)
         self.assertIn("best_effort", msg)
         fp = flat_pattern.make_flat_pattern(sph, "Face1", doc=self.doc)
-        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
-        with self.assertRaisesRegex(NotDevelopableError, "Sphere.Face1.*not ruled"):
+        self.assertTrue(_base.failed(fp), fp.State)
+        # the feature's status string is the core's message, one line on the console, no traceback
+        with self.assertRaisesRegex(NotDevelopableError, "Sphere.Face1.*not ruled") as ctx:
             _pattern(fp)
+        fp.touch()
+        self.assert_recompute_refused(self.doc, fp, str(ctx.exception))
         # a full sphere cannot be flattened even with BestEffort: its meridians run between the
         # poles, the ruled surface between the two boundary isolines (points) has no area
         fp.BestEffort = True
-        self.doc.recompute()
-        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
-        with self.assertRaisesRegex(DegenerateGeometryError, "run between two points"):
+        with self.assertRaisesRegex(DegenerateGeometryError, "run between two points") as ctx:
             _pattern(fp)
+        self.assert_recompute_refused(self.doc, fp, str(ctx.exception))
         # a gore (Angle3 = 45°) is flattened with BestEffort: rulings between its two meridians
         sph.Angle3 = 45.0
-        self.doc.recompute()
-        self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        self.assert_recompute_clean(self.doc, fp)
         self.assertTrue(fp.Shape.isValid())
         exact = 2 * 25.0 * math.radians(45.0)
         self.assertAlmostEqual(fp.Area3D, exact, delta=1e-9 * exact)
@@ -402,8 +404,7 @@ class FlatFacesTest(unittest.TestCase):
         # and SVG export refuse it (before: the stale gore, or an empty DXF for a feature that
         # never computed) and write nothing
         sph.Angle3 = 360.0
-        self.doc.recompute()
-        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        self.assert_recompute_refused(self.doc, fp, str(ctx.exception))
         for fn, ext in ((export.export_flat_pattern_dxf, "dxf"), (export.export_flat_pattern_svg, "svg")):
             target = os.path.join(OUT, f"stale.{ext}")
             with self.assertRaisesRegex(GHTError, "recompute failed"):
@@ -419,18 +420,18 @@ class FlatFacesTest(unittest.TestCase):
         self.doc.recompute()
         fp = flat_pattern.make_flat_pattern(cyl, "Face1", doc=self.doc)
         cases = (
-            ((cyl, ["Face9"]), r"Cyl has no Face9; allowed: Face1\.\.Face3"),
-            ((cyl, ["Edge1"]), r"Cyl\.Edge1 is not a face; allowed: a face \(Face1\.\.Face3\)"),
+            ((cyl, ["Face9"]), "Cyl has no Face9; allowed: Face1..Face3 (did the source's topology change? select the face again)"),
+            ((cyl, ["Edge1"]), "Cyl.Edge1 is not a face; allowed: a face (Face1..Face3)"),
         )
         circle = self.doc.addObject("Part::Circle", "Circ")
         self.doc.recompute()
-        cases += (((circle, []), r"Circ has no faces to unroll; allowed: a face or a developable feature"),)
-        for source, pattern in cases:
+        cases += (((circle, []), "Circ has no faces to unroll; allowed: a face or a developable feature of this workbench"),)
+        for source, message in cases:
             fp.Source = source
-            self.doc.recompute()
-            self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
-            with self.assertRaisesRegex(ValueError, pattern):
+            self.assert_recompute_refused(self.doc, fp, message)
+            with self.assertRaises(GHTError) as ctx:
                 _pattern(fp)
+            self.assertEqual(str(ctx.exception), message)
 
     def test_negative_bend_lines_are_refused_by_name(self):
         """BendLines = -1 was silently treated as 0 (feature Up-to-date): now an error naming it;
@@ -439,14 +440,12 @@ class FlatFacesTest(unittest.TestCase):
         self.doc.recompute()
         fp = flat_pattern.make_flat_pattern(cyl, "Face1", doc=self.doc)
         fp.BendLines = 0
-        self.doc.recompute()
-        self.assertFalse("Invalid" in fp.State or "Error" in fp.State, fp.State)
+        self.assert_recompute_clean(self.doc, fp)
         self.assertEqual(len(fp.Shape.Faces), 1)
         self.assertEqual(len(fp.Shape.Edges), 4)  # the rectangle alone
         fp.BendLines = -1
-        self.doc.recompute()
-        self.assertTrue("Invalid" in fp.State or "Error" in fp.State, fp.State)
-        with self.assertRaisesRegex(ValueError, r"BendLines=-1 is not allowed; allowed: 0 or more"):
+        self.assert_recompute_refused(self.doc, fp, "FlatPattern: BendLines=-1 is not allowed; allowed: 0 or more bend lines")
+        with self.assertRaisesRegex(GHTError, r"BendLines=-1 is not allowed; allowed: 0 or more"):
             _pattern(fp)
 
     def test_twisted_face_is_refused_with_theta(self):

@@ -20,7 +20,8 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import developable, export, flat_pattern, joined_developable
+from freecad.ght_workbench import _base, developable, export, flat_pattern, joined_developable
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_joined_")
 NORMAL_TOL_DEG = 1e-6
@@ -50,9 +51,7 @@ def _shared_edge_normal_angle(shell: "Part.Shape", n: int = 11) -> tuple[float, 
     return worst, gap
 
 
-def _bad(obj) -> bool:
-    """True if the object is in error after a recompute (its execute raised)."""
-    return "Invalid" in obj.State or "Error" in obj.State
+_bad = _base.failed  # the object's last recompute failed (FreeCAD state Invalid)
 
 
 def _samples(face: "Part.Face", n: int = 9) -> np.ndarray:
@@ -65,7 +64,7 @@ def _poles(face: "Part.Face") -> np.ndarray:
     return np.array([[[p.x, p.y, p.z] for p in row] for row in face.Surface.getPoles()])
 
 
-class JoinedDevelopableTest(unittest.TestCase):
+class JoinedDevelopableTest(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("joined")
         # exact quarter cylinder r = 10, H = 20 (γ = -1): ends at the plane y = 10
@@ -268,17 +267,16 @@ class JoinedDevelopableTest(unittest.TestCase):
             joined_developable.make_joined_developable(self.first, "G1", nu=1.5, doc=self.doc)
         j = joined_developable.make_joined_developable(self.first, "G1", doc=self.doc)
         j.PlaneCoordinates = [1.0, 2.0, 3.0]
-        self.doc.recompute()
-        self.assertIn("Invalid", j.State)
+        self.assert_recompute_refused(self.doc, j, "PlaneCoordinates has 3 numbers; give 4 per free control plane (at least one plane)")
         # own boundary planes: the joint ruling segments differ, so Fuse cannot sew one shell
         j.PlaneCoordinates = [float(x) for x in np.ravel(joined_developable.DEFAULT_FREE_PLANES)]
         j.BoundaryCoordinates = [-2.0, 0.0, 0.0, 1.0, -15.0, 0.0, 0.0, 1.0]
         j.Fuse = True
-        self.doc.recompute()
-        self.assertIn("Invalid", j.State)
+        self.assert_recompute_refused(
+            self.doc, j, "sewing with Previous did not give one shell in which the new face shares its start ruling edge; the strips do "
+            "not share their joint ruling segment (own BoundaryCoordinates?) — set Fuse to False")
         j.Fuse = False  # the single face is fine and the (dual-curve) joint order is unchanged
-        self.doc.recompute()
-        self.assertFalse(_bad(j), j.State)
+        self.assert_recompute_clean(self.doc, j)
         self.assertEqual(j.JointOrder, 1)
         self.assertAlmostEqual(j.Shape.BoundBox.ZLength, 13.0, delta=1e-9)
         # a non-enveloping previous feature is refused with its name in the message
@@ -286,8 +284,12 @@ class JoinedDevelopableTest(unittest.TestCase):
         plain.Shape = Part.makePlane(1, 1)
         j.PlaneCoordinates = [float(x) for x in np.ravel(joined_developable.DEFAULT_FREE_PLANES)]
         j.Previous = plain
-        with self.assertRaisesRegex(ValueError, "Plain"):
+        message = ("Previous=Plain is a Part::Feature; a developable join needs an enveloping developable (GHT 'Developable from "
+                   "planes' or another 'Joined developable')")
+        with self.assertRaises(ValueError) as ctx:
             j.Proxy.surface(j)
+        self.assertEqual(str(ctx.exception), message)
+        self.assert_recompute_refused(self.doc, j, message)
 
 
 def gui_check() -> dict:

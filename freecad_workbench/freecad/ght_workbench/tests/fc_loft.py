@@ -22,7 +22,8 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import developable_loft, export, flat_pattern, ght_curve, optimization
+from freecad.ght_workbench import _base, developable_loft, export, flat_pattern, ght_curve, optimization
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_loft_")
 # the dory's chine and sheer (examples/design_hull_plate.toml)
@@ -30,8 +31,7 @@ CHINE = [(0, -700, 300), (1500, -1050, 200), (3000, -1150, 250), (4500, -950, 45
 SHEER = [(0, -900, 1200), (1500, -1250, 1150), (3000, -1300, 1180), (4500, -1100, 1300)]
 
 
-def _bad(obj) -> bool:
-    return "Invalid" in obj.State or "Error" in obj.State
+_bad = _base.failed  # the object's last recompute failed (FreeCAD state Invalid)
 
 
 def _sketch(doc, name: str, radius: float, z: float):
@@ -62,7 +62,7 @@ def _frustum_area(r1: float, r2: float, h: float) -> float:
     return math.pi * (r1 + r2) * math.hypot(h, r1 - r2)
 
 
-class DevelopableLoftTest(unittest.TestCase):
+class DevelopableLoftTest(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("loft")
         self.ska = _sketch(self.doc, "SketchA", 5.0, 0.0)
@@ -192,10 +192,7 @@ class DevelopableLoftTest(unittest.TestCase):
         # a loft on non-GHT rails cannot be optimized: the message names the rail
         cone = self.loft()
         opt.Targets = [cone]
-        self.doc.recompute()
-        self.assertTrue(_bad(opt))
-        with self.assertRaisesRegex(ValueError, "RailA is SketchA, not a GHT curve"):
-            opt.Proxy.problem(opt)
+        self.assert_refused_as(self.doc, opt, lambda: opt.Proxy.problem(opt), "RailA is SketchA, not a GHT curve")
 
     def test_refusals_name_the_problem(self):
         l1 = self.doc.addObject("Part::Feature", "LineA")
@@ -204,20 +201,16 @@ class DevelopableLoftTest(unittest.TestCase):
         l2.Shape = Part.LineSegment(App.Vector(0, 5, 3), App.Vector(0, 8, 10)).toShape()
         lf = developable_loft.make_developable_loft(l1, l2, doc=self.doc)
         self.assertTrue(_bad(lf))
-        with self.assertRaisesRegex(Exception, "no developable joins the rails"):
-            lf.Proxy.surface(lf)
+        # each refusal: the feature's status string is the message, one console line, no traceback
+        self.assert_refused_as(self.doc, lf, lambda: lf.Proxy.surface(lf), "no developable joins the rails")
         lf.RailB = None
-        self.doc.recompute()
-        self.assertTrue(_bad(lf))
-        with self.assertRaisesRegex(ValueError, "RailB is not linked"):
-            lf.Proxy.surface(lf)
+        self.assertEqual(self.assert_refused_as(self.doc, lf, lambda: lf.Proxy.surface(lf), "RailB is not linked"),
+                         "DevelopableLoft.RailB is not linked; select two edges (of sketches, GHT curves or any Part feature)")
         lf.RailB = (self.skb, ["Edge7"])
-        with self.assertRaisesRegex(ValueError, r"SketchB.Edge7 is not an edge of it \(Edge1..Edge1\)"):
-            lf.Proxy.surface(lf)
+        self.assert_refused_as(self.doc, lf, lambda: lf.Proxy.surface(lf), r"SketchB.Edge7 is not an edge of it \(Edge1..Edge1\)")
         # a good pair again: the feature recovers
         lf.RailA, lf.RailB = (self.ska, ["Edge1"]), (self.skb, ["Edge1"])
-        self.doc.recompute()
-        self.assertFalse(_bad(lf), lf.State)
+        self.assert_recompute_clean(self.doc, lf)
         with self.assertRaisesRegex(ValueError, "orientation='sideways'"):
             developable_loft.make_developable_loft(l1, l2, orientation="sideways", doc=self.doc)
 

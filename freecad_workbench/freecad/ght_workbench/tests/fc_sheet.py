@@ -23,6 +23,7 @@ import Part
 
 from freecad.ght_workbench import export, flat_pattern
 from freecad.ght_workbench.tests.fc_features import _recompute, _reopen
+from freecad.ght_workbench.tests.refusal import RefusalAssertions
 from ght_cad.sheet import SheetError
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
@@ -33,7 +34,7 @@ def _cyl_face_name(obj) -> list[str]:
     return [f"Face{i + 1}" for i, f in enumerate(obj.Shape.Faces) if type(f.Surface).__name__ == "Cylinder"]
 
 
-class SheetTest(unittest.TestCase):
+class SheetTest(RefusalAssertions, unittest.TestCase):
     def setUp(self):
         self.doc = App.newDocument("sheet")
 
@@ -131,11 +132,16 @@ class SheetTest(unittest.TestCase):
         fp.KFactor = 1.5
         with self.assertRaisesRegex(SheetError, r"k_factor=1.5 is not allowed"):
             fp.Proxy.pattern(fp)
+        # the feature is in error with the same message: one console line, no traceback
+        self.assert_refused_as(self.doc, fp, lambda: fp.Proxy.pattern(fp), r"k_factor=1.5 is not allowed")
         fp.KFactor = K
         fp.Thickness = 250.0  # beyond the inside radius 240 on the reverse side
         fp.Side = "reverse"
         with self.assertRaisesRegex(SheetError, r"thickness=250.0 .*centre of curvature.*bending radius 240"):
             fp.Proxy.pattern(fp)
+        self.assert_refused_as(self.doc, fp, lambda: fp.Proxy.pattern(fp), r"thickness=250.0 .*centre of curvature.*bending radius 240")
+        fp.Thickness, fp.Side = T, "normal"
+        self.assert_recompute_clean(self.doc, fp)
 
     def test_save_reopen_keeps_the_sheet(self):
         c = self._quarter_cylinder()
