@@ -473,12 +473,24 @@ def main():
         "OrphanFlat: no Source linked",
     ]
 
-    def tree_items(labels):
-        """Per label: the tree item's tooltip and how many strongly red pixels its 16x16 icon has
-        (FreeCAD paints its error mark over the icon of a failed object in red)."""
+    def tree_items(labels, marked_over=None):
+        """Per label: how many strongly red pixels the tree item's 16x16 icon has (FreeCAD paints
+        its error mark over the icon of a failed object in red). The tree refreshes the items'
+        status on a timer: with ``marked_over`` (an earlier result) the icons are read again every
+        0.1 s, for up to 10 s, until each has 10 red pixels more than there."""
+        timer = QtCore.QElapsedTimer()
+        timer.start()
+        while True:
+            wait(100)
+            out = _tree_items(labels)
+            if marked_over is None or timer.elapsed() > 10000:
+                return out
+            if all(out.get(l, {}).get("red_pixels", 0) >= marked_over.get(l, {}).get("red_pixels", 0) + 10 for l in marked_over):
+                return out
+
+    def _tree_items(labels):
         from PySide2 import QtGui
 
-        wait(600)  # the tree refreshes the items' status on a timer
         out = {}
         for tree in Gui.getMainWindow().findChildren(QtWidgets.QTreeWidget):
             it = QtWidgets.QTreeWidgetItemIterator(tree)
@@ -534,7 +546,8 @@ def main():
         ctx["orphans"] = orphans
         # what a user sees: the Model tree (error marks) and the Report view
         Gui.Selection.clearSelection()
-        icons_after = tree_items(labels)
+        failed_labels = [o.Label for o in orphans if _base.failed(o)]
+        icons_after = tree_items(labels, marked_over={l: icons_before.get(l, {}) for l in failed_labels})
         mw = Gui.getMainWindow()
         mw.resize(1280, 860)
         show_tree(labels[-1])
