@@ -181,8 +181,8 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     # the error the curve step provokes on purpose is seen in the Report view (the watch works):
     # one line naming the feature and the property, FreeCAD's "Recompute failed!", no traceback
     curve_lines = _report_lines(steps["GHT_Curve"])
-    assert set(curve_lines) == {"GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0",
-                                "Recompute failed! Please check report view."}, curve_lines
+    assert curve_lines == ["GHTCurve.Tolerance=-1.0 is not allowed; it must be a finite number > 0",
+                           "Recompute failed! Please check report view."], curve_lines
     assert not steps["GHT_Curve"]["tracebacks"], steps["GHT_Curve"]
     # double-click on every feature: a task panel opens (the flat pattern and the optimization
     # have no shape parameters of their own: a panel that says what to edit instead)
