@@ -85,6 +85,11 @@ class FreeCADSurface(SurfaceAdapter):
                 self.ruled_hint = "v"
             elif s.UDegree == 1 and s.NbUPoles == 2:
                 self.ruled_hint = "u"
+            if self.ruled_hint is not None:  # equal weights across the rulings: affine along them
+                w = np.asarray(s.getWeights(), dtype=float)
+                self.affine_ruled = bool(np.all(w[:, 0] == w[:, 1]) if self.ruled_hint == "v" else np.all(w[0] == w[1]))
+        elif self.kind == "extrusion":
+            self.affine_ruled = True  # C(u) + v D
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         val = self.s.value
