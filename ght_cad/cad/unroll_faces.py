@@ -358,8 +358,7 @@ class _Nurbs:
             if g.IsUPeriodic() or g.IsVPeriodic():
                 return None
             nu, nv = g.NbUPoles(), g.NbVPoles()
-            uk = np.array([g.UKnotSequence().Value(i) for i in range(1, g.UKnotSequence().Length() + 1)])
-            vk = np.array([g.VKnotSequence().Value(i) for i in range(1, g.VKnotSequence().Length() + 1)])
+            uk, vk = _array1(g.UKnotSequence()), _array1(g.VKnotSequence())
             pu, pv = g.UDegree(), g.VDegree()
         elif ad.GetType() == GeomAbs_BezierSurface:
             g = ad.Bezier()
@@ -369,12 +368,15 @@ class _Nurbs:
             vk = np.r_[np.zeros(pv + 1), np.ones(pv + 1)]
         else:
             return None
+        P = g.Poles()  # rows along u, columns along v
         cw = np.empty((nu, nv, 4))
-        for i in range(1, nu + 1):
-            for j in range(1, nv + 1):
-                w = g.Weight(i, j)
-                cw[i - 1, j - 1, :3] = np.array(g.Pole(i, j).Coord()) * w
-                cw[i - 1, j - 1, 3] = w
+        cw[..., :3] = np.array([P.Value(i, j).Coord() for i in range(P.LowerRow(), P.UpperRow() + 1)
+                                for j in range(P.LowerCol(), P.UpperCol() + 1)], dtype=float).reshape(nu, nv, 3)
+        if g.IsURational() or g.IsVRational():
+            cw[..., 3] = np.array([[g.Weight(i, j) for j in range(1, nv + 1)] for i in range(1, nu + 1)], dtype=float)
+            cw[..., :3] *= cw[..., 3:]
+        else:
+            cw[..., 3] = 1.0
         if uk.size != nu + pu + 1 or vk.size != nv + pv + 1:
             return None  # pragma: no cover - not a clamped flat knot vector
         return cls(uk, vk, pu, pv, cw)
@@ -466,6 +468,20 @@ class _Nurbs:
         P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu][..., :K]  # (i, v-span, e, f, k)
         G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
         ms, mv = s.size, v.size
+        if K == 3 and self.pv == 1 and starts_v.size == 1:
+            # degree 1 in v: S_u = U0 + y U1 (y = the patch's Chebyshev variable, T_1(y) = y) and
+            # S_v = V1 / h_v do not depend on v beyond that, so |S_u × S_v|² = a + b y + c y² with
+            # C0 = U0 × S_v, C1 = U1 × S_v, a = |C0|², b = 2 C0·C1, c = |C1|², per s only
+            U0, U1 = G[1][0][..., 0], G[1][0][..., 1]  # (k, i)
+            Sv = G[0][0][..., 1] / hv[0]
+            C0 = np.stack([U0[1] * Sv[2] - U0[2] * Sv[1], U0[2] * Sv[0] - U0[0] * Sv[2], U0[0] * Sv[1] - U0[1] * Sv[0]])
+            C1 = np.stack([U1[1] * Sv[2] - U1[2] * Sv[1], U1[2] * Sv[0] - U1[0] * Sv[2], U1[0] * Sv[1] - U1[1] * Sv[0]])
+            scale = 1.0 / (self.weight * self.weight)  # type: ignore[operator]
+            a, bq, c = (np.einsum("ki,ki->i", C0, C0) * scale, 2.0 * np.einsum("ki,ki->i", C0, C1) * scale,
+                        np.einsum("ki,ki->i", C1, C1) * scale)
+            y = Tv[0][:, 1]
+            r = a[:, None] + y[None, :] * (bq[:, None] + y[None, :] * c[:, None])
+            return np.sqrt(np.maximum(r, 0.0, out=r), out=r)
         keys = ((1, 0), (0, 1)) if K == 3 else ((0, 0), (1, 0), (0, 1))
         spans = np.unique(iv)
         if spans.size == 1:  # one v-span: (k i, f) @ (f, j) is already component-major
@@ -542,6 +558,11 @@ def _rational(H: dict[tuple[int, int], np.ndarray], order: int) -> list[np.ndarr
     Svv = (Hvv[:, :3] - 2 * Hv[:, 3:4] * Sv - Hvv[:, 3:4] * S) / W
     Suv = (Huv[:, :3] - Hu[:, 3:4] * Sv - Hv[:, 3:4] * Su - Huv[:, 3:4] * S) / W
     return [S, Su, Sv, Suu, Svv, Suv]
+
+
+def _array1(arr: Any) -> np.ndarray:
+    """A ``TColStd_Array1OfReal`` as a numpy array (read once, whatever its bounds)."""
+    return np.array([arr.Value(i) for i in range(arr.Lower(), arr.Upper() + 1)], dtype=float)
 
 
 def _spans(U: np.ndarray, p: int) -> np.ndarray:
@@ -736,11 +757,12 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
     kind = c.GetType()
     if kind == GeomAbs_Line:
         lin = c.Line()
-        P, D = np.array(lin.Location().Coord()), np.array(lin.Direction().Coord())
+        Pc = lin.Location().Coord()
+        P, D = np.array(Pc), np.array(lin.Direction().Coord())
 
         def f(p: np.ndarray) -> np.ndarray:
             return P + p[:, None] * D
-        scale = max(1.0, float(np.abs(P).max()))
+        scale = max(1.0, *(abs(x) for x in Pc))
     elif kind == GeomAbs_Circle:
         circ = c.Circle()
         ax = circ.Position()
@@ -764,10 +786,11 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
         return f
     else:
         return None
-    ps = np.array([c.FirstParameter(), c.LastParameter()])
-    ps = ps[np.abs(ps) < 1e50]
-    if ps.size and float(np.abs(f(ps) - np.array([c.Value(x).Coord() for x in ps.tolist()])).max()) > 1e-12 * scale:
-        return None  # pragma: no cover - a convention we do not know: evaluate by OCCT
+    for x in (c.FirstParameter(), c.LastParameter()):  # checked at the ends (plain floats: no numpy overhead)
+        if abs(x) < 1e50:
+            ours = f(np.array([x]))[0].tolist()
+            if max(abs(a - b) for a, b in zip(ours, c.Value(x).Coord())) > 1e-12 * scale:
+                return None  # pragma: no cover - a convention we do not know: evaluate by OCCT
     return f
 
 
