@@ -87,28 +87,27 @@ def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, n
     ignore those parameters.
     """
     gl = _norm(g)
-    g1 = b1 - a1
-    g1l = _norm(g1)
     a1l = _norm(a1)
     b1l = _norm(b1)
-    a_sing = a1l <= SINGULAR_NORMAL_TOL * gl
-    b_sing = b1l <= SINGULAR_NORMAL_TOL * gl
+    tol_g = SINGULAR_NORMAL_TOL * gl
+    a_sing = a1l <= tol_g
+    b_sing = b1l <= tol_g
     ca = _cross(a1, g)
     cb = _cross(b1, g)
     if a_sing.any() or b_sing.any():  # the limit normal g' × g where a tangent vanishes
+        g1 = b1 - a1
+        g1l = _norm(g1)
         lim = _cross(g1, g)
         ca = np.where(a_sing[..., None], lim, ca)
         cb = np.where(b_sing[..., None], -lim, cb)
+        a1l = np.where(a_sing, g1l, a1l)  # the tangent scale of each end's normal
+        b1l = np.where(b_sing, g1l, b1l)
+        g1_ok = g1l > tol_g  # the limit needs a turning ruling
+        ok = ~((a_sing | b_sing) & ~g1_ok)
+    else:
+        ok = gl > 0
     la, lb = _norm(ca), _norm(cb)
-    ta = np.where(a_sing, g1l, a1l)
-    tb = np.where(b_sing, g1l, b1l)
-    g1_ok = g1l > SINGULAR_NORMAL_TOL * gl  # the limit needs a turning ruling
-    ok = (
-        (la > SINGULAR_NORMAL_TOL * ta * gl)
-        & (lb > SINGULAR_NORMAL_TOL * tb * gl)
-        & ~((a_sing | b_sing) & ~g1_ok)
-        & (gl > 0)
-    )
+    ok &= (la > tol_g * a1l) & (lb > tol_g * b1l) & (gl > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
         na = ca / la[..., None]
         nb = cb / lb[..., None]

@@ -61,6 +61,10 @@ _VI = np.polynomial.chebyshev.chebvander(_X, _N + 1)  # for evaluating integrate
 _INT = np.polynomial.chebyshev.chebint(np.eye(_N + 1), lbnd=-1, axis=0)  # (N+2, N+1)
 
 
+#: the initial panel ends (4 equal panels; the surface's breakpoints are added)
+_EDGES0 = np.linspace(0.0, 1.0, 5)
+
+
 def _chebint(c: np.ndarray) -> np.ndarray:
     """``∫_{-1}^x`` of the series ``c`` (P, N+1, m) along axis 1: (P, N+2, m)."""
     return np.einsum("ij,pjm->pim", _INT, c)
@@ -198,8 +202,8 @@ class RuledDevelopment:
         place: bool = True,
     ) -> None:
         self.surface = surface
-        bp = np.asarray([b for b in breakpoints if 1e-12 < b < 1 - 1e-12], dtype=float)
-        edges = np.unique(np.concatenate([np.linspace(0.0, 1.0, 5), bp]))
+        bp = [b for b in breakpoints if 1e-12 < b < 1 - 1e-12]
+        edges = np.unique(np.concatenate([_EDGES0, bp])) if bp else _EDGES0.copy()
         for _ in range(40):
             P = edges.size - 1
             lo, hi = edges[:-1], edges[1:]
