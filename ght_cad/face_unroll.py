@@ -694,13 +694,16 @@ def chain_loop(
     return out
 
 
+#: the fractions of :func:`_metric_grid`'s 12 x 5 grid (u-major), made once
+_METRIC_FU = np.repeat(np.linspace(0.05, 0.95, 12), 5)
+_METRIC_FV = np.tile(np.linspace(0.05, 0.95, 5), 12)
+
+
 def _metric_grid(bounds: Bounds) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """The 12 x 5 grid ``(U, V)`` of :func:`_metric` and its difference steps ``hu, hv``."""
+    """The 12 x 5 grid ``(U, V)`` of :func:`_metric` (u at 0.05 .. 0.95 of its range, v likewise,
+    u-major) and its difference steps ``hu, hv`` (1e-3 of the ranges)."""
     u0, u1, v0, v1 = bounds
-    uu = u0 + (u1 - u0) * np.linspace(0.05, 0.95, 12)
-    vv = v0 + (v1 - v0) * np.linspace(0.05, 0.95, 5)
-    U, V = (x.ravel() for x in np.meshgrid(uu, vv, indexing="ij"))
-    return U, V, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0)
+    return u0 + (u1 - u0) * _METRIC_FU, v0 + (v1 - v0) * _METRIC_FV, 1e-3 * (u1 - u0), 1e-3 * (v1 - v0)
 
 
 def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds,

@@ -18,6 +18,7 @@ exporting methods only.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass, field
@@ -74,6 +75,14 @@ MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
 def _chords(p: np.ndarray) -> float:
     d = p[1:] - p[:-1]
     return float(np.sum(np.sqrt(np.einsum("ij,ij->i", d, d))))
+
+
+@functools.lru_cache(maxsize=8)
+def _unit_samples(n: int) -> np.ndarray:
+    """``linspace(0, 1, n)``, made once per n (read-only)."""
+    t = np.linspace(0.0, 1.0, n)
+    t.flags.writeable = False
+    return t
 
 
 def romberg_length(points: np.ndarray) -> float:
@@ -164,7 +173,7 @@ class BoundaryEdge:
         by about h², far below round-off for a smooth edge); otherwise (a tight circle, a short
         ``samples``) the edge is sampled at ``4 _ROMBERG_N + 1`` points as before.
         """
-        ts = np.linspace(0.0, 1.0, self.samples)
+        ts = _unit_samples(self.samples)
         self.flat = np.asarray(self.flat_fn(ts), dtype=float)
         m = self.samples - 1
         length = None
@@ -329,8 +338,10 @@ class FlatPanel:
         self.texts = [(float(x + delta[0]), float(y + delta[1]), s, h) for x, y, s, h in self.texts]
         self.forming_texts = [(float(x + delta[0]), float(y + delta[1]), s, h, a) for x, y, s, h, a in self.forming_texts]
 
-    def bbox(self) -> tuple[np.ndarray, np.ndarray]:
-        pts = np.concatenate(self.loop_polylines(), axis=0)
+    def bbox(self, loops: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Lower-left and upper-right corners of the outline (``loops``: :meth:`loop_polylines`
+        when already made)."""
+        pts = np.concatenate(self.loop_polylines() if loops is None else loops, axis=0)
         return pts.min(axis=0), pts.max(axis=0)
 
     def map(self, u: Any, v: Any) -> np.ndarray:
@@ -473,7 +484,7 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
     loops = panel.loop_polylines()
     if panel.bend_lines.size:
         panel.bend_lines = clip_segments(panel.bend_lines, loops)
-    lo, hi = panel.bbox()
+    lo, hi = panel.bbox(loops)
     c = _centroid(loops[0])
     ext = hi - lo
     # horizontal text is about 0.7 h wide per character: keep it within a third of the panel's width
