@@ -131,6 +131,42 @@ def test_bspline_developable_face_preserves_lengths_and_area(transpose: bool) ->
         assert L2 == pytest.approx(L3, rel=1e-10)
 
 
+def test_affine_ruled_face_maps_like_the_projection() -> None:
+    """A polynomial face of degree 1 across (the tangent developable) is affine along its rulings:
+    it is ruled by structure (no isoline measurement) and mapped with its own ruling parameter;
+    projecting every point onto its ruling instead gives the same pattern (outline, bend lines,
+    area) to 1e-12 of its size."""
+    from ght_cad.cad.unroll_faces import _open_face, face_data
+    from ght_cad.face_unroll import unroll_face_data
+
+    tf, _, bounds, ev = _open_face(_tangent_developable_face())
+    assert ev.ruled_hint == "v" and ev.affine_ruled
+    fast = unroll_face_data(face_data(tf, ev, bounds))
+    ev.affine_ruled = False
+    slow = unroll_face_data(face_data(tf, ev, bounds))
+    assert fast.panels[0].info["ruled_by"] == "structure" and fast.panels[0].info["deviation_v"] == 0.0
+    size = float(np.ptp(slow.outlines[0], axis=0).max())
+    np.testing.assert_allclose(fast.outlines[0], slow.outlines[0], rtol=0, atol=1e-12 * size)
+    np.testing.assert_allclose(fast.bend_lines, slow.bend_lines, rtol=0, atol=1e-12 * size)
+    assert fast.area == pytest.approx(slow.area, rel=1e-13)
+
+
+def test_weights_across_the_rulings_are_not_affine() -> None:
+    """Weights 1 and 2 on the two rows of a ruled Bézier face reparametrize its rulings (u is not
+    affine along them) without changing the surface: not affine_ruled, and the pattern is the
+    same rectangle as the unweighted face's."""
+    from ght_cad.cad.unroll_faces import _open_face
+
+    row = np.array([(0, 0, 0), (1, 0, 1), (2, 0, 0), (3, 0, 1)], float)
+    pts = [[tuple(p) for p in row], [tuple(p + (0.0, 2.0, 0.0)) for p in row]]
+    plain = bd.Face.make_bezier_surface(pts)
+    weighted = bd.Face.make_bezier_surface(pts, weights=[[1.0] * 4, [2.0] * 4])
+    assert _open_face(plain)[3].affine_ruled and not _open_face(weighted)[3].affine_ruled
+    p0, p1 = unroll(plain), unroll(weighted)
+    np.testing.assert_allclose(np.sort(np.ptp(p1.outlines[0], axis=0)), np.sort(np.ptp(p0.outlines[0], axis=0)), rtol=1e-12)
+    assert p1.area == pytest.approx(p0.area, rel=1e-12) and p1.errors["max"] < 1e-10
+
+
 def test_project_developable_face_matches_ruled_unroll() -> None:
     """developable_from_planes(...).to_face() (B-spline, degree 1 across): 1e-7 or better, and
     the same area as unrolling the exact surface (up to the face's fit tolerance)."""
