@@ -1012,7 +1012,14 @@ def clip_rulings_uv(polygons: Sequence[np.ndarray], c: np.ndarray, lo: float, hi
     """
     A = np.concatenate(polygons)
     B = np.concatenate([np.concatenate([p[1:], p[:1]]) for p in polygons])
-    k, j = np.nonzero((A[:, 0][None, :] <= c[:, None]) != (B[:, 0][None, :] <= c[:, None]))
+    # (A_x <= c) != (B_x <= c)  <=>  min(A_x, B_x) <= c < max(A_x, B_x): the crossing rulings of an
+    # edge are a run of the sorted c, found by bisection (no rulings x edges table)
+    by_c = np.argsort(c, kind="stable")
+    cs = c[by_c]
+    first = np.searchsorted(cs, np.minimum(A[:, 0], B[:, 0]), side="left")
+    cnt = np.searchsorted(cs, np.maximum(A[:, 0], B[:, 0]), side="left") - first
+    j = np.repeat(np.arange(A.shape[0]), cnt)
+    k = by_c[np.repeat(first, cnt) + (np.arange(j.size) - np.repeat(np.cumsum(cnt) - cnt, cnt))]
     y = A[j, 1] + (c[k] - A[j, 0]) * (B[j, 1] - A[j, 1]) / (B[j, 0] - A[j, 0])
     order = np.lexsort((y, k))
     k, y = k[order], y[order]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -55,7 +55,7 @@ class Developability:
 
     def as_dict(self) -> dict[str, float]:
         """The measures as a plain dict of floats (for JSON reports)."""
-        return {k: float(v) for k, v in asdict(self).items()}
+        return {k: float(getattr(self, k)) for k in ("theta_max", "theta_rms", "dd", "R", "residual_max")}
 
     def __str__(self) -> str:
         return (
