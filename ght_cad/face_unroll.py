@@ -484,7 +484,7 @@ def face_area(
             m = uu.size
             if m and np.all(uu == uu[0]):  # an edge along v (u constant): its inner nodes are shared
                 # (none on u = u_lo, where P = 0)
-                s_n, _, w_n, _ = _inner_nodes(uu[:1], vv[:1], u_lo, u_breaks, u_span, xg, wg) if uu[0] != u_lo else (np.zeros(0),) * 4
+                s_n, w_n = _inner_nodes_at(float(uu[0]), u_lo, u_breaks, u_span) if uu[0] != u_lo else (np.zeros(0),) * 2
                 if s_n.size:
                     f = grid(s_n, vv)
                     P[i:i + m] = np.einsum("k,kj->j", w_n, f)
@@ -525,6 +525,29 @@ def _edge_nodes(breaks: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     if breaks is None or not len(breaks):
         return _edge_nodes_plain()
     return _edge_nodes_at(np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), breaks])))
+
+
+def _inner_nodes_at(u: float, u_lo: float, u_breaks: np.ndarray, u_span: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_inner_nodes` of one u (an edge with constant u): the nodes ``s`` and weights ``w``
+    of ``∫_{u_lo}^{u} f(s, v) ds``, by the same panels and the same arithmetic, with the panel
+    ends made in plain floats (one u: the array bookkeeping cost more than the nodes)."""
+    xg, wg = _gauss12()
+    lo, hi = min(u, u_lo), max(u, u_lo)
+    sign = 1.0 if u >= u_lo else -1.0
+    cuts = [lo, *sorted(b for b in np.asarray(u_breaks, dtype=float).tolist() if lo < b < hi), hi]
+    a_s, b_s = [], []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        m = 0.5 * (a + b)
+        for x0, x1 in ((a, m), (m, b)):
+            if not x1 > x0:
+                continue
+            cnt = max(1, math.ceil((x1 - x0) * 8.0 / abs(u_span))) if u_span else 1
+            step = (x1 - x0) / cnt
+            a_s += [x0 + j * step for j in range(cnt)]
+            b_s += [x0 + (j + 1) * step for j in range(cnt)] if u_span else [x1]
+    A, B = np.array(a_s), np.array(b_s)
+    h = 0.5 * (B - A)
+    return ((A + h)[:, None] + h[:, None] * xg[None, :]).ravel(), (sign * h[:, None] * wg[None, :]).ravel()
 
 
 def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: float, u_breaks: np.ndarray, u_span: float | None,
