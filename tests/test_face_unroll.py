@@ -492,3 +492,18 @@ def test_clip_rulings_uv_disc_chord(c: float, lo: float, hi: float) -> None:
     assert k.tolist() == [0]
     tol = 0.5 * (1 - math.cos(math.pi / 1024)) * 0.5 / half * 1.01
     assert abs(y0[0] - max(0.5 - half, lo)) <= tol and abs(y1[0] - min(0.5 + half, hi)) <= tol
+
+
+@given(u=st.floats(-3, 3), u_lo=st.floats(-1, 1), breaks=st.lists(st.floats(-3, 3), max_size=5),
+       span=st.sampled_from([None, 0.7, 2.0, 6.0]))
+@settings(max_examples=200, deadline=None)
+def test_inner_nodes_of_one_u_match_the_vectorized_rule(u: float, u_lo: float, breaks: list, span) -> None:
+    """The plain-float panels of one constant-u edge are the vectorized ones, bit for bit (the
+    same cuts at the breaks, halves, panels no wider than span / 8, 12-point rule)."""
+    from ght_cad.face_unroll import _gauss12, _inner_nodes, _inner_nodes_at
+
+    xg, wg = _gauss12()
+    br = np.sort(np.asarray(breaks + [u], dtype=float))
+    s1, _, w1, _ = _inner_nodes(np.array([u]), np.array([0.0]), u_lo, br, span, xg, wg)
+    s2, w2 = _inner_nodes_at(u, u_lo, br, span)
+    assert np.array_equal(s1, s2) and np.array_equal(w1, w2)
