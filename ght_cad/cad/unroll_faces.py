@@ -757,21 +757,29 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
     kind = c.GetType()
     if kind == GeomAbs_Line:
         lin = c.Line()
-        Pc = lin.Location().Coord()
-        P, D = np.array(Pc), np.array(lin.Direction().Coord())
+        Pc, Dc = lin.Location().Coord(), lin.Direction().Coord()
+        P, D = np.array(Pc), np.array(Dc)
 
         def f(p: np.ndarray) -> np.ndarray:
             return P + p[:, None] * D
+
+        def f1(x: float) -> list[float]:  # the same formula at one parameter, in plain floats
+            return [a + x * b for a, b in zip(Pc, Dc)]
         scale = max(1.0, *(abs(x) for x in Pc))
     elif kind == GeomAbs_Circle:
         circ = c.Circle()
         ax = circ.Position()
-        O, X, Y = (np.array(x.Coord()) for x in (ax.Location(), ax.XDirection(), ax.YDirection()))
+        Oc, Xc, Yc = (x.Coord() for x in (ax.Location(), ax.XDirection(), ax.YDirection()))
+        O, X, Y = np.array(Oc), np.array(Xc), np.array(Yc)
         R = circ.Radius()
 
         def f(p: np.ndarray) -> np.ndarray:
             return O + R * (np.cos(p)[:, None] * X + np.sin(p)[:, None] * Y)
-        scale = max(1.0, float(np.abs(O).max()) + R)
+
+        def f1(x: float) -> list[float]:
+            cx, sx = math.cos(x), math.sin(x)
+            return [o + R * (cx * a + sx * b) for o, a, b in zip(Oc, Xc, Yc)]
+        scale = max(1.0, max(abs(x) for x in Oc) + R)
     elif kind in (GeomAbs_BSplineCurve, GeomAbs_BezierCurve):
         nc = _NurbsCurve.of(c, dim)
         if nc is None:
@@ -786,10 +794,9 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
         return f
     else:
         return None
-    for x in (c.FirstParameter(), c.LastParameter()):  # checked at the ends (plain floats: no numpy overhead)
+    for x in (c.FirstParameter(), c.LastParameter()):  # the formula checked at the ends, in plain floats
         if abs(x) < 1e50:
-            ours = f(np.array([x]))[0].tolist()
-            if max(abs(a - b) for a, b in zip(ours, c.Value(x).Coord())) > 1e-12 * scale:
+            if max(abs(a - b) for a, b in zip(f1(x), c.Value(x).Coord())) > 1e-12 * scale:
                 return None  # pragma: no cover - a convention we do not know: evaluate by OCCT
     return f
 
