@@ -98,6 +98,27 @@ def romberg_length(points: np.ndarray) -> float:
     return _romberg_pair(p)[0]
 
 
+def _outline_serves_length(samples: int) -> bool:
+    """``samples = 4N + 1`` outline points with ``N_ROMBERG / 2 <= N <= N_ROMBERG``: their Romberg
+    length may serve (:meth:`BoundaryEdge.measure`)."""
+    m = samples - 1
+    return m % 4 == 0 and 2 * _ROMBERG_N <= m <= 4 * _ROMBERG_N
+
+
+def _romberg_pairs(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_romberg_pair` of several polylines with the same number of points at once,
+    ``P`` (k, 4N + 1, d): the arrays ``(R, R2)``."""
+    ls = []
+    for step in (4, 2, 1):
+        q = P[:, ::step]
+        d = q[:, 1:] - q[:, :-1]
+        ls.append(np.sqrt(np.einsum("eij,eij->ei", d, d)).sum(axis=1))
+    l1, l2, l4 = ls
+    r1 = (4 * l2 - l1) / 3
+    r2 = (4 * l4 - l2) / 3
+    return (16 * r2 - r1) / 15, r2
+
+
 def _romberg_pair(p: np.ndarray) -> tuple[float, float]:
     """``(R, R2)``: the Romberg length of :func:`romberg_length` and its O(h⁴) value
     ``R2 = (4 ℓ_4N - ℓ_2N) / 3`` (``|R2 - R|`` estimates R2's error)."""
@@ -164,7 +185,7 @@ class BoundaryEdge:
     dense_flat: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     _xyz: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
 
-    def measure(self) -> None:
+    def measure(self, pair: tuple[float, float] | None = None) -> None:
         """Sample the edge and measure its flat length (Romberg, :func:`romberg_length`).
 
         The ``samples`` outline points serve the length when they are ``4N + 1`` with
@@ -172,13 +193,16 @@ class BoundaryEdge:
         the h⁶ value ``R`` agree to ``|R2 - R| <= _ROMBERG_ACCEPT · R`` (R's error is then smaller
         by about h², far below round-off for a smooth edge); otherwise (a tight circle, a short
         ``samples``) the edge is sampled at ``4 _ROMBERG_N + 1`` points as before.
+
+        Args:
+            pair: ``(R, R2)`` of :func:`_romberg_pair` for ``self.flat`` already sampled (several
+                edges' pairs computed together, :func:`measure_panel`); None: sample and compute.
         """
-        ts = _unit_samples(self.samples)
-        self.flat = np.asarray(self.flat_fn(ts), dtype=float)
-        m = self.samples - 1
+        if pair is None:
+            self.flat = np.asarray(self.flat_fn(_unit_samples(self.samples)), dtype=float)
         length = None
-        if m % 4 == 0 and 2 * _ROMBERG_N <= m <= 4 * _ROMBERG_N:
-            length, r2 = _romberg_pair(self.flat)
+        if _outline_serves_length(self.samples):
+            length, r2 = pair if pair is not None else _romberg_pair(self.flat)
             if not (math.isfinite(length) and abs(r2 - length) <= _ROMBERG_ACCEPT * abs(length)):
                 length = None
         if length is None:
@@ -439,9 +463,19 @@ def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
 def measure_panel(panel: FlatPanel) -> DistortionReport:
     """Sample the panel's edges, measure flat vs 3-D quantities, set ``panel.report``; add label."""
     names, rel = [], []
+    # the outline samples of all edges, their Romberg lengths together per sample count
+    pairs: dict[int, tuple[float, float]] = {}
+    groups: dict[int, list[BoundaryEdge]] = {}
+    for e in (e for loop in panel.loops for e in loop):
+        e.flat = np.asarray(e.flat_fn(_unit_samples(e.samples)), dtype=float)
+        if _outline_serves_length(e.samples):
+            groups.setdefault(e.samples, []).append(e)
+    for es in groups.values():
+        R, R2 = _romberg_pairs(np.stack([e.flat for e in es]))
+        pairs.update({id(e): (float(a), float(b)) for e, a, b in zip(es, R, R2)})
     for li, loop in enumerate(panel.loops):
         for e in loop:
-            e.measure()
+            e.measure(pair=pairs.get(id(e), (math.nan, math.nan)))
             names.append(f"{panel.label}:{'outer' if li == 0 else f'hole{li}'}:{e.name}")
             L3 = float(e.length_3d)
             rel.append(abs(e.length_flat - L3) / L3 if L3 > 0 else abs(e.length_flat))
