@@ -65,7 +65,30 @@ SIDES = ("normal", "reverse")
 
 
 class SheetError(GHTError):
-    """A bad sheet value (thickness, K-factor, side) or a thickness the surface cannot carry."""
+    """A bad sheet value (thickness, K-factor, side) or a thickness the surface cannot carry.
+
+    A refusal of :func:`check_offset` also says which rule refused, for callers that weigh
+    refusals (the optimizer of ``ght_cad.design`` keeps the best refused candidate):
+
+    Attributes:
+        constraint: ``"radius"`` (``|K T| >= |ρ_0|``), ``"centre"`` (the material reaches a centre
+            of curvature, ``ρ_0 (ρ_0 + σ T) <= 0``), ``"apex"`` (material on the concave side of an
+            apex) or None (a bad value, not a refusal of the geometry).
+        radius: the bending radius ``|ρ_0|`` of the refused ruling (0 at an apex), or None.
+        limit: the bound it was held against (``|K T|`` for "radius", ``T`` for "centre", 0 for
+            "apex"), or None.
+    """
+
+    constraint: str | None = None
+    radius: float | None = None
+    limit: float | None = None
+
+
+def _refusal(message: str, constraint: str, radius: float, limit: float) -> SheetError:
+    """A :class:`SheetError` of :func:`check_offset` carrying the rule that refused."""
+    err = SheetError(message)
+    err.constraint, err.radius, err.limit = constraint, float(radius), float(limit)
+    return err
 
 
 def _finite_number(name: str, value: Any) -> float:
@@ -271,12 +294,15 @@ def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *,
         label: name for the message.
         sign: +1 when the sheet's normal is :func:`ruling_normal`, -1 when opposite (a face whose
             parameters run the other way).
+        samples: rulings checked, ``u = linspace(0, 1, samples)`` (both ends of each); the run's
+            checks (plate solid, unroll) use the default 513.
 
     Returns:
         The smallest bending radius ``min |ρ_0|`` (``inf`` for a flat surface).
 
     Raises:
-        SheetError: naming the ruling (u and the ruling end), its radius and the allowed bound.
+        SheetError: naming the ruling (u and the ruling end), its radius and the allowed bound; its
+            ``constraint``, ``radius`` and ``limit`` say which rule refused (:class:`SheetError`).
     """
     u = np.linspace(0.0, 1.0, samples)
     uu = np.concatenate([u, u])
@@ -293,10 +319,11 @@ def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *,
         bad = np.isfinite(mid) & ((mid * delta < 0) | (mid * out < 0))
         if bad.any():
             j = int(np.nonzero(apex)[0][np.argmax(bad)])
-            raise SheetError(
+            raise _refusal(
                 f"thickness={sheet.thickness!r} (side={sheet.side!r}) is not allowed on {label}: the ruling at "
                 f"u={uu[j]:.6g} ends in an apex ({'b' if vv[j] else 'a'} end, bending radius 0) and the material lies "
-                "on its concave side; allowed: the material on the convex side of an apex (flip the side)"
+                "on its concave side; allowed: the material on the convex side of an apex (flip the side)",
+                "apex", 0.0, 0.0,
             )
         rho = np.where(apex, np.inf, rho)
     finite = np.isfinite(rho)
@@ -306,18 +333,20 @@ def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *,
     rmin = float(abs(rho[i]))
     where = f"the ruling at u={uu[i]:.6g} ({'b' if vv[i] else 'a'} end)"
     if abs(delta) >= rmin:
-        raise SheetError(
+        raise _refusal(
             f"thickness={sheet.thickness!r} with k_factor={sheet.k_factor!r} is not allowed on {label}: the neutral "
             f"offset |K*T|={abs(delta):.6g} reaches the bending radius {rmin:.6g} of {where}; allowed |K*T| < "
-            f"{rmin:.6g} (the smallest radius of curvature across the rulings)"
+            f"{rmin:.6g} (the smallest radius of curvature across the rulings)",
+            "radius", rmin, abs(delta),
         )
     cross = finite & (rho * (rho + out) <= 0)
     if cross.any():
         j = int(np.argmin(np.where(cross, np.abs(rho), np.inf)))
-        raise SheetError(
+        raise _refusal(
             f"thickness={sheet.thickness!r} (side={sheet.side!r}) is not allowed on {label}: the material reaches the "
             f"centre of curvature of the ruling at u={uu[j]:.6g} ({'b' if vv[j] else 'a'} end), bending radius "
-            f"{abs(rho[j]):.6g}; allowed a thickness below {abs(rho[j]):.6g} on that side (or side flipped)"
+            f"{abs(rho[j]):.6g}; allowed a thickness below {abs(rho[j]):.6g} on that side (or side flipped)",
+            "centre", abs(float(rho[j])), sheet.thickness,
         )
     return rmin
 
