@@ -281,6 +281,45 @@ def bending_radius(surface: RuledSurface, u: Any, v: Any) -> np.ndarray:
         return np.where(np.abs(w) > 1e-13 * max(scale, 1e-300), s / np.where(w == 0, 1.0, w), np.inf)
 
 
+class _Memo:
+    """A ruled surface whose ``a``, ``b`` and ``ruling`` keep their results for repeated identical
+    calls (same parameter array, same derivative): :func:`check_offset` asks for the same jets
+    several times (the normal, the across-ruling speed, the apex test), and each answer is the
+    surface's own, so the check computes bit for bit what it computes without the memo. Results are
+    read-only copies. ``ruling`` is ``b - a`` from the kept values unless the surface overrides it."""
+
+    def __init__(self, surface: RuledSurface) -> None:
+        self._surface = surface
+        self._kept: dict[tuple[Any, ...], np.ndarray] = {}
+        self._own_ruling = type(surface).ruling is not RuledSurface.ruling
+
+    def _get(self, name: str, fn: Callable[[Any, int], np.ndarray], u: Any, derivative: int) -> np.ndarray:
+        uu = np.asarray(u)
+        if uu.dtype != np.float64:
+            return fn(u, derivative)
+        key = (name, int(derivative), uu.shape, uu.tobytes())
+        hit = self._kept.get(key)
+        if hit is None:
+            hit = np.array(fn(u, derivative), dtype=float)
+            hit.setflags(write=False)
+            self._kept[key] = hit
+        return hit
+
+    def a(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._get("a", self._surface.a, u, derivative)
+
+    def b(self, u: Any, derivative: int = 0) -> np.ndarray:
+        return self._get("b", self._surface.b, u, derivative)
+
+    def ruling(self, u: Any, derivative: int = 0) -> np.ndarray:
+        if self._own_ruling:
+            return self._get("g", self._surface.ruling, u, derivative)
+        return self.b(u, derivative) - self.a(u, derivative)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._surface, name)
+
+
 def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *, sign: float = 1.0, samples: int = 513) -> float:
     r"""Refuse a sheet the surface cannot carry (spec 6.1): ``|δ| ≥ |ρ_0|`` or material through a
     centre of curvature (``ρ_0 (ρ_0 + σ T) ≤ 0``), at ``samples`` rulings, both ruling ends. An
@@ -304,6 +343,7 @@ def check_offset(surface: RuledSurface, sheet: Sheet, label: str = "surface", *,
         SheetError: naming the ruling (u and the ruling end), its radius and the allowed bound; its
             ``constraint``, ``radius`` and ``limit`` say which rule refused (:class:`SheetError`).
     """
+    surface = _Memo(surface)  # type: ignore[assignment]  # the same jets are asked for several times
     u = np.linspace(0.0, 1.0, samples)
     uu = np.concatenate([u, u])
     vv = np.concatenate([np.zeros_like(u), np.ones_like(u)])
