@@ -189,6 +189,53 @@ def _is_composite(surface: Any) -> bool:
     return hasattr(surface, "segments") and hasattr(surface, "joints")
 
 
+def sheet_parts(surface: Any) -> list[Any]:
+    """The ruled surfaces a ``[sheet]`` is checked on and thickened: every strip of a composite,
+    else the surface itself (a developable loft as a whole, fans included)."""
+    return list(surface.segments) if _is_composite(surface) else [surface]
+
+
+def sheet_part_label(design: Design, i: int) -> str:
+    """Name of part ``i`` (0-based) of the design's plate in messages: ``"<design name> part <i+1>"``."""
+    return f"{design.name} part {i + 1}"
+
+
+def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int = 513) -> float:
+    r"""The sheet check the run applies to a built surface (spec 6.1), on every part.
+
+    For each part of :func:`sheet_parts` :func:`ght_cad.sheet.check_offset` (the rule the plate
+    solid and the flat pattern of ``ght-cad run`` apply, with their default ``samples = 513``
+    rulings, both ends of each): refused when the neutral offset reaches a bending radius,
+    ``|K T| >= |ρ_0|``, when the material reaches a centre of curvature, ``ρ_0 (ρ_0 + σ T) <= 0``, or
+    when the material lies on the concave side of an apex (``ρ_0 = 0``: a cone point, a loft fan).
+
+    Args:
+        design: the design (its ``[sheet]`` and its name for the messages).
+        surface: the design's built surface (``BuiltSurface.surface``).
+        sheet: a :class:`ght_cad.sheet.Sheet` to check instead of the design's (the optimizer
+            passes the sheet with its margin); None: the design's ``[sheet]``.
+        samples: rulings per part (>= 2).
+
+    Returns:
+        The smallest bending radius ``min |ρ_0|`` over all parts (``inf`` when flat, or when there
+        is no sheet or ``T = 0``: nothing to check).
+
+    Raises:
+        SheetError: the first part the sheet cannot be made on (the message names the part, the
+            ruling, its radius and the bound; ``constraint``, ``radius``, ``limit`` as attributes).
+    """
+    from ..sheet import check_offset
+
+    if sheet is None:
+        if design.sheet is None:
+            return math.inf
+        sheet = design.sheet.to_sheet()
+    if sheet.is_zero:
+        return math.inf
+    return min(check_offset(part, sheet, f"surface {sheet_part_label(design, i)!r}", samples=samples)
+               for i, part in enumerate(sheet_parts(surface)))
+
+
 def _developability_dict(surface: Any) -> dict[str, float]:
     """Developability degree of a surface; for a composite the worst strip per quantity
     (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed)."""

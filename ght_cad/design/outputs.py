@@ -11,7 +11,8 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from .build import BuiltSurface, _is_composite, build_curves, build_surfaces, surfaces_summary, surface_view
+from .build import (BuiltSurface, _is_composite, build_curves, build_surfaces, sheet_part_label, sheet_parts, surfaces_summary,
+                    surface_view)
 from .schema import Design, DesignError
 
 
@@ -176,8 +177,8 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
     from ..cad.sheet_solid import plate_solid
 
     sheet = d.sheet.to_sheet()
-    parts = built.surface.segments if _is_composite(built.surface) else [built.surface]
-    return [plate_solid(s, sheet, label=f"{d.name} part {i + 1}") for i, s in enumerate(parts)]
+    # the parts and labels of check_sheet (the optimizer's sheet rule is the same check on the same parts)
+    return [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
 
 
 def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:

@@ -46,6 +46,8 @@ def report_markdown(r: dict[str, Any]) -> str:
               f"{o['method']} on {o['objective']}: {_f(o['initial_value'], '.8g')} → {o['best_value']:.8g} in "
               f"{o['iterations']} iterations ({o['nfev']} evaluations, {o['time_s']:.2f} s); best "
               + ", ".join(f"{k} = {v:.6g}" for k, v in o["best_parameters"].items()), ""]
+        if o.get("sheet"):
+            L += _sheet_rule_lines(o["sheet"], r["units"])
         if o.get("strips"):
             L += [f"Per strip ({o['objective']} of its dual curve as built):", "",
                   "| strip | before | after | μ, ν, γ before | μ, ν, γ after |", "|---|---|---|---|---|"]
@@ -88,6 +90,28 @@ def report_markdown(r: dict[str, Any]) -> str:
         L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))
     L.append("")
     return "\n".join(L)
+
+
+def _sheet_rule_lines(sh: dict[str, Any], units: str) -> list[str]:
+    """The optimization's sheet rule in words: candidates refused, the start, the result's radius."""
+    by = ", ".join(f"{n} {k}" for k, n in sh["refused_by"].items() if n)
+    start = ("passes the sheet check" + (f" (smallest bending radius {_f(sh['initial_min_bending_radius'])} {units})"
+                                          if sh.get("initial_min_bending_radius") is not None else "")
+             if sh["initial_feasible"] else
+             f"is refused by the sheet check ({sh['initial_error']})" if sh["initial_feasible"] is False else
+             "gives no surface")
+    return [f"Sheet constraint (T = {sh['thickness']:.6g} {units}, K = {sh['k_factor']:.4g}, side {sh['side']}, "
+            f"|K·T| = {sh['k_t']:.6g} {units}): every candidate surface was checked against the sheet "
+            f"(margin {sh['margin']:g}); {sh['candidates_refused']} of {sh['candidates_checked']} refused"
+            + (f" ({by})" if by else "") + f", so the constraint was {'active' if sh['active'] else 'not active'}. "
+            f"The start design {start}. Smallest bending radius of the result: {_f(sh['min_bending_radius'])} {units} "
+            f"(= {_f(sh['min_radius_over_k_t'], '.6g')} × |K·T|); it would carry a sheet up to "
+            f"{_f(sh['thickness_factor'], '.6g')} × T" + (f", beyond that {_RULES.get(sh['limiting_rule'], sh['limiting_rule'])}"
+                                                       if sh.get("limiting_rule") else "") + ".", ""]
+
+
+_RULES = {"radius": "the neutral offset |K·T| would reach a bending radius",
+          "centre": "the material would reach a centre of curvature"}
 
 
 def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: dict[str, Any] | None,

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import GHTError
 from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, build_surfaces,
-                    surface_summary, surface_view, surfaces_summary)
+                    check_sheet, surface_summary, surface_view, surfaces_summary)
 from .optimize import optimize_design
 from .outputs import (_jsonable, brep_shapes, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
                       unroll_surfaces)
@@ -151,6 +151,10 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 # the file's values are one rejected candidate; the optimization may find admissible ones
                 report["developability_initial"] = None
                 report["initial_surface_error"] = " ".join(str(exc).split())
+            if design.optimize is None and built is not None:
+                # [sheet]: the plate's check (the one the B-rep and the flat pattern apply) before anything
+                # else is computed; with [optimize] every candidate is checked and so is the result
+                check_sheet(design, built.surface)
             # 3. optimization
             if design.optimize is not None:
                 step("optimize")
