@@ -431,6 +431,11 @@ def cmd_optimize(args: argparse.Namespace) -> int:
             f"{r['name']}: {r['method']} on {r['objective']}: best {r['best_value']:.8g} at "
             + ", ".join(f"{k}={v:.6g}" for k, v in r["best_parameters"].items())
         )
+        sh = r.get("sheet")
+        if sh:  # [sheet]: what the sheet rule did (docs/design-files.md)
+            s += (f"\n  sheet T={sh['thickness']:g}, |K*T|={sh['k_t']:.6g}: {sh['candidates_refused']} of "
+                  f"{sh['candidates_checked']} candidates refused; smallest bending radius {sh['min_bending_radius']:.6g} "
+                  f"(start: {'feasible' if sh['initial_feasible'] else 'refused' if sh['initial_feasible'] is False else 'no surface'})")
         out = _outputs_text(r)
         return s + ("\n" + out if out else "")
 
