@@ -363,3 +363,14 @@ def test_exact_gradient_path_refuses_like_the_values() -> None:
     assert f[0] == f0[0] and np.array_equal(G[0], G0[0]) and np.any(G[0] != 0)
     assert f[1] == math.inf and not G[1].any() and math.isfinite(f0[1])
     assert guard.checked == 2 and guard.refused["centre"] == 1
+
+
+def test_thickness_factor_refuses_bad_values() -> None:
+    d = design(QUARTER.format(method="pso", pop=4, it=1) + _sheet(4.0))
+    s = build_surface(d).surface
+    for kw, word in (({"rtol": 0.0}, "rtol=0.0"), ({"rtol": float("nan")}, "rtol=nan"), ({"upto": 1.5}, "upto=1.5")):
+        with pytest.raises(ValueError, match=word):
+            thickness_factor(d, s, **kw)
+    with pytest.raises(ValueError, match="key 'sheet'"):
+        thickness_factor(design(QUARTER.format(method="pso", pop=4, it=1)), s)
+    assert thickness_factor(d, s, upto=100.0) == (100.0, None)  # f = 120 > 100 passes: reported as upto

@@ -13,17 +13,18 @@ so a result on the boundary of the feasible set (a bending radius equal to ``|K 
 ``m |K T|`` inside it, and the strict check of the build (``|K T| < |ρ_0|``) still passes when
 the result is rebuilt the way the run builds it (a loft traced again, the curves rebuilt from the
 optimized parameters: the same surface to round-off, about 1e-12 relative). The optimizer's result
-is then checked exactly as the run will check it (:func:`_verified_radius`); if that check refused
-it, the next best accepted candidates are tried (the ``fallbacks`` of the report), so the returned
-shape parameters always pass the final check.
+is then built and checked exactly as the run will build and check it (:func:`_run_surface`,
+:func:`check_sheet` with the sheet itself); if that check refused it, the next best accepted
+candidates are tried (``final_check_fallbacks`` of the report), so the returned shape parameters
+always pass the final check.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 import heapq
 import itertools
+import math
+from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -63,7 +64,7 @@ class OptimizationOutcome:
     joints: list[dict[str, Any]] | None = None
     #: exact gradients evaluated (one per point; 0 with finite differences or a population method)
     njev: int = 0
-    #: ``[sheet]`` with T > 0 only: the sheet rule's record (:meth:`_SheetGuard.summary`): the sheet,
+    #: ``[sheet]`` with T > 0 only: the sheet rule's record (:func:`_sheet_summary`): the sheet,
     #: candidates checked and refused (per rule), the start's check, the result's smallest bending
     #: radius against ``|K T|``
     sheet: dict[str, Any] | None = None
@@ -493,9 +494,14 @@ def thickness_factor(design: Design, surface: Any, *, rtol: float = 1e-4, upto: 
     Raises:
         DesignError: the design has no sheet with T > 0.
         SheetError: the sheet itself is refused (``f < 1``).
+        GHTError: ``rtol`` not in (0, 1) or ``upto`` not a finite number > 2.
     """
     from ..sheet import Sheet, SheetError
 
+    if not (isinstance(rtol, (int, float)) and 0.0 < rtol < 1.0):
+        raise GHTError(f"rtol={rtol!r} is not allowed; it must be a number in (0, 1)")
+    if not (isinstance(upto, (int, float)) and math.isfinite(upto) and upto > 2.0):
+        raise GHTError(f"upto={upto!r} is not allowed; it must be a finite number > 2")
     if design.sheet is None or not design.sheet.thickness > 0:
         raise DesignError(f"{design.source}: key 'sheet': thickness_factor needs a [sheet] with thickness > 0")
     sh = design.sheet.to_sheet()
