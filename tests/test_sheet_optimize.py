@@ -374,3 +374,24 @@ def test_thickness_factor_refuses_bad_values() -> None:
     with pytest.raises(ValueError, match="key 'sheet'"):
         thickness_factor(design(QUARTER.format(method="pso", pop=4, it=1)), s)
     assert thickness_factor(d, s, upto=100.0) == (100.0, None)  # f = 120 > 100 passes: reported as upto
+
+
+def test_a_result_the_final_check_refuses_falls_back_to_the_next_best(monkeypatch) -> None:
+    import ght_cad.design.optimize as O
+
+    d = design(QUARTER.format(method="pso", pop=6, it=3) + _sheet(180.0, 1.0))
+    ref = optimize_design(d, progress=False)
+    real = O._run_surface
+    calls = []
+
+    def refuse_the_first_result(design_, curves, shape):
+        calls.append(dict(shape))
+        if len(calls) == 2:  # call 1: the start's check; call 2: the optimizer's result
+            raise SheetError("refused by the final check (test)")
+        return real(design_, curves, shape)
+
+    monkeypatch.setattr(O, "_run_surface", refuse_the_first_result)
+    o = optimize_design(d, progress=False)
+    assert calls[1] == ref.shape and o.sheet["final_check_fallbacks"] == 1
+    assert o.shape != ref.shape and ref.best_value <= o.best_value < o.initial_value  # the next best kept candidate
+    assert check_sheet(d, run_surface(d, o.shape)) == o.sheet["min_bending_radius"] > 180.0
