@@ -487,7 +487,7 @@ def face_area(
                 s_n, w_n = _inner_nodes_at(float(uu[0]), u_lo, u_breaks, u_span) if uu[0] != u_lo else (np.zeros(0),) * 2
                 if s_n.size:
                     f = grid(s_n, vv)
-                    P[i:i + m] = np.einsum("k,kj->j", w_n, f)
+                    P[i:i + m] = w_n @ f
                 general[i:i + m] = False
             i += m
         if general.any():

@@ -465,8 +465,12 @@ class _Nurbs:
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, 1, hv[iv])
         # equal weights: S_u = A_u / w, S_v = A_v / w, the density needs neither S nor W
         K = 3 if self.weight is not None else 4
-        P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu][..., :K]  # (i, v-span, e, f, k)
-        G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
+        if starts_u.size == 1:  # one u-span: no per-point copy of its coefficients
+            P = pt.reshape(1, starts_v.size, A, B, 4)[0][..., :K]  # (v-span, e, f, k)
+            G = [np.ascontiguousarray(np.einsum("ie,sefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
+        else:
+            P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu][..., :K]  # (i, v-span, e, f, k)
+            G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]
         ms, mv = s.size, v.size
         if K == 3 and self.pv == 1 and starts_v.size == 1:
             # degree 1 in v: S_u = U0 + y U1 (y = the patch's Chebyshev variable, T_1(y) = y) and
@@ -477,10 +481,10 @@ class _Nurbs:
             C0 = np.stack([U0[1] * Sv[2] - U0[2] * Sv[1], U0[2] * Sv[0] - U0[0] * Sv[2], U0[0] * Sv[1] - U0[1] * Sv[0]])
             C1 = np.stack([U1[1] * Sv[2] - U1[2] * Sv[1], U1[2] * Sv[0] - U1[0] * Sv[2], U1[0] * Sv[1] - U1[1] * Sv[0]])
             scale = 1.0 / (self.weight * self.weight)  # type: ignore[operator]
-            a, bq, c = (np.einsum("ki,ki->i", C0, C0) * scale, 2.0 * np.einsum("ki,ki->i", C0, C1) * scale,
-                        np.einsum("ki,ki->i", C1, C1) * scale)
+            abc = np.stack([np.einsum("ki,ki->i", C0, C0), 2.0 * np.einsum("ki,ki->i", C0, C1),
+                            np.einsum("ki,ki->i", C1, C1)], axis=1) * scale  # (i, 3)
             y = Tv[0][:, 1]
-            r = a[:, None] + y[None, :] * (bq[:, None] + y[None, :] * c[:, None])
+            r = abc @ np.stack([np.ones_like(y), y, y * y])  # a + b y + c y² on the grid, one product
             return np.sqrt(np.maximum(r, 0.0, out=r), out=r)
         keys = ((1, 0), (0, 1)) if K == 3 else ((0, 0), (1, 0), (0, 1))
         spans = np.unique(iv)
