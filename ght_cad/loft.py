@@ -39,6 +39,7 @@ from typing import Any, Callable, Mapping, Protocol, Sequence, runtime_checkable
 import numpy as np
 
 from ._validate import as_parameter_array
+from ._vec import cross as _cross3
 from .curve import GHTCurve, gauss_legendre
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from .optimize.problems import Problem
@@ -1625,13 +1626,6 @@ def _rail_parameter_jets(curve: GHTCurve, t: np.ndarray, k: int, reverse: bool) 
     J = CurveParameterJets(x, curve.control_points, k)(np.array([curve.mu]), np.array([curve.nu]),
                                                        np.array([curve.gamma]), tuple(range(k + 1)))
     return [((-1.0) ** q if reverse else 1.0) * J[q][:, 0] for q in range(k + 1)]
-
-
-def _cross3(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``x × y`` over the last axis with broadcasting (explicit: np.cross is slow on small arrays)."""
-    x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
-    y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
-    return np.stack([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0], axis=-1)
 
 
 def _det6(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:

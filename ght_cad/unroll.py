@@ -264,10 +264,6 @@ class RuledDevelopment:
         pts = np.concatenate([A, A + L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)])
         self._t = -pts.min(axis=0)
 
-    # -- raw (unplaced) series ---------------------------------------------------------
-    def _raw_A(self, u: np.ndarray) -> np.ndarray:
-        return self._A(u)
-
     def phi(self, u: Any) -> np.ndarray:
         """Direction angle φ(u) of the flat ruling (after placement), radians."""
         uu = np.atleast_1d(np.asarray(u, dtype=float))

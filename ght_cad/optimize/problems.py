@@ -29,6 +29,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from .._vec import cross as _cross
 from ..basis import _compact_differences, basis_from_jets, bernstein, parameter_jets
 from ..curve import GHTCurve, gauss_legendre
 from ..errors import GHTError
@@ -310,16 +311,6 @@ class Problem:
     def report(self, x: Any) -> dict[str, float]:
         """Measures of the design at ``x`` (for before/after tables)."""
         return {"objective": self.value(x)}
-
-
-_I1 = np.array([1, 2, 0])
-_I2 = np.array([2, 0, 1])
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` over the last axis (length 3) with broadcasting: ``a[1] b[2] - a[2] b[1]``, ... per
-    component, the arithmetic of ``numpy.cross`` (same results bit for bit) without its axis handling."""
-    return np.take(a, _I1, axis=-1) * np.take(b, _I2, axis=-1) - np.take(a, _I2, axis=-1) * np.take(b, _I1, axis=-1)
 
 
 def _split(all_params: np.ndarray, start: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
