@@ -250,7 +250,11 @@ def _figures(report: dict[str, Any] | None) -> dict[str, Any]:
     """Key figures of a run report: area, θ_max, pattern error, optimization, best value."""
     r = report or {}
     pat = r.get("flat_pattern") or {}
-    errs = [v for v in (pat.get("errors") or {}).values() if isinstance(v, (int, float))]
+    errors = pat.get("errors") or {}
+    # the largest RELATIVE error: the pattern's own "max" (``angle_deg`` is an angle in degrees,
+    # the metric check's difference-stencil residual, not a relative error)
+    errs = [v for k, v in errors.items() if k == "max" and isinstance(v, (int, float))] or \
+        [v for k, v in errors.items() if k != "angle_deg" and isinstance(v, (int, float))]
     opt = r.get("optimization")
     return {
         "area": pat.get("area"),

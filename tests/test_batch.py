@@ -418,3 +418,15 @@ def test_sweep_expansion_grid_zip_and_errors():
                       ({"name": [1]}, "not a number")]:
         with pytest.raises(SweepError, match=__import__("re").escape(what)):
             expand_sweep({**base, "sweep": bad}, "f.toml")
+
+
+def test_pattern_error_is_the_largest_relative_error_not_the_angle() -> None:
+    """``pattern_error`` is the pattern's relative ``max``; ``angle_deg`` (degrees, the metric
+    check's difference residual, e.g. 3e-9 on a sheet's neutral surface) is not a relative error."""
+    from ght_cad.batch import _figures
+
+    errors = {"boundary_length": 1.2e-16, "ruling_length": 2.5e-16, "area": 1.8e-16, "angle_deg": 3.1e-9, "max": 2.5e-16}
+    assert _figures({"flat_pattern": {"errors": errors}})["pattern_error"] == 2.5e-16
+    del errors["max"]  # an older report without "max": the largest of the relative ones
+    assert _figures({"flat_pattern": {"errors": errors}})["pattern_error"] == 2.5e-16
+    assert _figures({})["pattern_error"] is None
