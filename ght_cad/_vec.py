@@ -8,6 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
+try:  # numpy.einsum without its Python wrapper (the same C routine numpy.einsum calls when not optimizing)
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # numpy < 2
+    try:
+        from numpy.core.multiarray import c_einsum as _einsum
+    except ImportError:  # pragma: no cover - a numpy without it
+        _einsum = np.einsum
+
 
 def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``x × y`` over the last axis (length 3), with broadcasting.
@@ -26,9 +34,9 @@ def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``Σ_k x_k y_k`` over the last axis (row-wise dot product)."""
-    return np.einsum("...k,...k->...", x, y)
+    return _einsum("...k,...k->...", x, y)
 
 
 def norm(x: np.ndarray) -> np.ndarray:
     """Euclidean norm over the last axis, ``sqrt(Σ_k x_k²)``."""
-    return np.sqrt(np.einsum("...k,...k->...", x, x))
+    return np.sqrt(_einsum("...k,...k->...", x, x))

@@ -217,7 +217,7 @@ class FaceRuledSurface(RuledSurface):
     def value_and_ends(self, t: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``S(u, v)`` at points on the rulings at ``t``, evaluated together with the ruling ends
         ``a(t)``, ``b(t)`` (kept for :meth:`a`, :meth:`b`) in one surface evaluation."""
-        t = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        t = _flat1(t)
         key = t.tobytes()
         if key in self._jets:
             return self.ev.value(u, v)
@@ -235,7 +235,7 @@ class FaceRuledSurface(RuledSurface):
         return p[:n]
 
     def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        t = _flat1(t)
         if derivative > 2:
             raise GHTError(f"derivative={derivative} is not available for faces; allowed 0, 1, 2")
         d = self._jet(t, derivative)
@@ -764,7 +764,7 @@ class _MapBatch:
         uu, vv = broadcast_uv(u, v)
         if uu.ndim == 1:
             for bu, bv, F in self.done:
-                if bu.size == uu.size and np.array_equal(bu, uu) and np.array_equal(bv, vv):
+                if (bu is uu and bv is vv) or (bu.size == uu.size and (bu == uu).all() and (bv == vv).all()):
                     return F.copy()
         return self.fmap(uu, vv)
 
@@ -1065,7 +1065,7 @@ def _strided_memo(fun: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarr
         t0, r0 = last
         if t0 is not None and t.ndim == 1 and t.size > 1 and t0.size >= t.size and (t0.size - 1) % (t.size - 1) == 0:
             k = (t0.size - 1) // (t.size - 1)
-            if np.array_equal(t0[::k], t):
+            if (t0[::k] == t).all():  # numpy.array_equal (same shapes here), without its overhead
                 return r0[::k].copy()
         r = np.asarray(fun(t), dtype=float)
         last[0], last[1] = t.copy(), r
@@ -1088,9 +1088,22 @@ def _edge_sample_uv(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[C
     if not edges or samples < 2:
         return [], t, (np.zeros(0), np.zeros(0))
     uvs = [uvf(t) for _, uvf in edges]
-    us = [np.broadcast_to(np.asarray(u, dtype=float), t.shape) for u, _ in uvs]
-    vs = [np.broadcast_to(np.asarray(v, dtype=float), t.shape) for _, v in uvs]
+    us = [_as_shape(u, t.shape) for u, _ in uvs]
+    vs = [_as_shape(v, t.shape) for _, v in uvs]
     return [e for e, _ in edges], t, (np.concatenate(us), np.concatenate(vs))
+
+
+def _flat1(t: Any) -> np.ndarray:
+    """``t`` as a 1-D float array (``np.atleast_1d(np.asarray(t, float)).ravel()``, the same
+    array object when it is one already)."""
+    t = np.asarray(t, dtype=float)
+    return t if t.ndim == 1 else t.reshape(-1)
+
+
+def _as_shape(x: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``np.broadcast_to(np.asarray(x, float), shape)``, the array itself when it has that shape."""
+    x = np.asarray(x, dtype=float)
+    return x if x.shape == shape else np.broadcast_to(x, shape)
 
 
 def _seed_edge_samples(edges: list[BoundaryEdge], t: np.ndarray, flat: np.ndarray) -> None:

@@ -365,8 +365,13 @@ def broadcast_uv(u: Any, v: Any) -> tuple[np.ndarray, np.ndarray]:
         u, v: scalars or arrays.
 
     Returns:
-        ``(u, v)`` as float arrays of at least one dimension, broadcast to a common shape.
+        ``(u, v)`` as float arrays of at least one dimension, broadcast to a common shape (two
+        float arrays of the same shape are returned as they are, as ``numpy.broadcast_arrays``
+        does, without its per-call overhead: this sits on every map call of the unrolling).
     """
+    if type(u) is np.ndarray and type(v) is np.ndarray and u.ndim and u.shape == v.shape \
+            and u.dtype == np.float64 and v.dtype == np.float64:
+        return u, v
     return np.broadcast_arrays(np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float)))
 
 

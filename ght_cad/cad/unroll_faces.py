@@ -935,7 +935,9 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     @_memo
     def duv(t: np.ndarray) -> np.ndarray:
         if line2:
-            return np.broadcast_to(d2 * (p1 - p0), (t.size, 2)).copy()
+            out = np.empty((t.size, 2))
+            out[:] = d2 * (p1 - p0)
+            return out
         if f2 is not None and hasattr(f2, "derivative"):
             return f2.derivative(p0 + t * (p1 - p0)) * (p1 - p0)
         p, vec = gp_Pnt2d(), gp_Vec2d()
