@@ -27,6 +27,7 @@ __all__ = [
     "fit_function",
     "curve_to_bspline",
     "clamped_knots",
+    "join_bsplines",
 ]
 
 
@@ -592,6 +593,70 @@ def fit_function(
             "end_orders": (r0 - 1, r1 - 1),
             "tol": tol,
         },
+    )
+
+
+def join_bsplines(pieces: Sequence[BSplineCurveData], breaks: Sequence[float]) -> BSplineCurveData:
+    r"""One B-spline from clamped pieces of one degree, piece ``k`` moved onto ``[λ_k, λ_{k+1}]``.
+
+    Piece ``k`` (knots ``x_j`` on ``[x_0, x_end]``, poles ``P^k_i``) becomes
+    ``C(λ) = C_k((λ - λ_k) / (λ_{k+1} - λ_k))`` on its interval: its knots map affinely
+    ``λ = λ_k + (x - x_0) / (x_end - x_0) (λ_{k+1} - λ_k)`` and every joint ``λ_k`` is a knot of
+    multiplicity ``p`` (C0): the basis functions of a span next to a knot of multiplicity ``p``
+    only see the knots of their own piece, so on each interval the joined curve is the piece
+    itself (to rounding of the knot map), and the joint is one shared pole. The shared pole is the
+    left piece's last pole; the gap ``g_k = |P^k_last - P^{k+1}_0|`` to the right piece's first
+    pole (0 for pieces that interpolate one continuous function at the joint, up to its rounding)
+    is added to the deviation: ``max_deviation = max_k dev_k + max_k g_k``.
+
+    Args:
+        pieces: non-rational :class:`BSplineCurveData` of one degree and dimension.
+        breaks: ``λ_0 < λ_1 < ... < λ_P``, one more than ``pieces``.
+
+    Returns:
+        :class:`BSplineCurveData` on ``[λ_0, λ_P]``; ``info["pieces"]`` the pieces' infos,
+        ``info["joint_gaps"]`` the ``g_k``, ``info["breaks"]`` the ``λ_k``, ``info["spans"]`` the
+        total number of spans.
+
+    Raises:
+        GHTError: no pieces, a rational piece, mixed degrees or dimensions, or breaks that are not
+            increasing or do not match the pieces.
+    """
+    ps = list(pieces)
+    lam = np.asarray(breaks, dtype=float)
+    if not ps:
+        raise GHTError("join_bsplines needs at least one piece")
+    if lam.ndim != 1 or lam.size != len(ps) + 1 or not np.all(np.isfinite(lam)) or np.any(np.diff(lam) <= 0):
+        raise GHTError(f"breaks={lam.tolist()!r} are not allowed; give {len(ps) + 1} increasing finite parameters "
+                       f"for {len(ps)} pieces")
+    p, dim = ps[0].degree, ps[0].dim
+    for i, c in enumerate(ps):
+        if c.weights is not None:
+            raise GHTError(f"piece #{i + 1} is rational; join_bsplines joins non-rational pieces only")
+        if c.degree != p or c.dim != dim:
+            raise GHTError(f"piece #{i + 1} has degree {c.degree}, dimension {c.dim}; the first has degree {p}, "
+                           f"dimension {dim}: all pieces must agree")
+    knots = [np.full(p + 1, lam[0])]
+    poles = []
+    gaps = []
+    for k, c in enumerate(ps):
+        x = c.knots
+        x0, x1 = x[0], x[-1]
+        inner = x[p + 1 : x.size - p - 1]
+        knots.append(lam[k] + (inner - x0) / (x1 - x0) * (lam[k + 1] - lam[k]))
+        knots.append(np.full(p if k < len(ps) - 1 else p + 1, lam[k + 1]))
+        if k == 0:
+            poles.append(c.poles)
+        else:
+            gaps.append(float(np.linalg.norm(c.poles[0] - poles[-1][-1])))
+            poles.append(c.poles[1:])
+    devs = [c.max_deviation for c in ps]
+    dev = None if any(d is None for d in devs) else float(max(devs)) + (max(gaps) if gaps else 0.0)
+    full = np.concatenate(knots)
+    return BSplineCurveData(
+        np.vstack(poles), full, p, max_deviation=dev,
+        info={"pieces": [dict(c.info) for c in ps], "joint_gaps": gaps, "breaks": lam.tolist(),
+              "spans": int(knots_and_multiplicities(full)[0].size - 1)},
     )
 
 

@@ -431,6 +431,12 @@ class OffsetSurfaceAdapter:
     central differences of the first. A cylinder of radius R keeps its kind with radius
     ``R + δ_r`` and a cone (reference radius R, semi-angle α) radius ``R + δ_r cos α`` (same α),
     ``δ_r`` the offset towards the outside of the axis, so the closed-form maps stay exact.
+
+    Where ``N`` vanishes (``|N| <= 1e-9 |S_u| |S_v|``: a collapsed boundary row, the apex of a
+    cone-like fan, where ``S_u = 0``) ``n, n_u, n_v`` are taken ``1e-6`` of the half box inward
+    across the collapsed direction (v when ``|S_u| < |S_v|``, else u), on the same ruling of a
+    developable: its normal is constant along the ruling, so that is the limit (the offset of an
+    apex is then the arc ``P + δ n(u)``, not NaN).
     """
 
     def __init__(self, base: Any, delta: float, orientation: float = 1.0, bounds: Sequence[float] | None = None) -> None:
@@ -442,43 +448,64 @@ class OffsetSurfaceAdapter:
         self.semi_angle = base.semi_angle
         self.radius = base.radius
         b = bounds if bounds is not None else (0.0, 1.0, 0.0, 1.0)
+        self._box = tuple(float(x) for x in b)
         self._h = (1e-5 * (b[1] - b[0]), 1e-5 * (b[3] - b[2]))
         if self.kind in ("cylinder", "cone"):
             u = np.array([0.5 * (b[0] + b[1])])
             v = np.array([0.5 * (b[2] + b[3])])
             d = base.d2(u, v)
             outward = -d[3][0]  # S_uu points to the axis for a cylinder and a cone
-            n = self._normal(d)[0][0]
+            n = self._normal(d, u, v)[0][0]
             dr = self.delta * (1.0 if float(n @ outward) > 0 else -1.0)
             self.radius = base.radius + (dr if self.kind == "cylinder" else dr * math.cos(base.semi_angle))
 
-    def _normal(self, d: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(n, n_u, n_v) from ``[S, S_u, S_v, S_uu, S_vv, S_uv]``."""
+    @staticmethod
+    def _frame(d: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(n, n_u, n_v, degenerate) from ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` (orientation not applied)."""
         N = np.cross(d[1], d[2])
         Nl = np.linalg.norm(N, axis=1)[:, None]
-        n = N / Nl
-        Nu = np.cross(d[3], d[2]) + np.cross(d[1], d[5])
-        Nv = np.cross(d[5], d[2]) + np.cross(d[1], d[4])
-        nu = (Nu - n * np.einsum("ij,ij->i", n, Nu)[:, None]) / Nl
-        nv = (Nv - n * np.einsum("ij,ij->i", n, Nv)[:, None]) / Nl
+        bad = Nl[:, 0] <= 1e-9 * np.linalg.norm(d[1], axis=1) * np.linalg.norm(d[2], axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = N / Nl
+            Nu = np.cross(d[3], d[2]) + np.cross(d[1], d[5])
+            Nv = np.cross(d[5], d[2]) + np.cross(d[1], d[4])
+            nu = (Nu - n * np.einsum("ij,ij->i", n, Nu)[:, None]) / Nl
+            nv = (Nv - n * np.einsum("ij,ij->i", n, Nv)[:, None]) / Nl
+        return n, nu, nv, bad
+
+    def _normal(self, d: list[np.ndarray], u: Any, v: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(n, n_u, n_v) at the points ``(u, v)`` whose base derivatives are ``d`` (class doc:
+        collapsed rows take the frame 1e-6 of the half box inward)."""
+        n, nu, nv, bad = self._frame(d)
+        if bad.any():
+            uu = np.broadcast_to(np.asarray(u, dtype=float), bad.shape)[bad]
+            vv = np.broadcast_to(np.asarray(v, dtype=float), bad.shape)[bad]
+            u0, u1, v0, v1 = self._box
+            uc, vc = 0.5 * (u0 + u1), 0.5 * (v0 + v1)
+            across_v = np.linalg.norm(d[1][bad], axis=1) < np.linalg.norm(d[2][bad], axis=1)
+            uu = np.where(across_v, uu, uu + 1e-6 * (uc - uu))
+            vv = np.where(across_v, vv + 1e-6 * (vc - vv), vv)
+            n2, nu2, nv2, _ = self._frame(self.base.d2(uu, vv))
+            n, nu, nv = n.copy(), nu.copy(), nv.copy()
+            n[bad], nu[bad], nv[bad] = n2, nu2, nv2
         return self.o * n, self.o * nu, self.o * nv
 
     def normal(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The sheet's unit normal ``n`` at the points."""
-        return self._normal(self.base.d2(u, v))[0]
+        return self._normal(self.base.d2(u, v), u, v)[0]
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         d = self.base.d2(u, v)
-        return d[0] + self.delta * self._normal(d)[0]
+        return d[0] + self.delta * self._normal(d, u, v)[0]
 
     def d1(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
         d = self.base.d2(u, v)
-        _, nu, nv = self._normal(d)
+        _, nu, nv = self._normal(d, u, v)
         return [d[1] + self.delta * nu, d[2] + self.delta * nv]
 
     def d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
         d = self.base.d2(u, v)
-        n, nu, nv = self._normal(d)
+        n, nu, nv = self._normal(d, u, v)
         hu, hv = self._h
         pu, mu_ = self.d1(u + hu, v), self.d1(u - hu, v)
         pv, mv = self.d1(u, v + hv), self.d1(u, v - hv)

@@ -33,6 +33,7 @@ __all__ = [
     "make_face",
     "is_valid",
     "volume",
+    "has_c0_faces",
     "write_step",
     "read_step",
     "unwrap",
@@ -134,15 +135,53 @@ def make_face(data: BSplineSurfaceData, tolerance: float = 1e-7) -> Any:
 def volume(shape: Any) -> float:
     """Volume of a solid (build123d, cadquery or OCP) by OCCT's default Gauss integration.
 
+    The default rule integrates a B-spline face with ONE Gauss rule over its whole parameter box
+    (order ``2 (p + 1) (spans)``, at most 61 points, not split at the knots), so a face that is
+    only C0 at an inner knot (the joint rulings of a loft's fans, knots of multiplicity p) is
+    integrated across a kink: 1.5e-3 relative error on a hull plate, 4.6e-2 on a hopper. A
+    shape with such a face is therefore integrated on a copy whose faces are split at their C0
+    knots (``ShapeUpgrade_ShapeDivideContinuity``, criterion C1), every piece smooth; a shape
+    without one is integrated as it is (the same numbers as before).
+
     The adaptive ``BRepGProp.VolumeProperties_s(shape, props, Eps)`` variant scattered by about 1e-5
     relative on GHT solids while reporting 1e-11, so it is not used.
     """
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
 
+    s = unwrap(shape)
+    if has_c0_faces(s):
+        from OCP.GeomAbs import GeomAbs_C1
+        from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideContinuity
+
+        div = ShapeUpgrade_ShapeDivideContinuity(s)
+        div.SetBoundaryCriterion(GeomAbs_C1)
+        div.SetPCurveCriterion(GeomAbs_C1)
+        div.SetSurfaceCriterion(GeomAbs_C1)
+        div.Perform()
+        s = div.Result()
     props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(unwrap(shape), props)
+    BRepGProp.VolumeProperties_s(s, props)
     return float(props.Mass())
+
+
+def has_c0_faces(shape: Any) -> bool:
+    """Whether a face of the shape lies on a surface that is only C0 inside its box
+    (``BRepAdaptor_Surface.UContinuity``/``VContinuity`` is ``GeomAbs_C0``: e.g. a B-spline with an
+    inner knot of multiplicity p)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.GeomAbs import GeomAbs_C0
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    exp = TopExp_Explorer(unwrap(shape), TopAbs_FACE)
+    while exp.More():
+        ad = BRepAdaptor_Surface(TopoDS.Face_s(exp.Current()))
+        if ad.UContinuity() == GeomAbs_C0 or ad.VContinuity() == GeomAbs_C0:
+            return True
+        exp.Next()
+    return False
 
 
 def is_valid(shape: Any) -> bool:

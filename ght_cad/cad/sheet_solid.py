@@ -1,13 +1,32 @@
 r"""The sheet as a solid plate (spec 6.1) through OCCT, and plates read back from STEP.
 
-:func:`plate_solid` thickens the design face (the exact B-spline face of a developable, or any
-build123d/cadquery/OCP face) by the sheet thickness ``T`` on the material side with
-``BRepOffset_MakeOffset`` (skin mode, thickening: the outside face is the offset surface
-``S + σ T n``, the side faces are swept along the normals of the boundary edges). Faces are
-classified by the distance of their parameter-box centre point from the design surface: below
-``T/4`` the inside face, above ``3T/4`` the outside face, the rest the edge faces. For a developable surface the B-spline face is
-fitted with a tolerance of ``3e-7 T`` (a fit deviation ``d`` changes the volume by ``d / T``
-relative: a thin plate needs a fit far tighter than the surface's size).
+:func:`plate_solid` makes the plate of thickness ``T`` on the material side of the design surface.
+
+* A developable :class:`~ght_cad.ruled.RuledSurface` (``method="exact"``, the default) gets its
+  plate built exactly: the region ``{X(u, v) + t n(u), t between 0 and σT}`` (n is constant along
+  each ruling) is bounded by six ruled B-spline faces from ONE joint fit of the four boundary
+  curves ``a, b, a + σT n, b + σT n`` (:func:`ght_cad.plate.plate_bspline`, tolerance
+  ``3e-7 T``): ``inside`` (the design surface), ``outside`` (the offset ``S + σT n``, again
+  developable with the same rulings), the two rail walls ``c(u) + t n(u)`` (over a fan's apex
+  ``P`` the cone patch between ``P`` and the arc ``P + σT n(u)``) and the two planar end walls.
+  Faces that meet share their boundary curves pole for pole; they are sewn
+  (``BRepBuilderAPI_Sewing``), made a solid (``BRepBuilderAPI_MakeSolid``), oriented
+  (``ShapeFix_Solid``) and checked (``BRepCheck_Analyzer``). A surface with ``breakpoints`` (a
+  loft's fans and main part) gets one face per side all the same: its pieces are fitted
+  separately and joined with knots of multiplicity p (C0 across the joint rulings), so the faces
+  keep their names and a reader finds one inside face to unroll. OCCT's thickening
+  (``BRepOffset_MakeOffset``) fails on such C0 faces and at a fan's apex.
+* ``method="offset"`` (a RuledSurface's single B-spline face, fit tolerance ``3e-7 T``) and any
+  build123d/cadquery/OCP face are thickened by ``BRepOffset_MakeOffset`` (skin mode, thickening:
+  the outside face is the offset surface ``S + σ T n``, the side faces are swept along the
+  normals of the boundary edges). Faces are classified by the distance of their parameter-box
+  centre point from the design surface: below ``T/4`` the inside face, above ``3T/4`` the
+  outside face, the rest the edge faces.
+
+A fit deviation ``d`` changes the volume by about ``d / T`` relative, so a thin plate needs a fit
+far tighter than the surface's size; measured: the exact plates of a quarter cylinder, a cone
+frustum and the demo strip are within 7e-10 of their closed-form volumes
+(:func:`ght_cad.plate.plate_volume`), the thickened ones within 4e-8 to 9e-8.
 
 :func:`write_plate_step` writes the solid through XCAF (``STEPCAFControl_Writer``) with the faces
 named ``inside``, ``outside`` and ``edge1..edgeN`` (STEP ``ADVANCED_FACE`` names);
@@ -41,7 +60,11 @@ from ..ruled import RuledSurface
 from ..sheet import Sheet, SheetError, make_sheet
 from .occ import is_valid, quiet_occt, unwrap
 
-__all__ = ["PlateSolid", "plate_solid", "write_plate_step", "read_step_face_names", "plate_faces", "PlateFaces"]
+#: how :func:`plate_solid` makes the solid of a RuledSurface: "exact" (its six faces built and sewn)
+#: or "offset" (OCCT's thickening of its B-spline face)
+PLATE_METHODS = ("exact", "offset")
+
+__all__ = ["PLATE_METHODS", "PlateSolid", "plate_solid", "write_plate_step", "read_step_face_names", "plate_faces", "PlateFaces"]
 
 
 @dataclass
@@ -52,8 +75,11 @@ class PlateSolid:
         solid: the OCP ``TopoDS_Solid``.
         inside: the design face (inside face of the sheet).
         outside: the offset face ``S + σ T n``.
-        edges: the side faces.
+        edges: the side faces (exact plate: ``[wall_a, end1, wall_b, end0]``, the walls over
+            boundary a, the end ruling u = 1, boundary b and the end ruling u = 0).
         sheet: the sheet.
+        data: the exact plate's :class:`ght_cad.plate.PlateBSplineData` (None when thickened by
+            OCCT).
     """
 
     solid: TopoDS_Shape
@@ -61,6 +87,7 @@ class PlateSolid:
     outside: TopoDS_Face
     edges: list[TopoDS_Face]
     sheet: Sheet
+    data: Any = None
 
     def named_faces(self) -> list[tuple[str, TopoDS_Face]]:
         """``[("inside", f), ("outside", f), ("edge1", f), ...]``."""
@@ -68,7 +95,8 @@ class PlateSolid:
 
     @property
     def volume(self) -> float:
-        """Volume by OCCT's Gauss integration (:func:`ght_cad.cad.occ.volume`)."""
+        """Volume by OCCT's Gauss integration (:func:`ght_cad.cad.occ.volume`: faces that are only
+        C0 at inner knots, a loft's joint rulings, integrated piece by piece)."""
         from .occ import volume
 
         return volume(self.solid)
@@ -126,32 +154,48 @@ def plate_solid(
     k_factor: float | None = None,
     side: str = "normal",
     label: str = "plate",
+    method: str = "exact",
 ) -> PlateSolid:
     r"""The plate of thickness T on the design surface as a valid solid (module doc).
 
+    For a RuledSurface with ``method="exact"`` the solid is the region
+    ``{X(u, v) + t n(u) : t between 0 and σT}`` bounded by its six exact faces, volume
+    ``V = T A + σ (T²/2) ∫ 2H dA`` (:func:`ght_cad.plate.plate_volume`).
+
     Args:
-        surface_or_face: a developable :class:`~ght_cad.ruled.RuledSurface` (made into its exact
-            B-spline face, fit tolerance ``3e-7 T``) or a build123d/cadquery/OCP face.
+        surface_or_face: a developable :class:`~ght_cad.ruled.RuledSurface` (fans and other
+            breakpoints included) or a build123d/cadquery/OCP face (thickened by OCCT).
         sheet: the sheet, or give ``thickness``, ``k_factor``, ``side``
             (:func:`ght_cad.sheet.make_sheet`; K does not change the solid).
         label: name for messages.
+        method: for a RuledSurface: ``"exact"`` (the six faces built and sewn, module doc) or
+            ``"offset"`` (OCCT's thickening of its single B-spline face; fails on a loft with
+            fans). Faces are always thickened by OCCT.
 
     Returns:
-        :class:`PlateSolid` (``BRepCheck_Analyzer`` valid).
+        :class:`PlateSolid` (``BRepCheck_Analyzer`` valid); for the exact plate
+        ``edges = [wall_a, end1, wall_b, end0]`` and ``data`` its
+        :class:`ght_cad.plate.PlateBSplineData`.
 
     Raises:
-        SheetError: no thickness, T = 0, or a thickness beyond a bending radius (before OCCT runs).
-        GHTError: OCCT failed to make a valid solid.
+        SheetError: no thickness, T = 0, or a thickness beyond a bending radius or on the concave
+            side of an apex (:func:`ght_cad.sheet.check_offset`, before OCCT runs).
+        GHTError: an unknown ``method``; OCCT failed to make a valid solid.
     """
+    if method not in PLATE_METHODS:
+        raise GHTError(f"method={method!r} is not allowed; allowed: {', '.join(repr(m) for m in PLATE_METHODS)}")
     if sheet is None:
         sheet = make_sheet(thickness, k_factor, side=side)
     if sheet is None or sheet.is_zero:
         raise SheetError(f"thickness={None if sheet is None else sheet.thickness!r} is not allowed for a solid plate; give a thickness > 0")
     if isinstance(surface_or_face, RuledSurface):
         from ..sheet import check_offset
-        from .developable_faces import developable_face
 
         check_offset(surface_or_face, sheet, f"surface {label!r}")
+        if method == "exact":
+            return _exact_plate(surface_or_face, sheet, label)
+        from .developable_faces import developable_face
+
         face = unwrap(developable_face(surface_or_face, tol=3e-7 * sheet.thickness))
     else:
         shape = unwrap(surface_or_face)
@@ -162,6 +206,11 @@ def plate_solid(
             raise GHTError(f"the shape has {len(faces)} faces; a plate is made from exactly one face")
         face = faces[0]
         _face_sheet_check(face, sheet, label)
+    return _offset_plate(face, sheet, label)
+
+
+def _offset_plate(face: TopoDS_Face, sheet: Sheet, label: str) -> PlateSolid:
+    """The plate of one CAD face by OCCT's thickening (``BRepOffset_MakeOffset``, module doc)."""
     T = sheet.thickness
     # OCCT's offset tolerance: 1e-7 first; a few faces (measured: a quarter cone frustum r 200..400,
     # T = 4, fitted as a degree-5 B-spline) give an invalid solid there and a valid one at 1e-6, so
@@ -200,6 +249,70 @@ def plate_solid(
     if inside is None or outside is None:
         raise GHTError(f"the thickened plate {label!r} has no inside/outside face pair")
     return PlateSolid(solid, inside, outside, edges, sheet)
+
+
+def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
+    """The exact plate of a developable (module doc): the six B-spline faces of
+    :func:`ght_cad.plate.plate_bspline`, sewn, made a solid and oriented."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+    from OCP.ShapeFix import ShapeFix_Solid
+    from OCP.TopAbs import TopAbs_SHELL
+
+    from ..plate import plate_bspline
+    from .occ import make_face
+
+    T = sheet.thickness
+    data = plate_bspline(surface, sheet)
+    size = float(data.info["size"])
+    faces = []
+    for name, d in data.faces:
+        f = unwrap(make_face(d))
+        if not is_valid(f):
+            raise GHTError(f"the {name} face of the plate {label!r} (thickness={T!r}) is not a valid B-rep (BRepCheck_Analyzer)")
+        faces.append((name, f))
+    # the faces share their boundary curves pole for pole: a sewing tolerance far below T only
+    # has to absorb rounding (and must stay below the thickness, the distance of unrelated edges)
+    sew_tol = min(1e-6 * max(size, T), 1e-3 * T)
+    with quiet_occt():
+        sewing = BRepBuilderAPI_Sewing(sew_tol)
+        for _, f in faces:
+            sewing.Add(f)
+        sewing.Perform()
+        sewn = sewing.SewedShape()
+    shells = []
+    exp = TopExp_Explorer(sewn, TopAbs_SHELL)
+    while exp.More():
+        shells.append(TopoDS.Shell_s(exp.Current()))
+        exp.Next()
+    if len(shells) != 1 or sewing.NbFreeEdges() or sewing.NbMultipleEdges():
+        raise GHTError(f"sewing the six faces of the plate {label!r} (thickness={T!r}) gave {len(shells)} shells, "
+                       f"{sewing.NbFreeEdges()} free and {sewing.NbMultipleEdges()} multiple edges; expected one closed shell")
+    with quiet_occt():
+        solid = BRepBuilderAPI_MakeSolid(shells[0]).Solid()
+        fix = ShapeFix_Solid(solid)
+        fix.Perform()
+        solid = fix.Solid()
+    if solid.ShapeType() != TopAbs_SOLID:
+        exp = TopExp_Explorer(solid, TopAbs_SOLID)
+        if not exp.More():
+            raise GHTError(f"the sewn shell of the plate {label!r} (thickness={T!r}) gave no solid")
+        solid = TopoDS.Solid_s(exp.Current())
+    if not is_valid(solid):
+        raise GHTError(f"the exact plate {label!r} (thickness={T!r}) is not a valid solid (BRepCheck_Analyzer)")
+    from .occ import volume
+
+    if not volume(solid) > 0:
+        raise GHTError(f"the exact plate {label!r} (thickness={T!r}) is not oriented outwards (volume <= 0)")
+    in_solid = _faces(solid)
+    found: dict[str, TopoDS_Face] = {}
+    for name, f in faces:
+        mod = sewing.Modified(f)
+        hit = next((g for g in in_solid if g.IsSame(mod)), None)
+        if hit is None:
+            raise GHTError(f"the {name} face of the plate {label!r} is missing from the sewn solid")
+        found[name] = hit
+    return PlateSolid(solid, found["inside"], found["outside"], [found[n] for n in ("wall_a", "end1", "wall_b", "end0")],
+                      sheet, data)
 
 
 def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm",
@@ -290,7 +403,9 @@ def read_step_face_names(path: str | os.PathLike) -> tuple[TopoDS_Shape, dict[in
     tr = reader.WS().TransferReader()
     names: dict[int, str] = {}
     for k, f in enumerate(_faces(shape)):
-        ent = tr.EntityFromShapeResult(f, 1)
+        # mode 1 finds the face's entity when the root is the solid itself; in a compound (the
+        # plate with the design's curve edges) only the search below the roots (-1) finds it
+        ent = tr.EntityFromShapeResult(f, 1) or tr.EntityFromShapeResult(f, -1)
         if ent is None:
             continue
         nm = getattr(ent, "Name", None)
