@@ -132,24 +132,38 @@ def make_face(data: BSplineSurfaceData, tolerance: float = 1e-7) -> Any:
     return Face(builder.Face())
 
 
-def volume(shape: Any) -> float:
-    """Volume of a solid (build123d, cadquery or OCP) by OCCT's default Gauss integration.
+def volume(shape: Any, *, eps: float | None = None) -> float:
+    """Volume of a solid (build123d, cadquery or OCP) by OCCT's Gauss integration.
 
-    The default rule integrates a B-spline face with ONE Gauss rule over its whole parameter box
-    (order ``2 (p + 1) (spans)``, at most 61 points, not split at the knots), so a face that is
-    only C0 at an inner knot (the joint rulings of a loft's fans, knots of multiplicity p) is
-    integrated across a kink: 1.5e-3 relative error on a hull plate, 4.6e-2 on a hopper. A
-    shape with such a face is therefore integrated on a copy whose faces are split at their C0
-    knots (``ShapeUpgrade_ShapeDivideContinuity``, criterion C1), every piece smooth; a shape
-    without one is integrated as it is (the same numbers as before).
+    Default (``eps=None``): OCCT's default rule. It integrates a B-spline face with ONE Gauss rule
+    over its whole parameter box (order ``2 (p + 1) spans``, at most 61 points, not split at the
+    knots), so a face that is only C0 at an inner knot (the joint rulings of a loft's fans, knots
+    of multiplicity p) is integrated across a kink: 1.5e-3 relative error on a hull plate, 4.6e-2
+    on a hopper. A shape with such a face is therefore integrated on a copy whose faces are split
+    at their C0 knots (``ShapeUpgrade_ShapeDivideContinuity``, criterion C1), every piece smooth;
+    a shape without one is integrated as it is (the same numbers as before). Even on smooth faces
+    the single rule can be off: 9.4e-6 on the exact plate of a strongly bent tangent developable
+    (T = 0.05 at a bending radius of 0.16).
 
-    The adaptive ``BRepGProp.VolumeProperties_s(shape, props, Eps)`` variant scattered by about 1e-5
-    relative on GHT solids while reporting 1e-11, so it is not used.
+    ``eps``: the adaptive ``BRepGProp.VolumeProperties_s(shape, props, eps)`` (split at the knots,
+    refined until the estimate is below ``eps``). On the exact plates of
+    :func:`ght_cad.cad.sheet_solid.plate_solid` it agrees with their closed-form volumes to 5e-10
+    (7 surfaces, fans included); on solids made by OCCT's thickening it scattered by about 1e-5
+    relative while reporting 1e-11, so it is not the default.
+
+    Raises:
+        GHTError: ``eps`` not a positive number.
     """
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
 
     s = unwrap(shape)
+    props = GProp_GProps()
+    if eps is not None:
+        if isinstance(eps, bool) or not isinstance(eps, (int, float, np.floating)) or not 0 < float(eps) < 1:
+            raise GHTError(f"eps={eps!r} is not allowed; give a relative integration tolerance in (0, 1)")
+        BRepGProp.VolumeProperties_s(s, props, float(eps))
+        return float(props.Mass())
     if has_c0_faces(s):
         from OCP.GeomAbs import GeomAbs_C1
         from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideContinuity
@@ -160,7 +174,6 @@ def volume(shape: Any) -> float:
         div.SetSurfaceCriterion(GeomAbs_C1)
         div.Perform()
         s = div.Result()
-    props = GProp_GProps()
     BRepGProp.VolumeProperties_s(s, props)
     return float(props.Mass())
 

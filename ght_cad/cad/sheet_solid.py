@@ -80,6 +80,7 @@ class PlateSolid:
         sheet: the sheet.
         data: the exact plate's :class:`ght_cad.plate.PlateBSplineData` (None when thickened by
             OCCT).
+        surface: the exact plate's design surface (None when thickened by OCCT).
     """
 
     solid: TopoDS_Shape
@@ -88,6 +89,7 @@ class PlateSolid:
     edges: list[TopoDS_Face]
     sheet: Sheet
     data: Any = None
+    surface: Any = None
 
     def named_faces(self) -> list[tuple[str, TopoDS_Face]]:
         """``[("inside", f), ("outside", f), ("edge1", f), ...]``."""
@@ -95,11 +97,22 @@ class PlateSolid:
 
     @property
     def volume(self) -> float:
-        """Volume by OCCT's Gauss integration (:func:`ght_cad.cad.occ.volume`: faces that are only
-        C0 at inner knots, a loft's joint rulings, integrated piece by piece)."""
+        """Volume by OCCT's Gauss integration (:func:`ght_cad.cad.occ.volume`): the exact plate's
+        by the adaptive rule (``eps = 1e-12``: within 5e-10 of :attr:`closed_form_volume` where the
+        default rule was off by up to 9.4e-6), a thickened face's by the default rule."""
         from .occ import volume
 
-        return volume(self.solid)
+        return volume(self.solid, eps=1e-12) if self.data is not None else volume(self.solid)
+
+    @property
+    def closed_form_volume(self) -> float | None:
+        r"""``V = T A + σ (T²/2) ∫ 2H dA`` of the exact plate's design surface
+        (:func:`ght_cad.plate.plate_volume`); None for a thickened face."""
+        if self.surface is None:
+            return None
+        from ..plate import plate_volume
+
+        return plate_volume(self.surface, self.sheet)
 
     def to_build123d(self) -> Any:
         """The solid as a build123d ``Solid``."""
@@ -301,7 +314,7 @@ def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
         raise GHTError(f"the exact plate {label!r} (thickness={T!r}) is not a valid solid (BRepCheck_Analyzer)")
     from .occ import volume
 
-    if not volume(solid) > 0:
+    if not volume(solid, eps=1e-6) > 0:
         raise GHTError(f"the exact plate {label!r} (thickness={T!r}) is not oriented outwards (volume <= 0)")
     in_solid = _faces(solid)
     found: dict[str, TopoDS_Face] = {}
@@ -312,7 +325,7 @@ def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
             raise GHTError(f"the {name} face of the plate {label!r} is missing from the sewn solid")
         found[name] = hit
     return PlateSolid(solid, found["inside"], found["outside"], [found[n] for n in ("wall_a", "end1", "wall_b", "end0")],
-                      sheet, data)
+                      sheet, data, surface)
 
 
 def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm",

@@ -193,7 +193,10 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             report["brep"]["curve_edges"] = len(edges)
             plates = plate_solids(built) if built is not None else []  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
             if plates:
+                closed = [p.closed_form_volume for p in plates]
                 report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
+                                   # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)
+                                   "volume_closed_form": None if None in closed else float(sum(closed)),
                                    **design.sheet.to_sheet().as_dict()}
             if "step" in want_files:
                 if plates:
