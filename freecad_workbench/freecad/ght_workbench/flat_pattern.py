@@ -108,10 +108,11 @@ def read_curve(c: Any, dim: int, p0: float, p1: float) -> _CurveEval | None:
 
     Lines (``Line2d``/``Line``: ``P + p D`` from ``Location``/``Direction``; a ``Line2dSegment`` /
     ``LineSegment``: affine through its values at p0 and p1), circles and arcs (``O + R (cos p X +
-    sin p Y)`` from ``Location``/``Center``, ``Radius``, ``XAxis``, ``YAxis``), non-periodic
-    B-splines and Béziers (:class:`ght_cad.nurbs.NurbsCurve` from ``getPoles``, ``getWeights``,
-    ``getKnots``/``getMultiplicities``, ``Degree``), with exact first derivatives. Other kinds:
-    None.
+    sin p Y)`` from ``Location``/``Center``, ``Radius``, ``XAxis``, ``YAxis``), B-splines and
+    Béziers (:class:`ght_cad.nurbs.NurbsCurve` from ``getPoles``, ``getWeights``,
+    ``getKnots``/``getMultiplicities``, ``Degree``; a periodic B-spline, e.g. a drilled hole's
+    pcurve, from a ``setNotPeriodic`` copy: the same curve on clamped knots, checked like the
+    others), with exact first derivatives. Other kinds: None.
     """
     name = type(c).__name__.replace("2d", "")
     try:
@@ -131,8 +132,9 @@ def read_curve(c: Any, dim: int, p0: float, p1: float) -> _CurveEval | None:
                              lambda p: R * (np.cos(p)[:, None] * Y - np.sin(p)[:, None] * X))
         elif name in ("BSplineCurve", "BezierCurve"):
             if name == "BSplineCurve":
-                if c.isPeriodic():
-                    return None
+                if c.isPeriodic():  # the same curve on clamped knots, same parameters (OCCT SetNotPeriodic)
+                    c = c.copy()
+                    c.setNotPeriodic()
                 U = expand_knots(c.getKnots(), c.getMultiplicities())
             else:
                 U = np.r_[np.zeros(c.Degree + 1), np.ones(c.Degree + 1)]
@@ -268,7 +270,7 @@ class _Edge:
     functions of t ∈ [0, 1] (``reverse``: from the last parameter to the first), ``shift`` added
     to (u, v) (a seam's other pcurve lies a period away).
 
-    Lines, circles and non-periodic B-splines/Béziers (pcurve and 3-D ``edge.Curve``) are
+    Lines, circles and B-splines/Béziers (pcurve and 3-D ``edge.Curve``) are
     evaluated in numpy (:func:`read_curve`) with exact pcurve derivatives; ``paths`` says which
     (``{"pcurve": "line" | "circle" | "bspline" | "freecad", "curve3d": ...}``). Other curves (and
     ``fast=False``): point by point, pcurve derivatives by finite differences between knots

@@ -178,7 +178,7 @@ class NurbsAdapterTest(unittest.TestCase):
         face = _rational_cylinder_face(hole=True)
         self.assertEqual(len(face.Wires), 2)
         self._check_surface_against_freecad(face)
-        pat = self._fast_and_old("drilled_rational_cylinder", face, {"line"}, {"bspline"})
+        pat = self._fast_and_old("drilled_rational_cylinder", face, {"line", "bspline"}, {"bspline"})  # the hole: periodic B-splines
         self.assertEqual(len(pat.panels[0].loops), 2)
 
     def test_tangent_developable_bspline(self):
