@@ -6,8 +6,9 @@ surface is developable: the lateral face of a ``Part::Cylinder`` / ``Part::Cone`
 maps), a plane, a surface of extrusion, a ruled B-spline or Bézier face (``Part::RuledSurface``,
 re-imported STEP), trimmed or with holes. Faces go through the kernel-free
 :func:`ght_cad.face_unroll.unroll_face_data` (the same code that unrolls build123d/OCP faces)
-via the small adapter below (:func:`face_data`): FreeCAD's ``face.Surface`` evaluated with
-``value``/``getDN``, every wire (``OuterWire`` first) in ``OrderedEdges`` order with its pcurve
+via the small adapter below (:func:`face_data`): FreeCAD's ``face.Surface`` (B-spline and
+Bézier surfaces read into the core's :mod:`ght_cad.nurbs`, others evaluated with
+``value``/``getDN``), every wire (``OuterWire`` first) in ``OrderedEdges`` order with its pcurve
 ``face.curveOnSurface(edge)``, the edges' 3-D curves and lengths. The face's real outline and
 holes are kept. Non-developable faces (sphere, torus, twisted loft) are refused with the
 isolines' deviation or θ_max / DD unless ``BestEffort``.
