@@ -87,12 +87,6 @@ class PlateBSplineData:
         return [(name, getattr(self, name)) for name in PLATE_FACES]
 
 
-def _size(surface: RuledSurface) -> float:
-    u = np.linspace(0.0, 1.0, 33)
-    g = np.vstack([surface.a(u), surface.b(u)])
-    return float(np.linalg.norm(g.max(axis=0) - g.min(axis=0)))
-
-
 def _offset_thickness(sheet: Any) -> float:
     out = getattr(sheet, "outside_offset", None)
     if out is None or not math.isfinite(float(out)) or float(out) == 0.0:
@@ -161,7 +155,7 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
             :class:`ght_cad.sheet.SheetError` where the normal is undefined (a zero ruling).
         ConversionError: the fit did not reach ``tol``.
     """
-    from .developable import ruled_pieces
+    from .developable import _size, ruled_pieces
 
     if not isinstance(surface, RuledSurface):
         raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")
