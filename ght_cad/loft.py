@@ -62,6 +62,11 @@ __all__ = [
 ]
 
 _EPS = np.finfo(float).eps
+#: rails whose ends are closer than this (relative to the size) meet there: a pointed loft end
+CORNER_TOL = 1e-12
+#: parameter distance from a meeting corner within which ``g = b - a`` is integrated (no cancellation)
+CORNER_RADIUS = 1.0 / 32
+_CORNER_GL = np.polynomial.legendre.leggauss(16)
 #: relative size of a fan (in the rail parameter) below which the branch is taken to start or end
 #: at the corner (no fan)
 MIN_FAN = 1e-12
@@ -274,12 +279,57 @@ class _Pair:
 
     def __init__(self, ra: Any, rb: Any, size: float) -> None:
         self.ra, self.rb, self.size = ra, rb, size
+        # corners (0, 0), (1, 1) where the rails meet (a pointed end of the loft: a zero ruling);
+        # near them g = b - a is computed without cancellation (:meth:`_near_corner_gap`)
+        self.corners: list[tuple[float, float, np.ndarray]] = []
+        for c in (0.0, 1.0):
+            e = np.array([c])
+            gap = np.asarray(rb.derivative(e, 0), dtype=float)[0] - np.asarray(ra.derivative(e, 0), dtype=float)[0]
+            if float(np.linalg.norm(gap)) <= CORNER_TOL * max(float(size), 1e-300):
+                self.corners.append((c, c, gap))
 
-    def parts(self, t: np.ndarray, s: np.ndarray, k: int = 1) -> dict[str, Any]:
-        """F, F_t, F_s (and with k = 2 the second partials) at (t, s); scale = |a'||b'||g|."""
+    def _near_corner_gap(self, t: np.ndarray, s: np.ndarray, g: np.ndarray,
+                         offsets: tuple[np.ndarray, np.ndarray, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        r"""``g = b(s) - a(t)`` near a corner where the rails meet, without cancellation, and a mask
+        of the points where it was so computed.
+
+        ``g = (b(s0) - a(t0)) + y ∫_0^1 b'(s0 + τ y) dτ - x ∫_0^1 a'(t0 + τ x) dτ`` (``x = t - t0``,
+        ``y = s - s0``, 16-point Gauss–Legendre: round-off relative to ``|g|``, where the plain
+        difference of two points near the meeting point carries ``eps |a|``).
+        """
+        near = np.zeros(t.shape, dtype=bool)
+        if not self.corners:
+            return g, near
+        g = g.copy()
+        for c, (t0, s0, gap) in enumerate(self.corners):
+            if offsets is not None and offsets[2] == c:
+                # exact offsets from the corner (t - t0 rounded near 1 would carry eps absolute)
+                x, y = offsets[0], offsets[1]
+            else:
+                x, y = t - t0, s - s0
+            m = (np.abs(x) <= CORNER_RADIUS) & (np.abs(y) <= CORNER_RADIUS)
+            if not m.any():
+                continue
+            xs, ys = x[m], y[m]
+            nodes, weights = _CORNER_GL
+            tau = 0.5 * (nodes + 1.0)
+            w = 0.5 * weights
+            da = np.asarray(self.ra.derivative((t0 + xs[:, None] * tau[None, :]).ravel(), 1), dtype=float)
+            db = np.asarray(self.rb.derivative((s0 + ys[:, None] * tau[None, :]).ravel(), 1), dtype=float)
+            ia = np.einsum("j,ijk->ik", w, da.reshape(xs.size, tau.size, 3))
+            ib = np.einsum("j,ijk->ik", w, db.reshape(ys.size, tau.size, 3))
+            g[m] = gap + ys[:, None] * ib - xs[:, None] * ia
+            near |= m
+        return g, near
+
+    def parts(self, t: np.ndarray, s: np.ndarray, k: int = 1,
+              offsets: tuple[np.ndarray, np.ndarray, int] | None = None) -> dict[str, Any]:
+        """F, F_t, F_s (and with k = 2 the second partials) at (t, s); scale = |a'||b'||g|.
+        ``offsets``: exact ``(t - t0, s - s0, corner index)`` near a meeting corner."""
         A = _jet(self.ra, t, k + 1)
         B = _jet(self.rb, s, k + 1)
         g = B[0] - A[0]
+        g, near = self._near_corner_gap(np.asarray(t, float), np.asarray(s, float), g, offsets)
         out: dict[str, Any] = {"A": A, "B": B, "g": g}
         out["F"] = _det(A[1], B[1], g)
         out["Ft"] = _det(A[2], B[1], g)
@@ -288,6 +338,8 @@ class _Pair:
         out["scale"] = ab * np.linalg.norm(g, axis=1)
         # rounding error of F: g = b - a carries eps (|a| + |b|), the product eps |a'||b'||g|
         out["noise"] = _EPS * ab * (np.linalg.norm(g, axis=1) + np.linalg.norm(A[0], axis=1) + np.linalg.norm(B[0], axis=1))
+        if near.any():  # near a meeting corner g is good to eps |g| (the jets to eps)
+            out["noise"] = np.where(near, 4.0 * _EPS * ab * np.linalg.norm(g, axis=1), out["noise"])
         if k >= 2:
             out["Ftt"] = _det(A[3], B[1], g) - _det(A[2], B[1], A[1])
             out["Fts"] = _det(A[2], B[2], g)
@@ -297,7 +349,87 @@ class _Pair:
     def F(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
         A0, A1 = _jet(self.ra, t, 1)
         B0, B1 = _jet(self.rb, s, 1)
-        return _det(A1, B1, B0 - A0)
+        g, _ = self._near_corner_gap(np.asarray(t, float), np.asarray(s, float), B0 - A0)
+        return _det(A1, B1, g)
+
+    def _corner_H(self, c: int, x: np.ndarray, w: np.ndarray) -> np.ndarray:
+        r"""``H = F / x²`` at ``(t0 + x, s0 + w x)`` near the meeting corner ``c``, free of cancellation:
+
+            H = det(A2, b', G) + w det(a1, B2, G) + det(a1, b1, w² B̃2 - Ã2),
+
+        ``a1 = a'(t0)``, ``b1 = b'(s0)``, ``b' = b'(s0 + y)``, ``G = g/x = w B1(y) - A1(x)`` and the
+        divided differences ``A1 = ∫ a'(t0 + τx) dτ``, ``A2 = ∫ a''(t0 + τx) dτ``,
+        ``Ã2 = ∫ (1-τ) a''(t0 + τx) dτ`` (likewise B with y = w x; τ ∈ [0, 1], 16-point
+        Gauss–Legendre); the first-order terms of F cancel identically, ``H(0, w) = ½ (D_a - w² D_b)``.
+        """
+        t0, s0, _ = self.corners[c]
+        y = w * x
+        nodes, weights = _CORNER_GL
+        tau = 0.5 * (nodes + 1.0)
+        wt = 0.5 * weights
+        n = x.size
+
+        def dd(rail: Any, z0: float, z: np.ndarray) -> tuple[np.ndarray, ...]:
+            pts = (z0 + z[:, None] * tau[None, :]).ravel()
+            d1 = np.asarray(rail.derivative(pts, 1), dtype=float).reshape(n, tau.size, 3)
+            d2 = np.asarray(rail.derivative(pts, 2), dtype=float).reshape(n, tau.size, 3)
+            return (np.einsum("j,ijk->ik", wt, d1), np.einsum("j,ijk->ik", wt, d2),
+                    np.einsum("j,ijk->ik", wt * (1.0 - tau), d2))
+
+        A1, A2, A2t = dd(self.ra, t0, x)
+        B1, B2, B2t = dd(self.rb, s0, y)
+        e = np.array([t0]), np.array([s0])
+        a1 = np.broadcast_to(np.asarray(self.ra.derivative(e[0], 1), dtype=float), (n, 3))
+        b1 = np.broadcast_to(np.asarray(self.rb.derivative(e[1], 1), dtype=float), (n, 3))
+        bp = b1 + y[:, None] * B2
+        G = w[:, None] * B1 - A1
+        return _det(A2, bp, G) + w * _det(a1, B2, G) + _det(a1, b1, (w * w)[:, None] * B2t - A2t)
+
+    def corner_branch(self, c: int, dlam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r"""Offsets ``(x, y) = (t - t0, s - s0)`` of the branch point at ``λ = λ_c + dlam`` near the
+        meeting corner ``c`` (``x + y = 2 dlam``): ``y = w x`` with ``H(x, w) = 0``
+        (:meth:`_corner_H`, secant iteration in w from the corner slope), so the point is on the
+        branch to round-off relative to its distance from the corner (a Newton on F in absolute t
+        resolves ``t - t0`` only to ``eps``, and the ruling direction to ``eps/|t - t0|``).
+        """
+        t0, s0, _ = self.corners[c]
+        dlam = np.asarray(dlam, dtype=float)
+        r = self.corner_slope(t0, s0)
+        w0 = np.full(dlam.shape, r)
+        x_of = lambda w: 2.0 * dlam / (1.0 + w)  # noqa: E731
+        h0 = self._corner_H(c, x_of(w0), w0)
+        w1 = w0 * (1.0 + 1e-6)
+        h1 = self._corner_H(c, x_of(w1), w1)
+        for _ in range(30):
+            den = h1 - h0
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = np.where(den != 0, h1 * (w1 - w0) / den, 0.0)
+            w0, h0 = w1, h1
+            w1 = w1 - step
+            if np.all(np.abs(step) <= 4 * _EPS * np.abs(w1)):
+                break
+            h1 = self._corner_H(c, x_of(w1), w1)
+        x = x_of(w1)
+        return x, w1 * x
+
+    def corner_slope(self, t0: float, s0: float) -> float:
+        r"""``ds/dt`` of the branch at a corner where the rails meet: with ``x = t - t0``,
+        ``y = s - s0``, ``F = ½ (D_a x² - D_b y²) + O(3)``, ``D_a = det(a', b', a'')``,
+        ``D_b = det(a', b', b'')`` (the first-order terms cancel), so ``y/x → r = sqrt(D_a/D_b)``.
+
+        Raises:
+            NotDevelopableError: ``D_a/D_b <= 0`` (no increasing branch enters the corner).
+        """
+        A = _jet(self.ra, np.array([t0]), 2)
+        B = _jet(self.rb, np.array([s0]), 2)
+        Da = float(_det(A[1], B[1], A[2])[0])
+        Db = float(_det(A[1], B[1], B[2])[0])
+        if not (Db != 0 and Da / Db > 0):
+            raise NotDevelopableError(
+                f"the rails meet at the corner t={t0:g}, s={s0:g} but no increasing branch of F = 0 enters it "
+                f"(det(a', b', a'')={Da:.6g}, det(a', b', b'')={Db:.6g} must have the same sign)"
+            )
+        return math.sqrt(Da / Db)
 
     def f(self, t: np.ndarray, s: np.ndarray) -> np.ndarray:
         """Scale-free ``F / (|a'| |b'| |g|)`` (the sine of the angle between the two end planes,
@@ -588,6 +720,71 @@ class _Path:
             self._guess = None
         self.lam0, self.lam1 = float(lam[0]), float(lam[-1])
         self._cache: dict[bytes, Any] = {}
+        # branch ends at a corner where the rails meet (a pointed loft end): (corner index, λ there)
+        self.corner_ends: list[tuple[int, float]] = []
+        for c, (t0, s0, _) in enumerate(pair.corners):
+            for (tb, sb), lb in ((branch.start, self.lam0), (branch.end, self.lam1)):
+                if abs(tb - t0) <= MIN_FAN and abs(sb - s0) <= MIN_FAN:
+                    self.corner_ends.append((c, float(t0)))
+
+    def near_corner(self, lam: np.ndarray) -> np.ndarray | None:
+        """Mask of the λ within ``CORNER_RADIUS / 2`` of a meeting corner (None: the branch has none)."""
+        if not self.corner_ends:
+            return None
+        m = np.zeros(lam.shape, dtype=bool)
+        for _, lc in self.corner_ends:
+            m |= np.abs(lam - lc) <= 0.5 * CORNER_RADIUS
+        return m
+
+    def _corner_main(self, lam: np.ndarray, k: int) -> tuple[list[np.ndarray], list[np.ndarray], dict[str, Any], np.ndarray] | None:
+        r"""The branch within ``CORNER_RADIUS / 2`` (in λ) of a meeting corner (:meth:`_Pair.corner_branch`):
+        ``t, s`` and their λ-derivatives ``t' = 2 F_s / (F_s - F_t)``, ``t''`` from the partials at
+        the exact offsets (F_t, F_s are O(|g|), computed without cancellation); at the corner
+        itself ``t' = 2 / (1 + r)``, ``r = sqrt(D_a / D_b)`` (:meth:`_Pair.corner_slope`) and
+        ``t''`` extrapolated (cubic, from λ offsets 1e-4 .. 4e-4). None when no point is near one.
+        """
+        if not self.corner_ends:
+            return None
+        hit = None
+        for c, lc in self.corner_ends:
+            m = np.abs(lam - lc) <= 0.5 * CORNER_RADIUS
+            if m.all():
+                hit = (c, lc)
+                break
+        if hit is None:
+            return None
+        c, lc = hit
+        t0, s0, _ = self.pair.corners[c]
+        dlam = lam - lc
+        at = dlam == 0.0
+        dl = np.where(at, np.where(lc > 0.5, -1e-4, 1e-4), dlam)
+        x, y = self.pair.corner_branch(c, dl)
+        x, y = np.where(at, 0.0, x), np.where(at, 0.0, y)
+        t, s = t0 + x, s0 + y
+        p = self.pair.parts(t, s, max(k, 1), offsets=(x, y, c))
+        Ft, Fs = p["Ft"], p["Fs"]
+        den = Fs - Ft
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = 2 * Fs / den
+            out_t, out_s = [t, tp], [s, 2.0 - tp]
+            if k >= 2:
+                dFt = p["Ftt"] * tp + p["Fts"] * (2.0 - tp)
+                dFs = p["Fts"] * tp + p["Fss"] * (2.0 - tp)
+                tpp = 2 * (Fs * dFt - Ft * dFs) / den**2
+                out_t.append(tpp)
+                out_s.append(-tpp)
+        if at.any():
+            r = self.pair.corner_slope(t0, s0)
+            out_t[1][at], out_s[1][at] = 2.0 / (1.0 + r), 2.0 * r / (1.0 + r)
+            if k >= 2:
+                sgn = -1.0 if lc > 0.5 else 1.0
+                hs = sgn * 1e-4 * np.arange(1.0, 5.0)
+                sub = self._corner_main(lc + hs, 2)
+                assert sub is not None
+                q = sub[0][2]
+                out_t[2][at] = 4 * q[0] - 6 * q[1] + 4 * q[2] - q[3]
+                out_s[2][at] = -out_t[2][at]
+        return out_t[: k + 1], out_s[: k + 1], p, np.stack([x, y], axis=1)
 
     def main(self, lam: np.ndarray, k: int) -> list[np.ndarray]:
         """[t, t', t''], [s, s', s''] on the branch at ``lam`` (derivatives w.r.t. λ, up to k)."""
@@ -595,6 +792,24 @@ class _Path:
         hit = self._cache.get(key)
         if hit is not None and len(hit[0]) >= k + 1:
             return hit
+        near = self.near_corner(lam)
+        if near is not None and near.any() and not near.all():  # split: near a meeting corner / elsewhere
+            r1, r2 = self.main(lam[near], k), self.main(lam[~near], k)
+            tt = [np.empty(lam.shape) for _ in r1[0]]
+            ss = [np.empty(lam.shape) for _ in r1[1]]
+            for r in range(len(tt)):
+                tt[r][near], tt[r][~near] = r1[0][r], r2[0][r]
+                ss[r][near], ss[r][~near] = r1[1][r], r2[1][r]
+            g = np.empty((lam.size, 3))
+            g[near], g[~near] = r1[2]["g"], r2[2]["g"]
+            return tt, ss, {"g": g}
+        cm = self._corner_main(lam, k) if near is not None and near.size and near.all() else None
+        if cm is not None:
+            res = (cm[0], cm[1], cm[2])
+            if len(self._cache) > 8:
+                self._cache.clear()
+            self._cache[key] = res
+            return res
         g = np.clip(self._guess(lam), 0.0, 1.0) if self._guess is not None else np.full(lam.shape, self.branch.t[0])
         t, s, ok = self.pair.correct(lam, g)
         p = self.pair.last
@@ -701,6 +916,22 @@ class LoftSegment(RuledSurface):
         uu, _ = as_parameter_array(u, "u")
         _, ss = self._ts(uu, derivative)
         return self._compose(self._loft._pair.rb, ss, derivative)
+
+    def ruling(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``g = b - a``; near a corner where the rails meet (a pointed end) the ruling is the
+        branch's own, integrated from the corner without cancellation (:meth:`_Pair.corner_branch`):
+        the plain difference carries ``eps |a|``, i.e. the direction ``eps |a| / |g|``."""
+        g = self.b(u, derivative) - self.a(u, derivative)
+        path = self._loft._path
+        if derivative or self.kind != "main" or not path.corner_ends:
+            return g
+        uu, _ = as_parameter_array(u, "u")
+        lam0, lam1 = self.lam_range
+        lam = lam0 + uu * (lam1 - lam0)
+        near = path.near_corner(lam)
+        if near is not None and near.any():
+            g[near] = path.main(lam[near], 0)[2]["g"]
+        return g
 
     def parameters(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
         """Rail parameters ``(t, s)`` of the rulings at ``u`` (s on rail b as given)."""
@@ -882,6 +1113,12 @@ class DevelopableLoft(RuledSurface):
     def b(self, u: Any, derivative: int = 0) -> np.ndarray:
         """Rail b along the loft: ``b(s(λ))`` and its λ-derivatives."""
         return self._dispatch(u, lambda sg, x, w: sg.b(x, derivative) / w**derivative)
+
+    def ruling(self, u: Any, derivative: int = 0) -> np.ndarray:
+        """``g = b - a`` (near a pointed end the segment's cancellation-free ruling, :meth:`LoftSegment.ruling`)."""
+        if not self._path.corner_ends:
+            return super().ruling(u, derivative)
+        return self._dispatch(u, lambda sg, x, w: sg.ruling(x, derivative) / w**derivative)
 
     def parameters(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
         """Rail parameters ``(t, s)`` of the rulings at loft parameters ``u`` (= λ)."""

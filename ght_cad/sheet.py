@@ -223,6 +223,16 @@ def _fd_first(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray, breaks: Se
     return fd_derivative(fun, u, breaks, h=1e-4)
 
 
+#: a ruling at u = 0 or 1 shorter than this times ``|(a' + b')/2|`` is a pointed end (the rails meet)
+POINTED_END_TOL = 1e-9
+
+
+def _pointed_ends(uu: np.ndarray, g: np.ndarray, c1: np.ndarray) -> np.ndarray:
+    """Mask of the rulings that are a pointed strip end: u = 0 or 1 and ``|g| <= 1e-9 |c'|``."""
+    gl = np.linalg.norm(g, axis=1)
+    return ((uu == 0.0) | (uu == 1.0)) & (gl <= POINTED_END_TOL * np.linalg.norm(c1, axis=1))
+
+
 def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndarray]:
     r"""Unit normal along the rulings and its u-derivatives: ``[n, n', (n'')]``.
 
@@ -230,8 +240,21 @@ def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndar
     ``m' = ((a'' + b'')/2) × g + ((a' + b')/2) × g'``; ``n''`` (order 2) by 5-point differences of
     ``n'`` (the surfaces give analytic derivatives up to order 2 only).
 
+    **Pointed ends.** At a strip end ``u0 ∈ {0, 1}`` whose ruling has zero length (the two
+    boundaries meet: a bow where chine and sheer meet; ``|g| <= 1e-9 |c'|``, ``c' = (a' + b')/2``)
+    ``m = 0``, and n is the limit of the neighbouring rulings' normals: with
+    ``g(u) = g'(u0) (u - u0) + ½ g''(u0) (u - u0)² + ...``, ``M = m / (u - u0)`` is smooth,
+    ``M(u0) = c' × g'``, ``M'(u0) = c'' × g' + ½ c' × g''``, so
+
+        n(u0) = s M/|M|,   n'(u0) = (s M' - n (n·s M')) / |M|,
+
+    ``s = +1`` at u0 = 0 and ``-1`` at u0 = 1 (u approaches from inside the strip). ``n''`` there
+    is the one-sided difference of n' (:func:`ght_cad.face_unroll.fd_derivative`).
+
     Raises:
-        SheetError: a ruling where the normal is undefined (``m = 0``).
+        SheetError: a ruling where the normal is undefined (``m = 0`` on a ruling of positive
+            length, an interior zero ruling, or a pointed end where the boundaries meet
+            tangentially, ``c' × g' = 0``).
     """
     uu = np.atleast_1d(np.asarray(u, dtype=float))
     a1, b1 = surface.a(uu, 1), surface.b(uu, 1)
@@ -240,15 +263,39 @@ def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndar
     m = np.cross(c1, g)
     ml = np.linalg.norm(m, axis=1)
     scale = np.linalg.norm(c1, axis=1) * np.linalg.norm(g, axis=1)
-    if not np.all(ml > 1e-12 * np.maximum(scale, 1e-300)):
-        i = int(np.argmin(ml / np.maximum(scale, 1e-300)))
-        raise SheetError(f"the surface normal is undefined at the ruling u={uu[i]:.6g}; a sheet offset needs a regular surface")
+    bad = ~(ml > 1e-12 * np.maximum(scale, 1e-300))
+    point = np.zeros(uu.shape, dtype=bool)
+    if bad.any():
+        point = bad & _pointed_ends(uu, g, c1)
+        g1p = surface.ruling(uu[point], 1) if point.any() else np.zeros((0, 3))
+        Mp = np.cross(c1[point], g1p)
+        Ml = np.linalg.norm(Mp, axis=1)
+        ok = Ml > 1e-12 * np.linalg.norm(c1[point], axis=1) * np.linalg.norm(g1p, axis=1)
+        other = bad & ~point
+        if other.any() or not ok.all():
+            if other.any():
+                i = int(np.argmin(np.where(other, ml / np.maximum(scale, 1e-300), np.inf)))
+                why = "a sheet offset needs a regular surface"
+            else:
+                i = int(np.nonzero(point)[0][int(np.argmin(ok))])
+                why = ("the strip ends in a point where its two boundaries meet tangentially (c' x g' = 0), "
+                       "so the tangent plane there is undefined; allowed: boundaries meeting at an angle")
+            raise SheetError(f"the surface normal is undefined at the ruling u={uu[i]:.6g}; {why}")
+        sgn = np.where(uu[point] == 0.0, 1.0, -1.0)
+        m = m.copy()
+        ml = ml.copy()
+        m[point] = sgn[:, None] * Mp
+        ml[point] = Ml
     n = m / ml[:, None]
     out = [n]
     if order >= 1:
         c2 = 0.5 * (surface.a(uu, 2) + surface.b(uu, 2))
         g1 = surface.ruling(uu, 1)
         m1 = np.cross(c2, g) + np.cross(c1, g1)
+        if point.any():  # M' = c'' × g' + ½ c' × g'' (signed like M)
+            g2 = surface.ruling(uu[point], 2)
+            sgn = np.where(uu[point] == 0.0, 1.0, -1.0)
+            m1[point] = sgn[:, None] * (np.cross(c2[point], g1[point]) + 0.5 * np.cross(c1[point], g2))
         n1 = (m1 - n * np.einsum("ij,ij->i", n, m1)[:, None]) / ml[:, None]
         out.append(n1)
     if order >= 2:
@@ -257,11 +304,24 @@ def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndar
     return out
 
 
+def _unit_ruling(surface: RuledSurface, u: np.ndarray) -> np.ndarray:
+    """``d = g/|g|``; at a pointed end (:func:`ruling_normal`) the limit ``s g'/|g'|``."""
+    g = surface.ruling(u)
+    gl = np.linalg.norm(g, axis=1)
+    if np.all(gl > 0):
+        return g / gl[:, None]
+    point = _pointed_ends(u, g, 0.5 * (surface.a(u, 1) + surface.b(u, 1)))
+    if point.any():
+        g = g.copy()
+        g[point] = np.where(u[point] == 0.0, 1.0, -1.0)[:, None] * surface.ruling(u[point], 1)
+        gl = np.linalg.norm(g, axis=1)
+    return g / gl[:, None]
+
+
 def _across(surface: RuledSurface, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(X_u · e, ω = n' · e)`` at (u, v) (u, v same shape), ``e = n × d``."""
     n, n1 = ruling_normal(surface, u, 1)
-    g = surface.ruling(u)
-    d = g / np.linalg.norm(g, axis=1)[:, None]
+    d = _unit_ruling(surface, u)
     e = np.cross(n, d)
     xu = surface.a(u, 1) + v[:, None] * surface.ruling(u, 1)
     return np.einsum("ij,ij->i", xu, e), np.einsum("ij,ij->i", n1, e)
