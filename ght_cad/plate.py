@@ -14,7 +14,12 @@ bounded by six ruled faces, all of degree 1 in their second parameter:
   (nets ``[A, A']``, ``[B, B']``); over a fan whose apex ``P`` is on that boundary the wall is the
   cone patch between the point ``P`` (a collapsed pole row) and the arc ``P + σT n(u)``;
 * ``end0``, ``end1``: the end rulings swept along the normal, the planar parallelograms
-  ``a(e), b(e), b(e) + σT n(e), a(e) + σT n(e)`` (e = 0, 1; a bilinear 2 x 2 net).
+  ``a(e), b(e), b(e) + σT n(e), a(e) + σT n(e)`` (e = 0, 1; a bilinear 2 x 2 net). At a
+  **pointed end** (the end ruling has zero length: the boundaries meet at ``P``, a bow) the
+  parallelogram collapses to the segment ``P .. P + σT n(e)`` (``n(e)`` the limit normal,
+  :func:`ght_cad.sheet.ruling_normal`): there is no end face, ``inside`` and ``outside`` end in a
+  collapsed pole column (a degenerate edge) and the walls ``wall_a``, ``wall_b`` meet along that
+  segment (their end pole columns are snapped to the same points).
 
 The four boundary curves are fitted TOGETHER as one 12-D function
 ``f(u) = (a, b, a + σT n, b + σT n)`` by :func:`ght_cad.bspline.fit_function` (one knot vector,
@@ -74,17 +79,20 @@ class PlateBSplineData:
     outside: BSplineSurfaceData
     wall_a: BSplineSurfaceData
     wall_b: BSplineSurfaceData
-    end0: BSplineSurfaceData
-    end1: BSplineSurfaceData
+    end0: BSplineSurfaceData | None
+    end1: BSplineSurfaceData | None
     breaks: tuple[float, ...]
     apex: tuple[str | None, ...]
     max_deviation: float
     info: dict[str, Any] = field(default_factory=dict)
+    #: per end (u = 0, u = 1): True where the strip ends in a point (zero-length end ruling)
+    pointed: tuple[bool, bool] = (False, False)
 
     @property
     def faces(self) -> list[tuple[str, BSplineSurfaceData]]:
-        """``[(name, data)]`` in the order of :data:`PLATE_FACES`."""
-        return [(name, getattr(self, name)) for name in PLATE_FACES]
+        """``[(name, data)]`` in the order of :data:`PLATE_FACES`, without the end wall of a
+        pointed end (None: it collapsed to the segment ``P .. P + σT n``)."""
+        return [(name, getattr(self, name)) for name in PLATE_FACES if getattr(self, name) is not None]
 
 
 def _offset_thickness(sheet: Any) -> float:
@@ -179,6 +187,16 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
     if len(fits) == 1:  # the single piece's knots are already on [0, 1]
         curve.info = {"pieces": [dict(curve.info)], "joint_gaps": [], "breaks": breaks, "spans": curve.info.get("spans")}
     P = curve.poles
+    # a pointed end (zero-length end ruling, the rails meet): the end poles of a and b (and of
+    # their offsets) are one point; snapped to it so the faces' edges there collapse exactly
+    g_end = surface.ruling_lengths(np.array([0.0, 1.0]))
+    pointed = tuple(bool(x <= 64.0 * np.finfo(float).eps * size) for x in g_end)
+    for k, row in ((0, 0), (1, -1)):
+        if pointed[k]:
+            for c0, c1 in ((0, 3), (6, 9)):
+                mid = 0.5 * (P[row, c0:c0 + 3] + P[row, c1:c1 + 3])
+                P[row, c0:c0 + 3] = mid
+                P[row, c1:c1 + 3] = mid
     A, B, A2, B2 = P[:, 0:3], P[:, 3:6], P[:, 6:9], P[:, 9:12]
     K = curve.knots
 
@@ -193,8 +211,9 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
     dev = float(curve.max_deviation) + snap
     info = dict(curve.info)
     info.update({"tol": tol, "snap": snap, "size": size, "offset": off})
-    return PlateBSplineData(ruled(A, B), ruled(A2, B2), ruled(A, A2), ruled(B, B2), quad(0), quad(-1),
-                            tuple(float(x) for x in breaks), tuple(a for _, a, _ in fits), dev, info)
+    return PlateBSplineData(ruled(A, B), ruled(A2, B2), ruled(A, A2), ruled(B, B2),
+                            None if pointed[0] else quad(0), None if pointed[1] else quad(-1),
+                            tuple(float(x) for x in breaks), tuple(a for _, a, _ in fits), dev, info, pointed)
 
 
 def plate_volume(surface: RuledSurface, sheet: Any, *, rtol: float = 1e-13) -> float:

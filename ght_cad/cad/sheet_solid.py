@@ -325,7 +325,7 @@ def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
         if hit is None:
             raise GHTError(f"the {name} face of the plate {label!r} is missing from the sewn solid")
         found[name] = hit
-    return PlateSolid(solid, found["inside"], found["outside"], [found[n] for n in ("wall_a", "end1", "wall_b", "end0")],
+    return PlateSolid(solid, found["inside"], found["outside"], [found[n] for n in ("wall_a", "end1", "wall_b", "end0") if n in found],
                       sheet, data, surface)
 
 
