@@ -263,14 +263,16 @@ def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndar
     m = np.cross(c1, g)
     ml = np.linalg.norm(m, axis=1)
     scale = np.linalg.norm(c1, axis=1) * np.linalg.norm(g, axis=1)
-    bad = ~(ml > 1e-12 * np.maximum(scale, 1e-300))
-    point = np.zeros(uu.shape, dtype=bool)
+    # a pointed end counts as such even where rounding leaves a tiny ruling (its direction is noise)
+    point = _pointed_ends(uu, g, c1)
+    bad = ~(ml > 1e-12 * np.maximum(scale, 1e-300)) | point
     if bad.any():
-        point = bad & _pointed_ends(uu, g, c1)
         g1p = surface.ruling(uu[point], 1) if point.any() else np.zeros((0, 3))
         Mp = np.cross(c1[point], g1p)
         Ml = np.linalg.norm(Mp, axis=1)
-        ok = Ml > 1e-12 * np.linalg.norm(c1[point], axis=1) * np.linalg.norm(g1p, axis=1)
+        # the boundaries meet at an angle: |c' x g'| against |c'|² (g' = b' - a' is rounding noise
+        # where they meet tangentially with the same speed)
+        ok = Ml > POINTED_END_TOL * np.linalg.norm(c1[point], axis=1) ** 2
         other = bad & ~point
         if other.any() or not ok.all():
             if other.any():
@@ -308,7 +310,8 @@ def _unit_ruling(surface: RuledSurface, u: np.ndarray) -> np.ndarray:
     """``d = g/|g|``; at a pointed end (:func:`ruling_normal`) the limit ``s g'/|g'|``."""
     g = surface.ruling(u)
     gl = np.linalg.norm(g, axis=1)
-    if np.all(gl > 0):
+    ends = (u == 0.0) | (u == 1.0)
+    if not ends.any():
         return g / gl[:, None]
     point = _pointed_ends(u, g, 0.5 * (surface.a(u, 1) + surface.b(u, 1)))
     if point.any():

@@ -1,0 +1,234 @@
+"""Pointed ends (spec 5.7 + 6.1): a `type = "rails"` loft whose rails meet at an end (a bow where
+the chine meets the sheer) has a zero-length end ruling. The loft near that corner, the limit
+normal and bending radius there, the neutral-surface flat pattern, the sheet check and the plate
+solid (no end wall at the point).
+
+Tolerances: as tests/test_plate_fans.py (fit certified to ``3e-7 T``: face points within
+``1e-6 T`` of their exact points, inside also within ``1e-6 size``; volume against the closed form
+to ``1e-6``); flat pattern errors (exact 1-D quadrature) ``<= 1e-9``, measured ~1e-15.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, event, given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("OCP")
+
+from OCP.BRep import BRep_Tool  # noqa: E402
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf  # noqa: E402
+from OCP.gp import gp_Pnt  # noqa: E402
+
+from ght_cad import GHTCurve  # noqa: E402
+from ght_cad.cad.occ import is_valid  # noqa: E402
+from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
+from ght_cad.errors import NotDevelopableError  # noqa: E402
+from ght_cad.loft import developable_loft  # noqa: E402
+from ght_cad.plate import plate_volume  # noqa: E402
+from ght_cad.sheet import Sheet, SheetError, bending_radius, check_offset, ruling_normal  # noqa: E402
+from ght_cad.unroll import unroll  # noqa: E402
+
+SHEER = np.array([[0, -900, 1200], [1500, -1000, 1250], [3000, -700, 1350], [4200, 0, 1500]], float)
+CHINE = np.array([[0, -700, 300], [1500, -800, 350], [3000, -500, 700], [4200, 0, 1500]], float)
+BOW_TOML = Path(__file__).resolve().parent.parent / "examples" / "design_bow_plate.toml"
+
+
+def bow(both: bool = False, chine: np.ndarray | None = None, sheer: np.ndarray | None = None):
+    c = (CHINE if chine is None else chine).copy()
+    s = (SHEER if sheer is None else sheer).copy()
+    if both:  # the rails meet at both ends (a lens-shaped panel)
+        c[0] = s[0] = [0.0, -800.0, 700.0]
+    return developable_loft(GHTCurve(c), GHTCurve(s))
+
+
+def _size(loft) -> float:
+    u = np.linspace(0.0, 1.0, 65)
+    p = np.vstack([loft.a(u), loft.b(u)])
+    return float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
+
+
+def _face_points(face, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    s = BRep_Tool.Surface_s(face)
+    return np.array([s.Value(float(a), float(b)).Coord() for a, b in zip(u, v)])
+
+
+def check_pointed_plate(loft, sheet: Sheet) -> dict:
+    """Valid solid, no end wall at a point, inside on S, outside at T, volume = closed form."""
+    T, sig = sheet.thickness, sheet.sign
+    plate = plate_solid(loft, sheet)
+    assert is_valid(plate.solid)
+    pointed = plate.data.pointed
+    g = loft.ruling_lengths(np.array([0.0, 1.0]))
+    assert pointed == (bool(g[0] == 0), bool(g[1] == 0))
+    assert len(plate.edges) == 4 - sum(pointed)
+    assert [n for n, _ in plate.named_faces()][:2] == ["inside", "outside"]
+    size = _size(loft)
+    lam = np.linspace(0.0, 1.0, 41)
+    vv = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    U, V = np.repeat(lam, vv.size), np.tile(vv, lam.size)
+    X = loft.evaluate(U, V)
+    n = ruling_normal(loft, U, 0)[0]
+    d_in = float(np.linalg.norm(_face_points(plate.inside, U, V) - X, axis=1).max())
+    d_out = float(np.linalg.norm(_face_points(plate.outside, U, V) - (X + sig * T * n), axis=1).max())
+    assert d_in <= 1e-6 * min(size, T)
+    assert d_out <= 1e-6 * T
+    # outside at distance T from the inside face's surface, independently of the parametrization
+    inner = BRep_Tool.Surface_s(plate.inside)
+    keep = (V > 0) & (V < 1) & (U > 0) & (U < 1)
+    dist = []
+    for p in _face_points(plate.outside, U[keep], V[keep]):
+        proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*p), inner)
+        assert proj.NbPoints() > 0
+        dist.append(proj.LowerDistance())
+    assert np.max(np.abs(np.array(dist) - T)) <= 1e-6 * T
+    Vc = plate_volume(loft, sheet)
+    assert abs(plate.volume / Vc - 1) <= 1e-6
+    return {"plate": plate, "V": plate.volume, "Vc": Vc}
+
+
+# -- the loft and the limit normal at the point --------------------------------------------------
+@pytest.mark.parametrize("both", [False, True])
+def test_pointed_loft_is_exact_and_its_pattern_too(both: bool) -> None:
+    loft = bow(both)
+    g = loft.ruling_lengths(np.array([0.0, 1.0]))
+    assert g[1] == 0.0 and (g[0] == 0.0) == both
+    # the branch near the corner: the ruling direction is smooth (no eps/|g| noise), the
+    # developability residual at round-off
+    e = np.array([1e-2, 1e-4, 1e-6, 1e-8, 1e-10])
+    n = ruling_normal(loft, 1.0 - e, 0)[0]
+    n_end, n1_end = (x[0] for x in ruling_normal(loft, np.array([1.0]), 1))
+    # |n(1) - n(1 - e)| / e -> |n'(1)|: the n'' term (measured 0.35 e) plus the difference's
+    # round-off (eps/e: measured 1.7e-6 at e = 1e-10); noise of eps/|g| would be ~1e-4 there
+    slope = np.linalg.norm(n - n_end, axis=1) / e
+    assert np.all(np.abs(slope / np.linalg.norm(n1_end) - 1) <= 0.5 * e + 1e-15 / e)
+    assert loft.report.theta_max_deg <= 1e-9
+    pat = unroll(loft, rulings=8)
+    assert pat.errors["max"] <= 1e-9
+    assert pat.errors["boundary_length"] <= 1e-12  # measured 4e-16 (2.8e-9 before the corner fix)
+
+
+def test_limit_normal_and_radius_at_the_point() -> None:
+    loft = bow()
+    # the normal, its derivative and the bending radius tend to their values at the point
+    e = np.array([1e-3, 1e-4, 1e-5, 1e-6])
+    n, n1 = ruling_normal(loft, 1.0 - e, 1)
+    (n0,), (n10,) = ruling_normal(loft, np.array([1.0]), 1)
+    assert np.all(np.linalg.norm(n - n0, axis=1) <= 1.0 * e)  # |n'| = 0.715
+    assert np.linalg.norm(n1[-1] - n10) <= 1e-5 * np.linalg.norm(n10)
+    assert np.all(np.linalg.norm(n1 - n10, axis=1) <= 5.0 * e * np.linalg.norm(n10) + 1e-6 * np.linalg.norm(n10))
+    r_end = bending_radius(loft, np.array([1.0, 1.0]), np.array([0.0, 1.0]))
+    assert r_end[0] == pytest.approx(r_end[1], rel=1e-12)  # a zero ruling: both ends are the point
+    r = bending_radius(loft, 1.0 - e, np.full(e.size, 0.5))
+    assert np.all(np.abs(r / r_end[0] - 1) <= 30.0 * e)
+    # the normal is the ruled-surface normal's limit from inside: X_u x X_v at u = 1 - 1e-7
+    u = np.array([1.0 - 1e-7])
+    xu = loft.a(u, 1) + 0.5 * loft.ruling(u, 1)
+    m = np.cross(xu, loft.ruling(u))[0]
+    assert np.dot(m / np.linalg.norm(m), n0) > 1 - 1e-12
+
+
+def test_too_thick_is_refused_at_the_point_with_the_radius() -> None:
+    loft = bow()
+    r_end = float(abs(bending_radius(loft, np.array([1.0]), np.array([0.5]))[0]))
+    rmin = check_offset(loft, Sheet(4.0, 0.44))
+    assert rmin <= r_end * (1 + 1e-12)
+    # a neutral offset beyond the smallest radius: refused naming the ruling and the radius
+    K = 1.0
+    T = 1.001 * rmin / K
+    with pytest.raises(SheetError, match=r"reaches the bending radius .* of the ruling at u=") as exc:
+        check_offset(loft, Sheet(T, K))
+    assert exc.value.constraint in ("radius", "centre") and exc.value.radius == pytest.approx(rmin, rel=1e-9)
+    # just below the radius: accepted (the point is regular, not refused spuriously)
+    assert check_offset(loft, Sheet(0.999 * rmin / K, K)) == rmin
+
+
+def test_tangent_rails_at_the_point_are_refused() -> None:
+    # a ruled surface whose boundaries meet tangentially at u = 1: c' x g' = 0 there
+    from ght_cad.ruled import CurvePairRuledSurface
+
+    a = GHTCurve(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]], float))
+    b = GHTCurve(np.array([[0, 1, 0.2], [1, 1, 0.1], [2, 0, 0], [3, 0, 0]], float))  # same end tangent
+    surf = CurvePairRuledSurface(a, b)
+    if np.linalg.norm(np.cross(surf.a(np.array([1.0]), 1), surf.b(np.array([1.0]), 1))) > 1e-9:
+        pytest.skip("the test rails are not tangent at the point")
+    with pytest.raises(SheetError, match="meet tangentially"):
+        ruling_normal(surf, np.array([1.0]))
+
+
+# -- the plate ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("both, T, side", [(False, 4.0, "normal"), (False, 4.0, "reverse"), (False, 60.0, "normal"),
+                                           (True, 4.0, "normal"), (True, 20.0, "reverse")])
+def test_plate_of_a_pointed_loft(both: bool, T: float, side: str) -> None:
+    out = check_pointed_plate(bow(both), Sheet(T, 0.44, side))
+    names = [n for n, _ in out["plate"].named_faces()]
+    assert names == ["inside", "outside"] + [f"edge{i + 1}" for i in range(2 if both else 3)]
+    # the inside face ends in a degenerate (point) edge at each pointed end
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    ex, deg = TopExp_Explorer(out["plate"].inside, TopAbs_EDGE), 0
+    while ex.More():
+        deg += BRep_Tool.Degenerated_s(TopoDS.Edge_s(ex.Current()))
+        ex.Next()
+    assert deg == (2 if both else 1)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(dy1=st.floats(-200.0, 200.0), dz2=st.floats(-200.0, 200.0), dz0=st.floats(-300.0, 300.0),
+       both=st.booleans(), T=st.floats(0.5, 60.0), side=st.sampled_from(["normal", "reverse"]))
+def test_every_accepted_pointed_plate_is_exact(dy1, dz2, dz0, both, T, side) -> None:
+    """Bow rails moved in a box (chine's second point, sheer's third point height, sheer start
+    height), one or both ends pointed, any T and side: a refusal is the sheet check's (before
+    OCCT); every accepted plate is valid, on the design surface and at distance T."""
+    chine, sheer = CHINE.copy(), SHEER.copy()
+    chine[1, 1] += dy1
+    sheer[2, 2] += dz2
+    sheer[0, 2] += dz0
+    try:
+        loft = bow(both, chine, sheer)
+    except NotDevelopableError:
+        assume(False)
+    sheet = Sheet(T, 0.44, side)
+    try:
+        check_offset(loft, sheet)
+    except SheetError as exc:
+        assert exc.constraint in ("apex", "radius", "centre")
+        event(f"refused: {exc.constraint}")
+        return
+    event(f"accepted: {side}, both={both}")
+    check_pointed_plate(loft, sheet)
+
+
+def test_pointed_plate_step_names_and_readers(tmp_path) -> None:
+    loft = bow()
+    plate = plate_solid(loft, Sheet(4.0, 0.44))
+    path = write_plate_step(plate, tmp_path / "bow.step")
+    shape, names = read_step_face_names(path)
+    assert sorted(names.values()) == ["edge1", "edge2", "edge3", "inside", "outside"]
+    pf = plate_faces(shape, names)
+    assert pf is not None and pf.how == "names"
+    assert pf.thickness == pytest.approx(4.0, rel=1e-6)
+
+
+# -- the design run --------------------------------------------------------------------------------
+def test_run_bow_plate_with_a_sheet(tmp_path, capsys) -> None:
+    from ght_cad.cli import main
+
+    out = tmp_path / "out"
+    assert main(["run", str(BOW_TOML), "--out", str(out)]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    plate = rep["plate"]
+    assert plate["valid"] and plate["solids"] == 1
+    assert abs(plate["volume"] / plate["volume_closed_form"] - 1) <= 1e-6
+    errs = rep["flat_pattern"]["errors"]
+    assert errs["max"] <= 1e-9
+    sh = rep["flat_pattern"]["sheet"][0]
+    assert math.isfinite(sh["min_bending_radius"])
+    assert all(math.isfinite(r["radius_a"]) and math.isfinite(r["radius_b"]) for r in sh["forming"])
