@@ -408,6 +408,11 @@ def face_of_source(obj: Any) -> "Part.Face | None":
     subs = [s for s in (subs or []) if s]
     if not subs and hasattr(getattr(src, "Proxy", None), "surface"):
         return None
+    if not subs and hasattr(getattr(src, "Proxy", None), "inside_face"):  # a GHT Plate: its inside face
+        face = src.Proxy.inside_face(src)
+        if face is None:
+            raise GHTError(f"{src.Label} has no inside face yet (recompute it); allowed: a face ({src.Label}.FaceN) or a developable feature")
+        return face
     faces = src.Shape.Faces
     if not faces:
         raise GHTError(f"{src.Label} has no faces to unroll; allowed: a face or a developable feature of this workbench")
@@ -460,14 +465,15 @@ def _grid_points(face: "Part.Face", n: int = 5) -> list[Any]:
     return [face.valueAt(u0 + a * (u1 - u0), v0 + b * (v1 - v0)) for a in np.linspace(0.05, 0.95, n) for b in np.linspace(0.05, 0.95, n)]
 
 
-def plate_partner(shape: "Part.Shape", face: "Part.Face", rtol: float = 1e-6) -> tuple["Part.Face", float, str] | None:
-    r"""The plate a face belongs to (a SheetMetal-style or ``Part::Thickness`` solid).
+def plate_partner(shape: "Part.Shape", face: "Part.Face", rtol: float = 1e-6, inside: "Part.Face | None" = None) -> tuple["Part.Face", float, str] | None:
+    r"""The plate a face belongs to (a SheetMetal-style or ``Part::Thickness`` solid, a GHT Plate).
 
     Among the other faces of ``shape`` with at least a quarter of the face's area, the first whose
     25 grid points lie at a constant distance (spread <= ``rtol`` x size) from the face's surface
-    (``Surface.parameter`` projection) is the opposite face. The inside face is the smaller of the
-    two (the concave side of a bend); the side is where the other face lies relative to the
-    inside face's normal (``normalAt``, orientation included).
+    (``Surface.parameter`` projection) is the opposite face. The inside face is ``inside`` when it
+    is one of the two (a GHT Plate knows its design face), else the smaller of the two (the
+    concave side of a bend); the side is where the other face lies relative to the inside face's
+    normal (``normalAt``, orientation included).
 
     Returns:
         ``(inside face, thickness, side)`` or None (no solid, or no opposite face).
@@ -478,7 +484,10 @@ def plate_partner(shape: "Part.Shape", face: "Part.Face", rtol: float = 1e-6) ->
     for other in shape.Faces:
         if other.isSame(face) or other.Area < 0.25 * face.Area:
             continue
-        inner, outer = (face, other) if face.Area <= other.Area else (other, face)
+        if inside is not None and (inside.isSame(face) or inside.isSame(other)):
+            inner, outer = (face, other) if inside.isSame(face) else (other, face)
+        else:
+            inner, outer = (face, other) if face.Area <= other.Area else (other, face)
         dist, signs = [], []
         for p in _grid_points(outer):
             try:
@@ -525,7 +534,7 @@ class FlatPatternFeature(FeatureProxy):
             obj.Side = SIDES
             obj.Side = "normal"
         if "ThicknessFromSolid" not in have:
-            obj.addProperty("App::PropertyBool", "ThicknessFromSolid", "Sheet", "With Thickness 0 and a face of a solid plate: use the solid's thickness, inside face and side")
+            obj.addProperty("App::PropertyBool", "ThicknessFromSolid", "Sheet", "With Thickness 0 and a face of a solid plate: use the solid's thickness, inside face and side (a GHT Plate: also its KFactor)")
             obj.ThicknessFromSolid = True
         if "ThicknessUsed" not in have:
             obj.addProperty("App::PropertyFloat", "ThicknessUsed", "Output", "Sheet thickness the pattern was made with (0: none)")
@@ -551,10 +560,13 @@ class FlatPatternFeature(FeatureProxy):
         if T > 0:
             return Sheet(T, K, str(obj.Side)), face
         if face is not None and bool(obj.ThicknessFromSolid):
-            found = plate_partner(obj.Source[0].Shape, face)
+            src = obj.Source[0]
+            proxy = getattr(src, "Proxy", None)
+            is_plate = hasattr(proxy, "inside_face")  # a GHT Plate: its design face and K-factor
+            found = plate_partner(src.Shape, face, inside=proxy.inside_face(src) if is_plate else None)
             if found is not None:
                 inner, thickness, side = found
-                return Sheet(thickness, K, side), inner
+                return Sheet(thickness, float(src.KFactor) if is_plate else K, side), inner
         Sheet(0.0, K, str(obj.Side))  # validates K and Side even without a thickness
         return None, face
 
