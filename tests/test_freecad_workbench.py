@@ -162,7 +162,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     expected = {
         "GHT_Curve", "GHT_CompositeCurve", "GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern",
         "GHT_Optimization", "GHT_RunOptimization", "GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG",
-        "GHT_DevelopableLoft",
+        "GHT_DevelopableLoft", "GHT_Plate",
     }
     assert expected <= set(res["commands"]), res["commands"]
     assert all(res["commands"].values()), res["commands"]
@@ -188,7 +188,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     # have no shape parameters of their own: a panel that says what to edit instead)
     clicked = steps["double-click every feature"]["value"]
     assert {"GHT::Curve", "GHT::CompositeCurve", "GHT::Developable", "GHT::SpineDevelopable", "GHT::FlatPattern",
-            "GHT::Optimization"} <= set(clicked), clicked
+            "GHT::Optimization", "GHT::Plate"} <= set(clicked), clicked
     for kind, info in clicked.items():
         assert info["handled"] and info["dialog"] and info["panel"], (kind, info)
     for kind in ("GHT::Curve", "GHT::CompositeCurve", "GHT::Developable", "GHT::SpineDevelopable"):
@@ -204,12 +204,14 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
         "GHT::CompositeCurve": "a composite curve needs >= 2 segments; OrphanComposite has 0",
         "GHT::JoinedDevelopable": "Previous is not set; link a developable (from planes) or a joined developable",
         "GHT::FlatPattern": "OrphanFlat: no Source linked",
+        "GHT::Plate": "OrphanPlate: no Source linked; link a developable feature (from planes, joined, loft, spine/geodesic)",
     }
     lines = {  # the one Report view line each prints (its Label first, not repeated)
         "OrphanSpine: no Curve linked",
         "OrphanComposite: a composite curve needs >= 2 segments; OrphanComposite has 0",
         "OrphanJoined: Previous is not set; link a developable (from planes) or a joined developable",
         "OrphanFlat: no Source linked",
+        "OrphanPlate: no Source linked; link a developable feature (from planes, joined, loft, spine/geodesic)",
     }
     for name in ("features with unset links: recompute", "features with unset links: double-click"):
         got = _report_lines(steps[name])
@@ -224,7 +226,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert not unset["failed"]["GHT::Optimization"], unset  # its recompute does nothing; it fails only when run
     orphans = steps["features with unset links: double-click"]["value"]
     expected_msg = {"GHT::SpineDevelopable": "Curve", "GHT::CompositeCurve": "Segments", "GHT::JoinedDevelopable": "Previous",
-                    "GHT::FlatPattern": "Source", "GHT::Optimization": "Targets"}
+                    "GHT::FlatPattern": "Source", "GHT::Optimization": "Targets", "GHT::Plate": "Source"}
     assert set(orphans) == set(expected_msg), orphans
     for kind, prop in expected_msg.items():
         info = orphans[kind]
@@ -236,8 +238,13 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert lf["segments"] == ["main"] and lf["faces"] == 1 and lf["icon"], lf
     assert "RailA = RimA.Edge1" in lf["report"] and "fan share 0" in lf["report"], lf
     assert "RailB is not linked" in lf["unset"] and "Traceback" not in lf["unset"], lf
+    # the plate of the default quarter cylinder (T = 1): one valid solid of six faces, its volume
+    # (knot-split Shape.Volume) within 1e-8 of the closed form
+    pl = steps["GHT_Plate"]["value"]
+    assert pl["valid"] and not pl["failed"] and pl["shape_type"] == "Solid" and pl["faces"] == 6, pl
+    assert abs(pl["volume_error"]) < 1e-8 and abs(pl["volume"] / pl["closed_form"] - 1) < 1e-8, pl
     r = steps["reopen"]["value"]
-    assert r["objects"] == 9 and not r["bad"] and r["icons"] and r["panel_open"], r
+    assert r["objects"] == 10 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]
     assert opt["best"] <= opt["initial"] and not opt["status"].startswith("cancelled"), opt
     cancel = steps["cancel optimization"]["value"]

@@ -325,6 +325,14 @@ def main():
         step("GHT_DevelopableLoft", loft)
     if "GHT_FlatPattern" in _base.COMMANDS and "developable" in ctx:
         step("GHT_FlatPattern", generic("GHT_FlatPattern", "developable", "GHT::FlatPattern", "flat"))
+    if "GHT_Plate" in _base.COMMANDS and "developable" in ctx:
+        def plate_step():
+            out = generic("GHT_Plate", "developable", "GHT::Plate", "plate")()
+            pl = ctx["plate"]
+            out.update({"shape_type": pl.Shape.ShapeType, "faces": len(pl.Shape.Faces), "volume": pl.Volume,
+                        "closed_form": pl.ClosedFormVolume, "volume_error": pl.VolumeError, "failed": _base.failed(pl)})
+            return out
+        step("GHT_Plate", plate_step)
     if "GHT_Optimization" in _base.COMMANDS and "developable" in ctx:
         step("GHT_Optimization", generic("GHT_Optimization", "developable", "GHT::Optimization", "optimization"))
     if "GHT_RunOptimization" in _base.COMMANDS and "optimization" in ctx:
@@ -464,6 +472,7 @@ def main():
         "GHT::CompositeCurve": "a composite curve needs >= 2 segments; OrphanComposite has 0",
         "GHT::JoinedDevelopable": "Previous is not set; link a developable (from planes) or a joined developable",
         "GHT::FlatPattern": "OrphanFlat: no Source linked",
+        "GHT::Plate": "OrphanPlate: no Source linked; link a developable feature (from planes, joined, loft, spine/geodesic)",
     }
     # ... and the one Report view line each prints: "<Label>: <status>" (the Label not repeated)
     UNSET_LINES = [
@@ -471,6 +480,7 @@ def main():
         "OrphanComposite: a composite curve needs >= 2 segments; OrphanComposite has 0",
         "OrphanJoined: Previous is not set; link a developable (from planes) or a joined developable",
         "OrphanFlat: no Source linked",
+        "OrphanPlate: no Source linked; link a developable feature (from planes, joined, loft, spine/geodesic)",
     ]
 
     def tree_items(labels, marked_over=None):
@@ -530,6 +540,10 @@ def main():
             flat_pattern.make_flat_pattern(ctx["developable"], doc=doc, name="OrphanFlat"),
             optimization.make_optimization([c1], doc=doc, name="OrphanOptimization"),
         ]
+        if "GHT_Plate" in _base.COMMANDS:
+            from freecad.ght_workbench import plate
+
+            orphans.append(plate.make_plate(ctx["developable"], doc=doc, name="OrphanPlate"))
         ok_before = {o.Proxy.Type: not _base.failed(o) for o in orphans}
         labels = [o.Label for o in orphans]
         mw = Gui.getMainWindow()
