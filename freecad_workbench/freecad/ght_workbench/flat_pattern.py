@@ -566,7 +566,12 @@ class FlatPatternFeature(FeatureProxy):
             found = plate_partner(src.Shape, face, inside=proxy.inside_face(src) if is_plate else None)
             if found is not None:
                 inner, thickness, side = found
-                return Sheet(thickness, float(src.KFactor) if is_plate else K, side), inner
+                if is_plate:  # the plate's exact T and K; its faces are fitted within 3e-7 T each
+                    exact = float(src.Thickness.Value)
+                    if not abs(thickness - exact) <= 1e-6 * exact:
+                        raise GHTError(f"{obj.Label}: the faces of {src.Label} are {thickness!r} apart, not its Thickness {exact!r}; recompute {src.Label}")
+                    return Sheet(exact, float(src.KFactor), side), inner
+                return Sheet(thickness, K, side), inner
         Sheet(0.0, K, str(obj.Side))  # validates K and Side even without a thickness
         return None, face
 
