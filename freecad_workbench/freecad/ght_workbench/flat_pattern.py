@@ -16,8 +16,9 @@ isolines' deviation or θ_max / DD unless ``BestEffort``.
 Sheet metal (spec 6.1): with ``Thickness`` T > 0, ``KFactor`` K and ``Side`` (material along the
 face/surface normal or against it) the pattern is the development of the neutral surface
 ``S ± K T n`` (:mod:`ght_cad.sheet`); with Thickness 0 and a face of a solid plate (a SheetMetal
-base bend, ``Part::Thickness``, ``makeThickness``) the thickness, inside face and side are read
-from the solid (:func:`plate_partner`). ``FormingTable`` lists each bend line's neutral bending
+base bend, ``Part::Thickness``, ``makeThickness``, a GHT Plate) the thickness, inside face and side
+are read from the solid (:func:`plate_partner`; a GHT Plate, :mod:`.plate`, gives its inside face,
+exact thickness and K-factor; as Source without a face it stands for its inside face). ``FormingTable`` lists each bend line's neutral bending
 radius and angle; the DXF export carries them on layer FORMING.
 
 Every boundary edge of the pattern is fitted as a planar B-spline edge (straight ones become
