@@ -42,7 +42,7 @@ import Part
 
 from freecad.ght_workbench import _base, developable, developable_loft, export, flat_pattern, ght_curve, plate, spine_developable
 from freecad.ght_workbench.tests.fc_features import _recompute, _reopen
-from freecad.ght_workbench.tests.refusal import RefusalAssertions
+from freecad.ght_workbench.tests.refusal import RefusalAssertions, console_output
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_plate_")
 # the dory's chine and sheer (examples/design_hull_plate.toml), as in fc_loft
@@ -302,7 +302,7 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
         # a failed Source: the plate refuses to build on it
         dev.BoundaryCoordinates = [1.0, 2.0, 3.0]
         dev.BoundaryPlanes = []
-        _, text = __import__("freecad.ght_workbench.tests.refusal", fromlist=["x"]).console_output(self.doc.recompute)
+        _, text = console_output(self.doc.recompute)
         self.assertTrue(_base.failed(dev), text)
         self.assert_no_traceback(text)
         self.assertTrue(_base.failed_input(pl) is dev)
