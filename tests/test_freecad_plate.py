@@ -1,7 +1,7 @@
 """The GHT Plate feature in FreeCAD, and its STEP file read back with OCP.
 
 * ``freecadcmd -t freecad.ght_workbench.tests.fc_plate`` (see that module): exact plates of a
-  developable from planes, a loft with fans and a spine developable; volumes vs the closed form;
+  developable from planes, a loft with fans, a pointed loft (no end wall) and a spine developable; volumes vs the closed form;
   inside/outside faces; recompute, refusals, flat pattern of the plate, save/reopen, STEP;
 * the hull plate's STEP file FreeCAD wrote is read here with OCP: one valid solid whose volume
   (``ght_cad.cad.occ.volume``, C0 faces split first) equals the closed form to 1e-8 relative and
@@ -21,7 +21,7 @@ pytestmark = pytest.mark.freecad
 
 
 def test_plate_inside_freecad_and_its_step_read_back(tmp_path) -> None:
-    run_fc_unittest("freecad.ght_workbench.tests.fc_plate", tmp_path, 6, timeout=600)
+    run_fc_unittest("freecad.ght_workbench.tests.fc_plate", tmp_path, 7, timeout=600)
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
     from OCP.TopAbs import TopAbs_SOLID

@@ -200,12 +200,14 @@ class PlateFeature(FeatureProxy):
         data = plate_bspline(surface, sheet)
         T = sheet.thickness
         solid, surfaces = plate_shape(data, T, f"the plate {obj.Label}")
-        # which face of the sewn solid is which: the solid's faces lie on the six surfaces
+        # which face of the sewn solid is which: the solid's faces lie on the surfaces (six, or
+        # five/four without the end wall of a pointed end: data.faces leaves those out)
+        built = [name for name, _ in data.faces]
         names = []
         for f in solid.Faces:  # which surface each face of the sewn solid lies on
             p = f.valueAt(*_mid(f))
-            names.append(FACE_NAMES[int(np.argmin([(s.value(*s.parameter(p)) - p).Length for s in surfaces]))])
-        if sorted(names) != sorted(FACE_NAMES):
+            names.append(built[int(np.argmin([(s.value(*s.parameter(p)) - p).Length for s in surfaces]))])
+        if sorted(names) != sorted(built):
             raise GHTError(f"the faces of the plate {obj.Label} could not be told apart ({names})")
         tol = sew_tolerance(float(data.info["size"]), T)
         volume = split_volume(surfaces, tol, f"the plate {obj.Label}")

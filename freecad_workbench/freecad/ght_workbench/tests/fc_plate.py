@@ -47,6 +47,9 @@ from freecad.ght_workbench.tests.refusal import RefusalAssertions, console_outpu
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_plate_")
 # the dory's chine and sheer (examples/design_hull_plate.toml), as in fc_loft
 CHINE = [(0, -700, 300), (1500, -1050, 200), (3000, -1150, 250), (4500, -950, 450)]
+# the bow of examples/design_bow_plate.toml: both rails end at (4200, 0, 1500)
+BOW_SHEER = [(0, -900, 1200), (1500, -1000, 1250), (3000, -700, 1350), (4200, 0, 1500)]
+BOW_CHINE = [(0, -700, 300), (1500, -800, 350), (3000, -500, 700), (4200, 0, 1500)]
 SHEER = [(0, -900, 1200), (1500, -1250, 1150), (3000, -1300, 1180), (4500, -1100, 1300)]
 VOLUME_RTOL = 1e-8
 
@@ -65,16 +68,17 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
             App.closeDocument(name)
 
     # -- helpers -----------------------------------------------------------------------------
-    def assert_plate(self, pl, what: str) -> None:
-        """Valid solid of six named faces; Volume vs closed form; inside on X, outside at T."""
+    def assert_plate(self, pl, what: str, names: tuple = plate.FACE_NAMES) -> None:
+        """Valid solid of the named faces (six; a pointed end has no end wall); Volume vs closed
+        form; inside on X, outside at T."""
         from ght_cad.sheet import ruling_normal
 
         self.assertFalse(_base.failed(pl), f"{what}: {pl.getStatusString()}")
         sh = pl.Shape
         self.assertEqual(sh.ShapeType, "Solid", what)
         self.assertTrue(sh.isValid(), what)
-        self.assertEqual(len(sh.Faces), 6, what)
-        self.assertEqual(sorted(pl.FaceNames), sorted(plate.FACE_NAMES), what)
+        self.assertEqual(len(sh.Faces), len(names), what)
+        self.assertEqual(sorted(pl.FaceNames), sorted(names), what)
         self.assertGreater(sh.Volume, 0.0, what)
         self.assertAlmostEqual(sh.Volume, pl.ShapeVolume, delta=1e-12 * abs(sh.Volume))
         self.assertLess(abs(pl.VolumeError), VOLUME_RTOL, f"{what}: Volume {pl.Volume!r} closed form {pl.ClosedFormVolume!r}")
@@ -237,6 +241,17 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
         self.assertLess(abs(back.Solids[0].Volume / pl.ShapeVolume - 1.0), 1e-9)
         with open(os.path.join(OUT, "fc_plate.json"), "w") as fh:
             json.dump({"closed_form": pl.ClosedFormVolume, "volume": pl.Volume, "shape_volume": pl.ShapeVolume, "T": T}, fh)
+
+    def test_plate_of_pointed_loft(self):
+        """A bow where the chine meets the sheer (examples/design_bow_plate.toml): the zero-length
+        end ruling has no end wall, so the plate has five faces, one of them per rail wall meeting
+        along P .. P + T n."""
+        a = ght_curve.make_ght_curve(BOW_CHINE, doc=self.doc, name="BowChine")
+        b = ght_curve.make_ght_curve(BOW_SHEER, doc=self.doc, name="BowSheer")
+        lf = developable_loft.make_developable_loft(a, b, doc=self.doc, name="BowLoft")
+        self.assertEqual(_recompute(self.doc), [])
+        pl = plate.make_plate(lf, 4.0, 0.44, "normal", doc=self.doc, name="BowPlate")
+        self.assert_plate(pl, "pointed bow loft", ("inside", "outside", "wall_a", "wall_b", "end0"))
 
     def test_plate_of_spine_developable(self):
         c = ght_curve.make_ght_curve([(0, 0, 0), (10, 0, 5), (20, 10, 5), (25, 20, 0)], doc=self.doc, name="Spine curve")
