@@ -328,12 +328,18 @@ def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> 
     La = curve_len("a")
     Lb = curve_len("b")
     g0, g1 = surface.ruling_lengths(np.array([0.0, 1.0]))
-    return [
-        edge("a", lambda t: (t, np.zeros_like(t)), La),
-        edge("ruling u=1", lambda t: (np.ones_like(t), t), float(g1)),
-        edge("b", lambda t: (1.0 - t, np.ones_like(t)), Lb),
-        edge("ruling u=0", lambda t: (np.zeros_like(t), 1.0 - t), float(g0)),
-    ]
+    lengths = {"a": La, "ruling u=1": float(g1), "b": Lb, "ruling u=0": float(g0)}
+    return [edge(name, uv, lengths[name]) for name, uv in RULED_EDGE_UV.items()]
+
+
+#: the four boundary edges of a ruled panel in order around it, ``t -> (u, v)``: a(u), ruling u=1,
+#: b(u) reversed, ruling u=0
+RULED_EDGE_UV: dict[str, Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]] = {
+    "a": lambda t: (t, np.zeros_like(t)),
+    "ruling u=1": lambda t: (np.ones_like(t), t),
+    "b": lambda t: (1.0 - t, np.ones_like(t)),
+    "ruling u=0": lambda t: (np.zeros_like(t), 1.0 - t),
+}
 
 
 def _smooth_pieces(surface: RuledSurface) -> list[tuple[float, float]]:
@@ -652,6 +658,7 @@ def unroll_composite(
     labels: Sequence[str] | None = None,
     gap: float | None = None,
     sheet: Any = None,
+    marks_on: str = "pattern",
 ) -> FlatPattern:
     """Unroll several surfaces/faces into one pattern: one labelled panel per face.
 
@@ -667,12 +674,17 @@ def unroll_composite(
         best_effort, tol_deg, rulings, samples, units: as in :func:`unroll`.
         sheet: one :class:`ght_cad.sheet.Sheet` for every part, or a sequence of them (one per
             part, None for none): each panel is its part's neutral surface.
+        marks_on: ``"pattern"``: edges are matched on the panels' own 3-D edges (the neutral
+            surfaces' with a sheet); ``"design"``: on the design surfaces' edges at the same
+            parameters, so panels whose neutral surfaces part along a shared rail (plates of
+            surfaces meeting at an angle: the offsets ``±K T n`` differ there) still get their
+            marks, at the same rail points (ruled parts; faces keep their own edges).
 
     Returns:
         FlatPattern with one panel per part; ``.report`` aggregates all panels.
 
     Raises:
-        GHTError: an empty list or a label count that does not match.
+        GHTError: an empty list, a label count that does not match, an unknown ``marks_on``.
     """
     parts = list(parts)
     if not parts:
@@ -684,14 +696,30 @@ def unroll_composite(
     sheets = list(sheet) if isinstance(sheet, (list, tuple)) else [sheet] * len(parts)
     if len(sheets) != len(parts):
         raise GHTError(f"{len(sheets)} sheets given for {len(parts)} parts; give one sheet (or None) per part")
+    if marks_on not in ("pattern", "design"):
+        raise GHTError(f"marks_on={marks_on!r} is not allowed; allowed: 'pattern', 'design'")
     panels: list[FlatPanel] = []
+    swap: list[tuple[Any, np.ndarray]] = []  # (edge, design points) for marks_on="design"
     for part, lab, sh in zip(parts, labels, sheets):
         pat = unroll(part, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units, label=lab,
                      sheet=sh)
         panels.extend(pat.panels)
+        if marks_on == "design" and sh is not None and not sh.is_zero and isinstance(part, RuledSurface):
+            for pn in pat.panels:
+                for e in pn.loops[0]:
+                    if e.name in RULED_EDGE_UV:
+                        u, v = RULED_EDGE_UV[e.name](np.linspace(0.0, 1.0, len(e.xyz)))
+                        swap.append((e, np.asarray(part.evaluate(u, v), dtype=float)))
     from .flat_pattern import layout_panels, mark_shared_edges
 
-    mark_shared_edges(panels)
+    kept = [e.xyz for e, _ in swap]
+    for e, pts in swap:
+        e.xyz = pts
+    try:
+        mark_shared_edges(panels)
+    finally:
+        for (e, _), old in zip(swap, kept):
+            e.xyz = old
     layout_panels(panels, gap)
     return FlatPattern(panels, units=units)
 

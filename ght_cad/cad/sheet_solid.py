@@ -91,10 +91,15 @@ class PlateSolid:
     sheet: Sheet
     data: Any = None
     surface: Any = None
+    #: the solid's name in STEP (None: unnamed); its faces are then named ``<name>.inside``, ...
+    name: str | None = None
 
     def named_faces(self) -> list[tuple[str, TopoDS_Face]]:
-        """``[("inside", f), ("outside", f), ("edge1", f), ...]``."""
-        return [("inside", self.inside), ("outside", self.outside)] + [(f"edge{i + 1}", f) for i, f in enumerate(self.edges)]
+        """``[("inside", f), ("outside", f), ("edge1", f), ...]``, each prefixed ``<name>.`` when the
+        plate has a :attr:`name`."""
+        pre = f"{self.name}." if self.name else ""
+        return [(pre + "inside", self.inside), (pre + "outside", self.outside)] + [
+            (f"{pre}edge{i + 1}", f) for i, f in enumerate(self.edges)]
 
     @property
     def volume(self) -> float:
@@ -335,7 +340,8 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
 
     The solids go through ``STEPControl_Writer``; each face's ``ADVANCED_FACE`` entity (found by
     ``STEPConstruct::FindEntity`` in the writer's finder process) is named ``inside``,
-    ``outside`` or ``edge1..edgeN`` (:meth:`PlateSolid.named_faces`).
+    ``outside`` or ``edge1..edgeN`` (:meth:`PlateSolid.named_faces`; ``<name>.inside``, ... and the
+    solid itself ``<name>`` for a plate with a :attr:`PlateSolid.name`).
 
     Args:
         plate: one plate or several (written as a compound).
@@ -385,6 +391,10 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
             writer.Transfer(shape, STEPControl_AsIs)
             finder = writer.WS().TransferWriter().FinderProcess()
             for p in plates:
+                if p.name:  # the solid's MANIFOLD_SOLID_BREP carries the plate's name
+                    item = STEPConstruct.FindEntity_s(finder, p.solid)
+                    if item is not None and hasattr(item, "SetName"):
+                        item.SetName(TCollection_HAsciiString(p.name))
                 for name, f in p.named_faces():
                     item = STEPConstruct.FindEntity_s(finder, f)
                     if item is None:
@@ -484,7 +494,8 @@ def _offset_distance(inner: TopoDS_Face, outer: TopoDS_Face, n: int = 5) -> tupl
 def plate_faces(shape: Any, names: dict[int, str] | None = None, *, rtol: float = 1e-6) -> PlateFaces | None:
     """Find the inside/outside faces of a plate solid (module doc), or None if it is no plate.
 
-    By names: faces named ``inside`` and ``outside``. Else geometrically: among pairs of the
+    By names: faces named ``inside`` and ``outside`` (or ``<plate>.inside`` and ``<plate>.outside``
+    of one plate name). Else geometrically: among pairs of the
     largest faces (each at least a quarter of the largest's area), the pair whose points lie at a
     constant distance (spread <= ``rtol`` × size, distance > 0) from the other's surface; the face
     with the smaller area is the inside (the concave side of a bend).
@@ -499,10 +510,15 @@ def plate_faces(shape: Any, names: dict[int, str] | None = None, *, rtol: float 
     size = max(math.sqrt(a) for a in areas)
     pairs: list[tuple[int, int, str]] = []
     if names:
-        ins = [k for k, v in names.items() if v == "inside"]
-        outs = [k for k, v in names.items() if v == "outside"]
-        if len(ins) == 1 and len(outs) == 1:
-            pairs.append((ins[0], outs[0], "names"))
+        def plate_of(v: str, what: str) -> str | None:
+            return "" if v == what else v[: -len(what) - 1] if v.endswith("." + what) else None
+
+        ins = {plate_of(v, "inside"): k for k, v in names.items() if plate_of(v, "inside") is not None}
+        outs = {plate_of(v, "outside"): k for k, v in names.items() if plate_of(v, "outside") is not None}
+        both = [q for q in ins if q in outs]
+        n_in = sum(1 for v in names.values() if plate_of(v, "inside") is not None)
+        if len(both) == 1 and n_in == 1:
+            pairs.append((ins[both[0]], outs[both[0]], "names"))
     if not pairs:
         big = sorted(range(len(faces)), key=lambda k: -areas[k])
         big = [k for k in big if areas[k] >= 0.25 * areas[big[0]]][:6]

@@ -99,6 +99,9 @@ class BuiltSurface:
     surface: Any
     curves: dict[str, Any]
     shape: dict[str, float]
+    #: ``design.sheet`` is this surface's own sheet of a ``[[surfaces]]`` design (side on its own
+    #: normal, overrides applied: :func:`ght_cad.design.shell_sheet.apply_sheets`)
+    sheet_resolved: bool = False
 
 
 def _initial_shape(design: Design, curves: dict[str, Any]) -> dict[str, float]:

@@ -137,7 +137,7 @@ def export_step(built: BuiltSurface | Sequence[BuiltSurface], path: str | os.Pat
 
     builts = list(built) if isinstance(built, (list, tuple)) else [built]
     edges = curve_edges(builts[0].curves) if with_curves else []
-    plates = plate_solids(builts[0]) if len(builts) == 1 else []
+    plates = plate_solids(builts[0]) if len(builts) == 1 else design_plates(builts)[0]
     if plates:
         from ..cad.sheet_solid import write_plate_step
 
@@ -181,6 +181,51 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
     return [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
 
 
+def design_plates(builts: Sequence[BuiltSurface]) -> tuple[list[Any], Any]:
+    """The plates of a ``[[surfaces]]`` design with a ``[sheet]``: every surface's
+    :func:`plate_solids` with its own sheet (:func:`ght_cad.design.shell_sheet.surface_sheets`:
+    the material on one side of the shell), each named after its surface (``<surface>`` or
+    ``<surface>.<strip>``; faces ``<name>.inside``, ...). Returns ``(plates, (sheets, rails, builts))``
+    with the resolved per-surface sheets and the shared rails (None when ``builts`` carry their
+    sheets already); ``([], None)`` without a sheet or with one surface; a surface with T = 0 has
+    no plate.
+
+    Raises:
+        GHTError: a surface the sheet cannot be made on (names ``surfaces[i]`` and the surface).
+    """
+    if len(builts) < 2 or builts[0].design.sheet is None:
+        return [], None
+    resolved = None if all(b.sheet_resolved for b in builts) else resolve_design_sheets(builts)
+    sheeted = builts if resolved is None else resolved[2]
+    plates: list[Any] = []
+    for b in sheeted:
+        pl = plate_solids(b)
+        names = ([f"{b.design.name}.{g.name}" for g in b.design.surface.segments or []] if _is_composite(b.surface)
+                 else [str(b.design.name)])
+        for p, nm in zip(pl, names):
+            p.name = nm
+        plates += pl
+    return plates, resolved
+
+
+def resolve_design_sheets(builts: Sequence[BuiltSurface]) -> tuple[list[Any], list[Any], list[BuiltSurface]]:
+    """Per-surface sheets of a ``[[surfaces]]`` design (:func:`ght_cad.design.shell_sheet.surface_sheets`),
+    checked on every surface (:func:`~ght_cad.design.shell_sheet.check_surface_sheets`), the
+    shared rails, and the built surfaces carrying their own sheet."""
+    from .shell_sheet import apply_sheets, check_surface_sheets, surface_sheets
+
+    from dataclasses import replace
+
+    if all(b.sheet_resolved for b in builts):
+        raise DesignError("the surfaces' sheets are resolved already")  # pragma: no cover - internal misuse
+    # the design of all surfaces (the sub-designs carry the file's [sheet] and their own surface)
+    parent = replace(builts[0].design, surface=None, surfaces=[b.design.surface for b in builts])
+    sheets, rails = surface_sheets(parent, builts)
+    sheeted = apply_sheets(builts, sheets)
+    check_surface_sheets(parent, sheeted)
+    return sheets, rails, sheeted
+
+
 def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     """Flat pattern of a design's surfaces: :func:`unroll_surface` of a single surface; for several,
     one labelled panel per surface (per strip for a composite: ``<surface>.<strip>``) on one sheet
@@ -191,18 +236,29 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     from ..unroll import unroll_composite
 
     d = builts[0].design
+    if d.sheet is not None and not all(b.sheet_resolved for b in builts):
+        builts = resolve_design_sheets(builts)[2]
     parts: list[Any] = []
     labels: list[str] = []
+    sheets: list[Any] = []
     for b in builts:
+        sh = b.design.sheet.to_sheet() if b.design.sheet is not None else None
         if _is_composite(b.surface):
             parts += list(b.surface.segments)
             labels += [f"{b.design.name}.{g.name}" for g in b.design.surface.segments or []]
+            sheets += [sh] * len(b.surface.segments)
         else:
             parts.append(b.surface)
             labels.append(b.design.name)
+            sheets.append(sh)
     best_effort = any(b.design.surface is not None and b.design.surface.type == "curves" for b in builts)
+    if all(s is None for s in sheets):  # no [sheet]: as before
+        return unroll_composite(parts, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                                samples=d.unroll.samples, units=d.units, labels=labels)
+    # [sheet]: every panel its surface's neutral surface; edge marks matched on the design edges (the
+    # neutral surfaces of two plates meeting at an angle part along their shared rail)
     return unroll_composite(parts, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                            samples=d.unroll.samples, units=d.units, labels=labels)
+                            samples=d.unroll.samples, units=d.units, labels=labels, sheet=sheets, marks_on="design")
 
 
 def pattern_report(pattern: Any) -> dict[str, Any]:

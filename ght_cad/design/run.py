@@ -23,6 +23,7 @@ from .optimize import optimize_design
 from .outputs import (_jsonable, brep_shapes, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
                       unroll_surfaces)
 from .report import report_markdown
+from .outputs import design_plates, resolve_design_sheets
 from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
 
 
@@ -57,6 +58,28 @@ def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
         }
         for k, c in curves.items()
     ]
+
+
+def _shell_plate_report(design: Design, builts: list[Any], plates: list[Any], sheets: list[Any],
+                        rails: list[Any]) -> dict[str, Any]:
+    """``report["plate"]`` of a ``[[surfaces]]`` design with a ``[sheet]``: the totals, per surface
+    its sheet, which way its material goes, its plates' volumes against the closed form
+    ``T A + σ (T²/2) ∫ 2H dA``, and per shared rail how the plates meet
+    (:func:`ght_cad.design.shell_sheet.rail_joints`)."""
+    from .shell_sheet import rail_joints
+
+    rows = []
+    for b, sh in zip(builts, sheets):
+        mine = [p for p in plates if p.name == b.design.name or str(p.name).startswith(f"{b.design.name}.")]
+        closed = [p.closed_form_volume for p in mine]
+        rows.append({**sh.as_dict(), "solids": [p.name for p in mine],
+                     "volume": float(sum(p.volume for p in mine)) if mine else 0.0,
+                     "volume_closed_form": None if None in closed else float(sum(closed))})
+    closed_all = [r["volume_closed_form"] for r in rows]
+    return {"valid": True, "solids": len(plates), "volume": float(sum(r["volume"] for r in rows)),
+            "volume_closed_form": None if None in closed_all else float(sum(closed_all)),
+            **design.sheet.to_sheet().as_dict(), "side_reference": design.sheet.side_reference,
+            "surfaces": rows, "joints": rail_joints(builts, sheets, rails)}
 
 
 def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True, wait: bool = False,
@@ -136,6 +159,12 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             # 2. surfaces ([[surfaces]]: each built as if it were the only one)
             step("surface")
             builts = build_surfaces(design, curves)
+            shell = None
+            if design.sheet is not None:
+                # [sheet]: every surface's own sheet (the material on one side of the shell), checked on
+                # every surface before anything else is computed (a refusal names the surface)
+                shell_sheets, shell_rails, builts = resolve_design_sheets(builts)
+                shell = (shell_sheets, shell_rails)
             report["developability_initial"] = surfaces_summary(builts)["developability"]
             step("measure")
             report.update(surfaces_summary(builts))
@@ -192,7 +221,11 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             edges = curve_edges(curves)
             report["brep"]["curve_edges"] = len(edges)
             plates = plate_solids(built) if built is not None else []  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
-            if plates:
+            if built is None and design.sheet is not None:
+                # [[surfaces]] with [sheet]: one named plate per surface (per strip), faces <name>.inside, ...
+                plates = design_plates(builts)[0]
+                report["plate"] = _shell_plate_report(design, builts, plates, *shell)
+            elif plates:
                 closed = [p.closed_form_volume for p in plates]
                 report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
                                    # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)

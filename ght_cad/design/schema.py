@@ -53,6 +53,10 @@ CONTINUITIES = ("C0", "C1", "C2", "C3", "G0", "G1", "G2", "G3")
 UNITS = ("mm", "cm", "m", "in", "ft")
 
 
+#: what ``sheet.side`` refers to with several surfaces (``SheetSpec.side_reference``)
+SIDE_REFERENCES = ("shell", "surface")
+
+
 SHAPE_NAMES = ("mu", "nu", "gamma")
 
 
@@ -137,6 +141,9 @@ class SurfaceSpec:
     name: str | None = None
     #: where the surface is in the file (``surface`` or ``surfaces[i]``), for error messages
     key: str = "surface"
+    #: ``[surfaces.sheet]``: this surface's overrides of the design's ``[sheet]`` (any of
+    #: ``thickness``, ``k_factor``, ``side``; None: the design's sheet as it is)
+    sheet: dict[str, Any] | None = None
 
 
 @dataclass
@@ -183,6 +190,10 @@ class SheetSpec:
     thickness: float
     k_factor: float = 0.5
     side: str = "normal"
+    #: with several ``[[surfaces]]``: what ``side`` is measured on, ``"shell"`` (the shell's
+    #: orientation: the first surface's normal carried consistently across the shared rails) or
+    #: ``"surface"`` (each surface's own normal); one surface: its own normal either way
+    side_reference: str = "shell"
 
     def to_sheet(self) -> Any:
         """The :class:`ght_cad.sheet.Sheet`."""
@@ -221,6 +232,10 @@ class Design:
         d.pop("source")
         for sd in [d["surface"] or {}] + d["surfaces"]:
             sd.pop("key", None)
+            if sd.get("sheet", 0) is None:  # no per-surface sheet overrides: as before
+                sd.pop("sheet")
+        if d["sheet"] is not None and len(self.surfaces) <= 1:
+            d["sheet"].pop("side_reference")  # one surface: its own normal (as before)
         if len(self.surfaces) <= 1 and all(s.name is None for s in self.surfaces):
             d.pop("surfaces")  # a single [surface]: as before
         return d
@@ -515,9 +530,9 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     sheet = None
     st = ck.table(data, "sheet", "sheet")
     if st is not None:
-        ck.keys(st, "sheet", ("thickness", "k_factor", "din_k_factor", "side"))
-        if surface is None:
-            raise ck.fail("sheet", "needs a [surface] table (the sheet is the surface's plate)")
+        ck.keys(st, "sheet", ("thickness", "k_factor", "din_k_factor", "side", "side_reference"))
+        if not surfaces:
+            raise ck.fail("sheet", "needs a [surface] table or [[surfaces]] (the sheet is the surfaces' plate)")
         T = ck.number(st, "thickness", "sheet", required=True, lo=0.0, allowed="a length >= 0")
         if "k_factor" in st and "din_k_factor" in st:
             raise ck.fail("sheet.din_k_factor", "given together with sheet.k_factor; allowed: one of them (DIN k = 2K)")
@@ -525,7 +540,13 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
             K = ck.number(st, "din_k_factor", "sheet", lo=0.0, hi=2.0, required=True) / 2.0
         else:
             K = ck.number(st, "k_factor", "sheet", 0.5, lo=0.0, hi=1.0)
-        sheet = SheetSpec(T, K, ck.string(st, "side", "sheet", "normal", choices=("normal", "reverse")))
+        sheet = SheetSpec(T, K, ck.string(st, "side", "sheet", "normal", choices=("normal", "reverse")),
+                          ck.string(st, "side_reference", "sheet", "shell", choices=SIDE_REFERENCES))
+    else:
+        for spec in surfaces:
+            if spec.sheet is not None:
+                raise ck.fail(f"{spec.key}.sheet", "overrides the design's sheet but the design has no [sheet] table; "
+                              "allowed: a [sheet] table (thickness, k_factor, side) with per-surface overrides")
 
     # outputs
     outputs = OutputSpec()
@@ -597,16 +618,43 @@ def _parse_surfaces(ck: _Checker, data: dict, curves: list[CurveSpec]) -> list[S
         name = ck.string(t, "name", path, f"surface{i + 1}")
         if any(s.name == name for s in out):
             raise ck.fail(f"{path}.name", f"{name!r} is used twice; allowed: a name unique among [[surfaces]]")
+        over = t.get("sheet")
         spec = _parse_surface(ck, t, path, curves)
         spec.name, spec.key = name, path
+        if over is not None:
+            spec.sheet = _parse_sheet_override(ck, over, f"{path}.sheet")
         out.append(spec)
+    return out
+
+
+#: keys of a ``[surfaces.sheet]`` table (overrides of the design's ``[sheet]`` for one surface)
+SURFACE_SHEET_KEYS = ("thickness", "k_factor", "din_k_factor", "side")
+
+
+def _parse_sheet_override(ck: _Checker, st: Any, path: str) -> dict[str, Any]:
+    """``[surfaces.sheet]`` at ``path``: ``thickness``, ``k_factor`` (or ``din_k_factor``), ``side``."""
+    if not isinstance(st, dict):
+        raise ck.fail(path, f"expected a table [{path.rsplit('[', 1)[0]}.sheet] of {', '.join(SURFACE_SHEET_KEYS)}, "
+                      f"got {_tname(st)} {_short(st)}")
+    ck.keys(st, path, SURFACE_SHEET_KEYS)
+    out: dict[str, Any] = {}
+    if "thickness" in st:
+        out["thickness"] = ck.number(st, "thickness", path, required=True, lo=0.0, allowed="a length >= 0")
+    if "k_factor" in st and "din_k_factor" in st:
+        raise ck.fail(f"{path}.din_k_factor", f"given together with {path}.k_factor; allowed: one of them (DIN k = 2K)")
+    if "din_k_factor" in st:
+        out["k_factor"] = ck.number(st, "din_k_factor", path, lo=0.0, hi=2.0, required=True) / 2.0
+    elif "k_factor" in st:
+        out["k_factor"] = ck.number(st, "k_factor", path, required=True, lo=0.0, hi=1.0)
+    if "side" in st:
+        out["side"] = ck.string(st, "side", path, required=True, choices=("normal", "reverse"))
     return out
 
 
 def _parse_surface(ck: _Checker, st: dict, path: str, curves: list[CurveSpec]) -> SurfaceSpec:
     """One surface table (``[surface]`` or an entry of ``[[surfaces]]`` at ``path``)."""
     stype = ck.string(st, "type", path, "planes", choices=SURFACE_TYPES)
-    extra = ("name",) if path != "surface" else ()
+    extra = ("name", "sheet") if path != "surface" else ()
     if stype != "composite" and "segments" in st:
         raise ck.fail(f"{path}.segments", f"strips need type = \"composite\" (this surface has type = \"{stype}\"); "
                       f"allowed: [[{path}.segments]] only with type = \"composite\"")
