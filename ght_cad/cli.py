@@ -551,6 +551,8 @@ def _unroll_step(args: argparse.Namespace) -> int:
     }
     if res.plate is not None:
         result["plate"] = res.plate
+    if res.plates is not None:
+        result["plates"] = res.plates
     _sheet_result(result, pattern)
     result["outputs"] = _write_pattern(args, pattern, name)
 
@@ -566,6 +568,9 @@ def _unroll_step(args: argparse.Namespace) -> int:
             pl = r["plate"]
             lines.append(f"  plate solid: inside face F{pl['inside_face']}, outside face F{pl['outside_face']}, "
                          f"thickness {pl['thickness']:.9g} (found by {pl['found_by']})")
+        for pl in r.get("plates") or []:
+            lines.append(f"  plate solid {pl['name'] or ''}: inside face F{pl['inside_face']}, outside face "
+                         f"F{pl['outside_face']}, thickness {pl['thickness']:.9g}, side {pl['side']} (found by {pl['found_by']})")
         out = _outputs_text(r)
         return "\n".join(lines) + _sheet_text(r, pattern) + ("\n" + out if out else "")
 

@@ -85,6 +85,8 @@ def report_markdown(r: dict[str, Any]) -> str:
             L += [f"| {'all' if f['line'] == 0 else f['line']} | {f['u']:.6f} | {f['radius_a']:.9g} | {f['radius_b']:.9g} | "
                   f"{f['angle_deg']:.6f} | {f['position']:.6g} |" for f in sh["forming"]]
             L.append("")
+    if (r.get("plate") or {}).get("surfaces"):
+        L += _plates_section(r["plate"], r["units"])
     L += ["## Files", ""]
     for f in r.get("files", []):
         L.append(f"- [{f}]({f})" + (f"\n\n  ![{f}]({f})" if f.endswith(".png") else ""))
@@ -161,5 +163,34 @@ def _strips_section(s: dict[str, Any]) -> list[str]:
             L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
                      f"{'yes' if j['satisfied'] else 'NO'} | {j['plane_angle_deg']:.2e} | "
                      + ", ".join(f"{x:.1e}" for x in j["residuals"]) + " |")
+        L.append("")
+    return L
+
+
+def _plates_section(pl: dict[str, Any], units: str) -> list[str]:
+    """The plates of a ``[[surfaces]]`` design with a ``[sheet]``: per surface its sheet, the side
+    its material goes and the volume against the closed form; per shared rail the joint."""
+    L = ["## Plates (spec section 6.1)", "",
+         f"{pl['solids']} solid(s), volume {pl['volume']:.12g} {units}³ (closed form {_f(pl['volume_closed_form'], '.12g')}); "
+         f"`side = \"{pl['side']}\"` measured on {'the shell' if pl['side_reference'] == 'shell' else 'each surface'}'s normal"
+         + (" (the first surface's normal, carried consistently across the shared rails)" if pl["side_reference"] == "shell" else "")
+         + ".", "",
+         "| surface | T | K | side | orientation | side on own normal | normal at centre | material goes | volume | closed form |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
+    for x in pl["surfaces"]:
+        n = ", ".join(f"{c:.4f}" for c in x["normal_at_centre"])
+        L.append(f"| {x['surface']} | {x['thickness']:.6g} | {x['k_factor']:.4g} | {x['side']} | {x['orientation']:+d} | "
+                 f"{x['side_on_own_normal']} | ({n}) | {x['material_goes']} | {x['volume']:.12g} | "
+                 f"{_f(x['volume_closed_form'], '.12g')} |")
+    L.append("")
+    if pl.get("joints"):
+        L += ["Joints along the shared rails (the plates are not trimmed): `gap` = the material lies on the convex side "
+              "of the fold (an open wedge between the plates' end walls), `overlap` = on the concave side (the plates "
+              "interpenetrate); distance = between the two plates' outside edges.", "",
+              "| surfaces | kind | fold angle [deg] | outside-edge distance (max) | at |", "|---|---|---|---|---|"]
+        for j in pl["joints"]:
+            at = ", ".join(f"{c:.6g}" for c in j["at"])
+            L.append(f"| {' / '.join(j['surfaces'])} | {j['kind']} | {j['fold_angle_deg_min']:.4g}–{j['fold_angle_deg_max']:.4g} | "
+                     f"{j['outside_edge_distance_max']:.6g} {units} | ({at}) |")
         L.append("")
     return L

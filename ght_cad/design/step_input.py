@@ -55,6 +55,9 @@ class StepUnroll:
     #: the plate solid found in the file (sheet options without a face selection): inside_face,
     #: outside_face (1-based), thickness, side, found_by; None otherwise
     plate: dict[str, Any] | None = None
+    #: a file of several plate solids (e.g. ``ght-cad run`` of ``[[surfaces]]`` with a ``[sheet]``):
+    #: one such dict per plate (with its ``name`` when the file names it); ``plate`` is then None
+    plates: list[dict[str, Any]] | None = None
 
 
 def _step_unit(name: str | None) -> str | None:
@@ -178,25 +181,91 @@ def unroll_step(
             raise DesignError(f"{p}: face {k!r} does not exist; allowed: face numbers 1..{n}")
     if len(set(chosen)) != len(chosen):
         raise DesignError(f"{p}: face numbers {chosen} repeat a face; allowed: each face once")
-    sheet, plate = _step_sheet(p, shape, faces, thickness, k_factor, din_k_factor, side)
-    if plate is not None:
-        chosen = [plate["inside_face"]]
+    plates = _step_plates(p, shape, faces, thickness, k_factor, din_k_factor, side)
+    if plates is not None:  # several plate solids: every plate's inside face with its own sheet
+        sheet, plate = None, None
+        chosen = [pl["inside_face"] for pl, _ in plates]
+        face_sheets = {pl["inside_face"]: sh for pl, sh in plates}
+    else:
+        sheet, plate = _step_sheet(p, shape, faces, thickness, k_factor, din_k_factor, side)
+        if plate is not None:
+            chosen = [plate["inside_face"]]
+        face_sheets = {k: sheet for k in chosen}
     panels = []
     report: list[dict[str, Any]] = []
     fkw = dict(best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, unit=unit, sheet=sheet)
     if (jobs == 1 or len(chosen) < 2) and scheduler is None:
-        results = [unroll_step_face(p, all_faces[k - 1], k, n, **fkw) for k in chosen]
+        results = [unroll_step_face(p, all_faces[k - 1], k, n, **{**fkw, "sheet": face_sheets[k]}) for k in chosen]
     else:
         from ..batch import map_step_faces
 
-        results = map_step_faces(p, all_faces, chosen, fkw, jobs=jobs, scheduler=scheduler)
+        by_face: dict[int, Any] = {}
+        for sh in dict.fromkeys(face_sheets.values()):  # the faces of one sheet together
+            group = [k for k in chosen if face_sheets[k] == sh]
+            for k, res in zip(group, map_step_faces(p, all_faces, group, {**fkw, "sheet": sh}, jobs=jobs, scheduler=scheduler)):
+                by_face[k] = res
+        results = [by_face[k] for k in chosen]
     for pans, row in results:
         panels.extend(pans)
         report.append(row)
     mark_shared_edges(panels)
     layout_panels(panels)
     declared = _step_unit(file_unit) or (file_unit.strip().lower() if file_unit and file_unit.strip() else None)
-    return StepUnroll(FlatPattern(panels, units=unit), unit, declared, n, report, plate)
+    return StepUnroll(FlatPattern(panels, units=unit), unit, declared, n, report, plate,
+                      None if plates is None else [pl for pl, _ in plates])
+
+
+def _step_plates(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any, k_factor: Any,
+                 din_k_factor: Any, side: str | None) -> list[tuple[dict[str, Any], Any]] | None:
+    """Several plate solids in the file (sheet options, no face selection, two or more solids each
+    a plate: :func:`ght_cad.cad.sheet_solid.plate_faces` per solid, by its face names
+    ``<plate>.inside``/``<plate>.outside`` when the file has them, else geometrically): per plate
+    its dict (as :attr:`StepUnroll.plate`, plus ``name``) and its sheet (its own thickness, the side
+    towards its outside face, the given K). None when that is not the case (one solid, a face
+    selection, no sheet options, a solid that is no plate: :func:`_step_sheet` decides).
+
+    Raises:
+        SheetError: a given ``thickness`` that differs from a plate's.
+    """
+    from ..sheet import SheetError, make_sheet
+
+    if faces or (thickness is None and k_factor is None and din_k_factor is None and side is None) or thickness == 0:
+        return None
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    from ..cad.sheet_solid import _faces, plate_faces, read_step_face_names
+
+    solids = []
+    exp = TopExp_Explorer(shape, TopAbs_SOLID)
+    while exp.More():
+        solids.append(exp.Current())
+        exp.Next()
+    if len(solids) < 2:
+        return None
+    everything = _faces(shape)
+    _, names = read_step_face_names(p)  # the same file, the same face order (TopExp)
+    out = []
+    for solid in solids:
+        local = _faces(solid)
+        index = [next(k for k, g in enumerate(everything) if g.IsSame(f)) for f in local]
+        found = plate_faces(solid, {i: names[k] for i, k in enumerate(index) if k in names})
+        if found is None:
+            return None
+        name = names.get(index[found.inside_index], "")
+        name = name[: -len(".inside")] if name.endswith(".inside") else None
+        if thickness is not None:
+            make_sheet(thickness, k_factor, din_k_factor=din_k_factor)  # the value itself first
+            if abs(float(thickness) - found.thickness) > 1e-6 * found.thickness:
+                raise SheetError(
+                    f"{p}: --thickness={float(thickness)!r} does not match the plate solid {name or ''} in the file, which is "
+                    f"{found.thickness:.9g} thick (faces {index[found.inside_index] + 1} and {index[found.outside_index] + 1}); "
+                    "allowed: its own thickness, or leave --thickness out"
+                )
+        info = {"name": name, "inside_face": index[found.inside_index] + 1, "outside_face": index[found.outside_index] + 1,
+                "thickness": found.thickness, "spread": found.spread, "side": found.side, "found_by": found.how}
+        out.append((info, make_sheet(found.thickness, k_factor, din_k_factor=din_k_factor, side=found.side)))
+    return out
 
 
 def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any, k_factor: Any,
