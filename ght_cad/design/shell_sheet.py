@@ -6,12 +6,16 @@ orients the parameter square counter-clockwise, so it induces on the boundary ``
 ``+a'(u)`` and on ``b`` the direction ``-b'(u)``. Two surfaces sharing a rail (a boundary ``a`` or
 ``b`` of one lies on a boundary of the other: points within ``1e-6`` of the model size) are
 oriented consistently when they induce **opposite** directions on the shared rail (as the two
-faces of one sewn shell do). The first surface keeps its normal (``orientation = +1``); every
-surface sharing a rail with an oriented one gets ``orientation = ±1`` so that the pair is
-consistent (breadth first over the surfaces, in file order; a surface sharing no rail with an
-earlier component starts a new one, again with ``+1``). ``sheet.side`` is then measured on the
-shell's normal ``orientation · n``; with ``side_reference = "surface"`` on each surface's own
-``n``. A shell that cannot be oriented (a cycle of rails that contradict each other, e.g. three
+faces of one sewn shell do). Breadth first over the surfaces in file order, the first surface of
+each connected shell provisionally keeps its normal and every surface sharing a rail with an
+oriented one gets ``±1`` so that the pair is consistent. Then each connected shell is turned
+**outward**: when ``∫ (X - c)·N dA < 0`` (``N`` the shell's normal, ``c`` the shell's area
+centroid), every orientation of that shell flips, so the shell's normal points to its convex
+side (away from its centroid: outboard on a hull, out of a duct) whatever the order and
+direction of every surface's rails. ``orientation`` (±1) is the sign of a surface's own normal
+against the shell's. ``sheet.side`` is then measured on the shell's normal
+``orientation · n`` (``"normal"``: the material on the outer, convex side); with
+``side_reference = "surface"`` on each surface's own ``n``. A shell that cannot be oriented (a cycle of rails that contradict each other, e.g. three
 surfaces on one rail) is refused with ``side_reference = "shell"``.
 
 Joints. Along a shared rail point ``p`` the plates' outside edges are ``p + T_i m_i`` (``m_i`` the
@@ -174,7 +178,58 @@ def shell_orientation(builts: Sequence[BuiltSurface], rails: Sequence[SharedRail
                 elif sign[other] != want:
                     conflicts.append(f"{names[r.i]!r} and {names[r.j]!r} along their shared rail ({r.edge_i} of "
                                      f"{names[r.i]!r}, {r.edge_j} of {names[r.j]!r})")
-    return [float(s) for s in sign], conflicts  # type: ignore[arg-type]
+    signs = [float(s) for s in sign]  # type: ignore[arg-type]
+    # every connected shell is turned outward: its normal on its convex side (away from its centroid)
+    comp = _components(n, rails)
+    for members in comp:
+        flux = _outward_flux(builts, members, signs)
+        if flux < 0:
+            for k in members:
+                signs[k] = -signs[k]
+    return signs, conflicts
+
+
+def _components(n: int, rails: Sequence[SharedRail]) -> list[list[int]]:
+    """The surfaces connected through shared rails, each list in file order."""
+    parent = list(range(n))
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            k = parent[k]
+        return k
+
+    for r in rails:
+        if abs(r.vote) >= 0.5:
+            parent[root(r.j)] = root(r.i)
+    groups: dict[int, list[int]] = {}
+    for k in range(n):
+        groups.setdefault(root(k), []).append(k)
+    return list(groups.values())
+
+
+def _outward_flux(builts: Sequence[BuiltSurface], members: Sequence[int], signs: Sequence[float], samples: int = 129) -> float:
+    r"""``∫ (X - c)·N dA`` over the surfaces ``members`` with the normals ``N = sign · n`` and ``c``
+    their area centroid; > 0 when N points away from the centroid (the convex side). Along a
+    ruling of a developable ``(X - c)·n = (a - c)·n`` and ``dA = |m| du dv`` with
+    ``m = ((a' + b')/2) × g`` (trapezoid rule over ``samples`` rulings)."""
+    u = np.linspace(0.0, 1.0, samples)
+    rows = []
+    for k in members:
+        for part in sheet_parts(builts[k].surface):
+            a, b = _edge(part, "a", u), _edge(part, "b", u)
+            m = np.cross(0.5 * (_edge(part, "a", u, 1) + _edge(part, "b", u, 1)), b - a)
+            w = np.linalg.norm(m, axis=1)
+            nrm = signs[k] * m / np.where(w > 0, w, 1.0)[:, None]
+            rows.append((a, 0.5 * (a + b), nrm, _trap(w, u), w))
+    area = sum(r[3] for r in rows)
+    c = sum(_trap(r[1] * r[4][:, None], u) for r in rows) / area
+    return float(sum(_trap(np.einsum("ij,ij->i", r[0] - c, r[2]) * r[4], u) for r in rows))
+
+
+def _trap(y: np.ndarray, x: np.ndarray) -> Any:
+    """Trapezoid rule along axis 0 (numpy >= 1.24 and 2.x alike)."""
+    dx = np.diff(x)
+    return np.tensordot(dx, 0.5 * (y[1:] + y[:-1]), axes=(0, 0))
 
 
 def _resolved(base: SheetSpec, over: dict[str, Any] | None) -> SheetSpec:
