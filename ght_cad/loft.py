@@ -613,6 +613,11 @@ def _meeting_tangent(pair: _Pair, t: float, s: float) -> tuple[float, float]:
     return 2.0 / (1.0 + m), 2.0 * m / (1.0 + m)
 
 
+def _at_corner(pair: _Pair, t: float, s: float) -> bool:
+    """(t, s) is a corner where the rails meet (``_Pair.corners``: a pointed end of the loft)."""
+    return any(abs(t - t0) <= 1e-12 and abs(s - s0) <= 1e-12 for t0, s0, _ in pair.corners)
+
+
 def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: float, tol: float) -> _Branch:
     """Predictor–corrector continuation in λ = (t + s) / 2 from ``start`` to an upper-right side.
 
@@ -627,7 +632,9 @@ def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: 
     t, s = start
     lam = 0.5 * (t + s)
     tp, sp = (float(v[0]) for v in pair.tangent(np.array([t]), np.array([s])))
-    if not (np.isfinite(tp) and np.isfinite(sp)):
+    if not (np.isfinite(tp) and np.isfinite(sp)) or _at_corner(pair, t, s):
+        # where the rails meet both partials of F vanish: (F_s, -F_t) is round-off (0/0, or a
+        # finite direction of noise when the meeting point carries a gap of a few eps)
         tp, sp = _meeting_tangent(pair, t, s)
     mono = -1e-9
 
@@ -666,7 +673,9 @@ def _trace(pair: _Pair, start: tuple[float, float], reversed_b: bool, max_step: 
                 # the end must be reached by a short monotone step (else keep stepping)
                 if lam_e - lam <= 1.5 * h or h <= 1e-9:
                     tpe, spe = (float(v[0]) for v in pair.tangent(np.array([te]), np.array([se])))
-                    if not (np.isfinite(tpe) and np.isfinite(spe)):
+                    if _at_corner(pair, te, se):
+                        tpe, spe = _meeting_tangent(pair, te, se)
+                    elif not (np.isfinite(tpe) and np.isfinite(spe)):
                         tpe, spe = tp, sp
                     if lam_e - lam > 1e-14:
                         L.append(lam_e), T.append(te), S.append(se), TP.append(tpe), SP.append(spe)
@@ -2014,7 +2023,8 @@ class _LoftJets:
 def _side_shift(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve, t: float, s: float, end: str) -> np.ndarray:
     r"""``∂λ/∂p`` of a branch end (6,): on ``s = 0`` or ``s = 1`` ``F(t, s; p) = 0`` gives
     ``∂t/∂p = -F_p/F_t``, on ``t = 0`` or ``t = 1`` ``∂s/∂p = -F_p/F_s`` (``λ = (t + s)/2``); a branch
-    end at a corner where ``F`` vanishes to round-off stays there (``0``).
+    end at a corner where ``F`` vanishes to round-off, or where the rails meet (a pointed end:
+    they meet there for every shape parameter), stays there (``0``).
 
     Raises:
         LoftGradientFallback: an end at (within MIN_FAN of) a corner where F does not vanish (a fan
@@ -2027,6 +2037,8 @@ def _side_shift(lf: DevelopableLoft, ca: GHTCurve, cb: GHTCurve, t: float, s: fl
     else:
         at_t, at_s = t >= 1.0 - MIN_FAN, s >= 1.0 - MIN_FAN  # on the side t = 1 / s = 1
     if at_t and at_s:
+        if _at_corner(pair, t, s):  # the rails meet there for every shape parameter (a GHT curve
+            return np.zeros(6)      # interpolates its end points): the end stays at the corner
         p = pair.parts(tt, ss, 1)
         if abs(float(p["F"][0])) <= 64 * float(p["noise"][0]) + 1e-13 * float(p["scale"][0]):
             return np.zeros(6)
