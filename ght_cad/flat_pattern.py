@@ -98,6 +98,34 @@ def romberg_length(points: np.ndarray) -> float:
     return _romberg_pair(p)[0]
 
 
+def piecewise_samples(breaks: Sequence[float], m: int) -> np.ndarray | None:
+    r"""Parameters ``t`` of ``m + 1`` uniform samples on every piece ``[t_k, t_{k+1}]`` of [0, 1]
+    cut at ``breaks`` (those in (0, 1)), joints shared: ``P m + 1`` points for P pieces, piece k at
+    indices ``k m .. (k + 1) m``. None when no break lies inside (0, 1).
+
+    With ``m`` divisible by 4, every 2nd and every 4th sample are again uniform on each piece and
+    hit every joint, so chord sums (:func:`piecewise_romberg_length`) and shoelace areas
+    (:func:`measure_panel`) on ``[::4]``, ``[::2]``, ``[::1]`` extrapolate piece by piece.
+    """
+    bp = sorted({float(b) for b in breaks if 0.0 < float(b) < 1.0})
+    if not bp:
+        return None
+    edges = [0.0, *bp, 1.0]
+    parts = [np.linspace(lo, hi, m + 1)[:-1] for lo, hi in zip(edges[:-1], edges[1:])]
+    return np.concatenate(parts + [np.array([1.0])])
+
+
+def piecewise_romberg_length(points: np.ndarray, m: int) -> float:
+    r"""Length of a piecewise smooth curve sampled by :func:`piecewise_samples` (``m + 1`` points a
+    piece, ``m = 4N``): ``Σ_k R_k``, ``R_k`` the Romberg length (:func:`romberg_length`, O(h⁶)) of
+    piece k. Between joints the chord-sum error expands in even powers of h; a chord across a joint
+    where the curvature jumps would leave an O(h³) term that Romberg cannot remove."""
+    p = np.asarray(points, dtype=float)
+    if m % 4 or (p.shape[0] - 1) % m:
+        raise GHTError(f"piecewise_romberg_length needs k*{m}+1 samples with {m} divisible by 4; got {p.shape[0]}")
+    return float(sum(_romberg_pair(p[i: i + m + 1])[0] for i in range(0, p.shape[0] - 1, m)))
+
+
 def _outline_serves_length(samples: int) -> bool:
     """``samples = 4N + 1`` outline points with ``N_ROMBERG / 2 <= N <= N_ROMBERG``: their Romberg
     length may serve (:meth:`BoundaryEdge.measure`)."""
@@ -172,6 +200,13 @@ class BoundaryEdge:
         samples: number of output polyline points.
         xyz: the 3-D points at the ``samples`` outline parameters, ``xyz_fn`` evaluated on first
             access (a single panel needs none; shared-edge marks and exports ask for them).
+        breaks: edge parameters ``t`` in (0, 1) where the edge is not smooth (a developable loft's
+            joint rulings: the edge is G1 there but its curvature and parametric speed jump). The
+            length and area measures then sample every smooth piece ``[t_k, t_{k+1}]`` on its
+            own ``4 _ROMBERG_N + 1`` uniform points (:func:`piecewise_samples`), so Romberg's
+            even-power error expansion holds on each piece; a chord across a break leaves an
+            O(h³) term Romberg cannot remove (measured 1e-11 .. 2e-7 relative on loft edges with
+            fans). The outline polyline ``flat`` stays the ``samples`` uniform points.
     """
 
     name: str
@@ -184,6 +219,11 @@ class BoundaryEdge:
     length_flat: float = float("nan")
     dense_flat: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     _xyz: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
+    breaks: tuple[float, ...] = ()
+
+    def _pieces(self) -> np.ndarray | None:
+        """The dense measuring parameters of an edge with ``breaks`` (None: no break inside)."""
+        return piecewise_samples(self.breaks, 4 * _ROMBERG_N)
 
     def measure(self, pair: tuple[float, float] | None = None) -> None:
         """Sample the edge and measure its flat length (Romberg, :func:`romberg_length`).
@@ -201,6 +241,12 @@ class BoundaryEdge:
         if pair is None:
             self.flat = np.asarray(self.flat_fn(_unit_samples(self.samples)), dtype=float)
         length = None
+        t_pw = self._pieces()
+        if t_pw is not None:  # breaks inside: every smooth piece measured on its own samples
+            self.densify()
+            if self.length_3d is None:
+                self.length_3d = piecewise_romberg_length(np.asarray(self.xyz_fn(t_pw), dtype=float), 4 * _ROMBERG_N)
+            return
         if _outline_serves_length(self.samples):
             length, r2 = pair if pair is not None else _romberg_pair(self.flat)
             if not (math.isfinite(length) and abs(r2 - length) <= _ROMBERG_ACCEPT * abs(length)):
@@ -218,7 +264,14 @@ class BoundaryEdge:
                 self._xyz = dense[::4 * _ROMBERG_N // max(self.samples - 1, 1)].copy()
 
     def densify(self) -> None:
-        """Flat samples at ``4 _ROMBERG_N + 1`` points (``dense_flat``) and the length from them."""
+        """Flat samples at ``4 _ROMBERG_N + 1`` points (``dense_flat``) and the length from them;
+        with ``breaks``, ``4 _ROMBERG_N + 1`` points on every smooth piece (joints shared) and the
+        sum of the pieces' Romberg lengths (:func:`piecewise_romberg_length`)."""
+        t_pw = self._pieces()
+        if t_pw is not None:
+            self.dense_flat = np.asarray(self.flat_fn(t_pw), dtype=float)
+            self.length_flat = piecewise_romberg_length(self.dense_flat, 4 * _ROMBERG_N)
+            return
         t = np.linspace(0.0, 1.0, 4 * _ROMBERG_N + 1)
         self.dense_flat = np.asarray(self.flat_fn(t), dtype=float)
         self.length_flat = romberg_length(self.dense_flat)
@@ -468,7 +521,7 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
     groups: dict[int, list[BoundaryEdge]] = {}
     for e in (e for loop in panel.loops for e in loop):
         e.flat = np.asarray(e.flat_fn(_unit_samples(e.samples)), dtype=float)
-        if _outline_serves_length(e.samples):
+        if _outline_serves_length(e.samples) and not e.breaks:
             groups.setdefault(e.samples, []).append(e)
     for es in groups.values():
         R, R2 = _romberg_pairs(np.stack([e.flat for e in es]))

@@ -314,7 +314,8 @@ def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> 
         )
         return sum(integrate(f, lo, hi, rtol=1e-14) for lo, hi in _smooth_pieces(surface))
 
-    def edge(name: str, uv: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], length: float) -> BoundaryEdge:
+    def edge(name: str, uv: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], length: float,
+             breaks: tuple[float, ...]) -> BoundaryEdge:
         def flat(t: np.ndarray) -> np.ndarray:
             u, v = uv(t)
             return dev.map(u, v)
@@ -323,13 +324,17 @@ def _ruled_edges(surface: RuledSurface, dev: RuledDevelopment, samples: int) -> 
             u, v = uv(t)
             return surface.evaluate(u, v)
 
-        return BoundaryEdge(name=name, flat_fn=flat, xyz_fn=xyz, length_3d=length, samples=samples)
+        return BoundaryEdge(name=name, flat_fn=flat, xyz_fn=xyz, length_3d=length, samples=samples, breaks=breaks)
 
     La = curve_len("a")
     Lb = curve_len("b")
     g0, g1 = surface.ruling_lengths(np.array([0.0, 1.0]))
     lengths = {"a": La, "ruling u=1": float(g1), "b": Lb, "ruling u=0": float(g0)}
-    return [edge(name, uv, lengths[name]) for name, uv in RULED_EDGE_UV.items()]
+    # the boundary curves' joints (the surface's breakpoints; edge b runs t = 1 - u): their flat
+    # lengths and the area are measured piece by piece (BoundaryEdge.breaks)
+    bp = tuple(lo for lo, _ in _smooth_pieces(surface)[1:])
+    breaks = {"a": bp, "ruling u=1": (), "b": tuple(sorted(1.0 - b for b in bp)), "ruling u=0": ()}
+    return [edge(name, uv, lengths[name], breaks[name]) for name, uv in RULED_EDGE_UV.items()]
 
 
 #: the four boundary edges of a ruled panel in order around it, ``t -> (u, v)``: a(u), ruling u=1,
