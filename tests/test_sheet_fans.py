@@ -152,3 +152,25 @@ def test_boundary_edge_with_breaks_measures_a_g1_curve_exactly() -> None:
     assert t.tolist() == np.concatenate([np.linspace(0, 0.3, 9)[:-1], np.linspace(0.3, 1, 9)]).tolist()
     assert piecewise_samples((), 8) is None
     assert piecewise_romberg_length(_arc_then_line(t), 8) == pytest.approx(exact, rel=1e-6)
+
+
+def test_metric_check_does_not_difference_across_a_joint() -> None:
+    """The dory's bottom plate (examples/design_dory_multichine_plated.toml, keel to chine) has a
+    joint ruling at λ = 0.85656, 1.5e-3 from the metric grid's u = 0.85478: the 5-point stencil
+    (h = 1e-3) straddled it and the first-fundamental-form check said 0.29° (a measure's artifact:
+    the development is exact); samples are now kept off the joints."""
+    from pathlib import Path
+
+    import tomllib
+
+    from ght_cad.design import build_surfaces
+    from ght_cad.design.schema import parse_design
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "design_dory_multichine_plated.toml"
+    design = parse_design(tomllib.loads(path.read_text()), str(path))
+    bottom = next(b for b in build_surfaces(design) if b.design.surface.name == "bottom").surface
+    grid = np.linspace(0.02, 0.98, 24)
+    assert any(abs(g - b) < 2e-3 for g in grid for b in bottom.breakpoints)  # the case this guards
+    pat = unroll(bottom, rulings=0)
+    assert pat.errors["angle_deg"] <= 1e-6
+    assert pat.errors["boundary_length"] <= FAN_RTOL and pat.errors["area"] <= FAN_RTOL
