@@ -107,6 +107,12 @@ class SurfaceAdapter:
         may include the ends; empty for analytic surfaces."""
         return np.zeros(0)
 
+    def c0_breaks(self, direction: str) -> np.ndarray:
+        """Parameters in ``direction`` where the surface is only C0 (B-spline knots of full
+        multiplicity, e.g. a loft's joint rulings): the boundary measures are split there
+        (:attr:`ght_cad.flat_pattern.BoundaryEdge.breaks`); empty when unknown."""
+        return np.zeros(0)
+
     def jet(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         """``[S]`` (order 0), ``[S, S_u, S_v]`` (1) or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` (2) at the
         points in one evaluation (override when that is cheaper than :meth:`value` + :meth:`d1`)."""
@@ -907,6 +913,8 @@ def unroll_face_data(
     # boundary loops
     loops = []
     loops_uv = []
+    c0 = getattr(face.surface, "c0_breaks", None)
+    c0u, c0v = (c0("u"), c0("v")) if c0 is not None else (np.zeros(0), np.zeros(0))
     for wire in face.wires:
         loop = []
         loop_uv = []
@@ -919,11 +927,13 @@ def unroll_face_data(
             flat_fn = _strided_memo(lambda t, uvf=e.uv: dmap.map(*uvf(t)))
 
             name = e.name or f"edge{k}"
+            br = _c0_crossings(e.uv, c0u, c0v) if c0u.size or c0v.size else ()
             if fsheet is None:
-                loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=e.xyz, length_3d=float(e.length_3d), samples=samples))
+                loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=e.xyz, length_3d=float(e.length_3d), samples=samples,
+                                         breaks=br))
             else:  # the edge on the neutral surface, its length measured (Romberg)
                 loop.append(BoundaryEdge(name=name, flat_fn=flat_fn, xyz_fn=fsheet.edge_xyz(e.uv),
-                                         length_3d=0.0 if e.length_3d == 0 else None, samples=samples))
+                                         length_3d=0.0 if e.length_3d == 0 else None, samples=samples, breaks=br))
         if loop:
             loops.append(loop)
             loops_uv.append(loop_uv)
@@ -1091,6 +1101,26 @@ def _edge_sample_uv(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[C
     us = [_as_shape(u, t.shape) for u, _ in uvs]
     vs = [_as_shape(v, t.shape) for _, v in uvs]
     return [e for e, _ in edges], t, (np.concatenate(us), np.concatenate(vs))
+
+
+def _c0_crossings(uvf: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], c0u: np.ndarray,
+                  c0v: np.ndarray) -> tuple[float, ...]:
+    """Edge parameters ``t`` in (0, 1) where a straight isoline edge (v constant and u affine in t,
+    or the other way round: the rails and rulings of a B-spline face) crosses a knot line where the
+    surface is only C0 (``c0u``/``c0v``, :meth:`SurfaceAdapter.c0_breaks`): ``t = (k - u(0)) /
+    (u(1) - u(0))``. There the edge's parameter speed jumps (a loft's joint ruling), so its
+    measures are split there (:attr:`ght_cad.flat_pattern.BoundaryEdge.breaks`). Other edges: ()."""
+    u, v = (np.asarray(x, dtype=float) for x in uvf(np.array([0.0, 0.5, 1.0])))
+    out: list[float] = []
+    for along, fixed, ks in ((u, v, c0u), (v, u, c0v)):
+        span = float(along[2] - along[0])
+        if not ks.size or span == 0.0:
+            continue
+        tol = 1e-12 * abs(span)
+        if float(np.ptp(fixed)) <= tol and abs(float(along[1]) - 0.5 * float(along[0] + along[2])) <= tol:
+            t = (np.asarray(ks, dtype=float) - float(along[0])) / span
+            out += [float(x) for x in t if 1e-9 < x < 1.0 - 1e-9]
+    return tuple(sorted(out))
 
 
 def _flat1(t: Any) -> np.ndarray:

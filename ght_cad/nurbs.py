@@ -152,6 +152,17 @@ class NurbsSurface:
         """The Cartesian poles ``P = A / w``, (nu, nv, 3)."""
         return self.cw[..., :3] / self.cw[..., 3:]
 
+    def c0_knots(self, direction: str) -> np.ndarray:
+        """Interior knots of ``direction`` ("u" or "v") of multiplicity >= the degree there: where
+        the surface is only C0 in that parameter (e.g. a developable loft's joint rulings, joined
+        with full-multiplicity knots), sorted; empty when there are none."""
+        U, p = (self.U, self.pu) if direction == "u" else (self.V, self.pv)
+        inner = U[p + 1:U.size - p - 1]
+        if not inner.size or p < 1:
+            return np.zeros(0)
+        k, counts = np.unique(inner, return_counts=True)
+        return k[counts >= p]
+
     def _hom(self, su: np.ndarray, Nu: np.ndarray, sv: np.ndarray, Nv: np.ndarray, ku: int, kv: int) -> np.ndarray:
         """``∂^ku_u ∂^kv_v H`` from the non-zero basis functions ``Nu`` (n, pu-ku+1) and ``Nv``
         (n, pv-kv+1) at the spans ``su``, ``sv``; shape (n, 4)."""

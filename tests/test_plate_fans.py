@@ -265,6 +265,21 @@ def test_plate_step_names_readers_and_unroll(tmp_path) -> None:
         pat = unroll(found.inside, thickness=found.thickness, k_factor=0.4, side=found.side)
         assert len(pat.panels) == 1
         assert pat.area == pytest.approx(ref.area, rel=1e-9)
+        # the face's C0 knots (the joint rulings) split the edge measures: the pattern's own error
+        # report is round-off (measured across them: 1.4e-10 lengths, 9.1e-10 area)
+        assert pat.errors["max"] <= 1e-13, pat.errors
+
+
+def test_c0_knots_of_a_joined_surface() -> None:
+    """``NurbsSurface.c0_knots``: interior knots of full multiplicity (the degree) only."""
+    from ght_cad.nurbs import NurbsSurface
+
+    U = np.array([0, 0, 0, 0.25, 0.5, 0.5, 0.75, 0.75, 0.75, 1, 1, 1], float)  # degree 2: 0.5 and 0.75 are C0
+    V = np.array([0, 0, 1, 1], float)
+    poles = np.random.default_rng(0).normal(size=(U.size - 3, 2, 3))
+    s = NurbsSurface.from_poles(U, V, 2, 1, poles)
+    assert s.c0_knots("u").tolist() == [0.5, 0.75]
+    assert s.c0_knots("v").size == 0
 
 
 def test_fan_face_unrolls_with_a_sheet() -> None:

@@ -202,6 +202,9 @@ class _SurfEval(SurfaceAdapter):
             self._breaks[direction] = surface_breaks(self.ad, direction)
         return self._breaks[direction]
 
+    def c0_breaks(self, direction: str) -> np.ndarray:
+        return self._nurbs.c0_knots(direction) if self._nurbs is not None else np.zeros(0)
+
     def _analytic(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         """[S, S_u, S_v, S_uu, S_vv, S_uv] (up to ``order``) of a plane, cylinder or cone."""
         O, X, Y, Z = self._ax  # type: ignore[misc]

@@ -251,6 +251,9 @@ class FreeCADSurface(SurfaceAdapter):
         d = self.d1(np.repeat(s, v.size), np.tile(v, s.size))
         return np.linalg.norm(np.cross(d[0], d[1]), axis=1).reshape(s.size, v.size)
 
+    def c0_breaks(self, direction: str) -> np.ndarray:
+        return self._nurbs.c0_knots(direction) if self._nurbs is not None else np.zeros(0)
+
     def breaks(self, direction: str) -> np.ndarray:
         s = self.s
         if self.kind == "bspline":
