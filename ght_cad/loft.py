@@ -599,17 +599,12 @@ def _meeting_tangent(pair: _Pair, t: float, s: float) -> tuple[float, float]:
             rails do not meet there (a singular point of F with a nonzero ruling).
     """
     p = pair.parts(np.array([t]), np.array([s]), 1)
-    A, B = p["A"], p["B"]
     if float(np.linalg.norm(p["g"][0])) > 1e-9 * pair.size:
         raise _TraceFailure(f"F is singular (grad F = 0) at t={t:.6g}, s={s:.6g}")
-    Da = float(_det(A[1], B[1], A[2])[0])
-    Db = float(_det(A[1], B[1], B[2])[0])
-    if not (Db != 0 and Da / Db > 0):
-        raise _TraceFailure(
-            f"the rails meet at t={t:.6g}, s={s:.6g} and no increasing branch of F = 0 leaves the meeting point "
-            f"(det(a', b', a'') = {Da:.3g}, det(a', b', b'') = {Db:.3g} must have the same sign)"
-        )
-    m = math.sqrt(Da / Db)
+    try:
+        m = pair.corner_slope(t, s)  # ds/dt = sqrt(D_a / D_b) there
+    except NotDevelopableError as exc:
+        raise _TraceFailure(str(exc)) from None
     return 2.0 / (1.0 + m), 2.0 * m / (1.0 + m)
 
 
