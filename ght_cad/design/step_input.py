@@ -227,11 +227,11 @@ def _step_plates(p: Path, shape: Any, faces: Sequence[int] | None, thickness: An
     Raises:
         SheetError: a given ``thickness`` that differs from a plate's.
     """
-    from ..sheet import SheetError, make_sheet
+    from ..sheet import make_sheet
 
     if faces or (thickness is None and k_factor is None and din_k_factor is None and side is None) or thickness == 0:
         return None
-    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+    from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
     from ..cad.sheet_solid import _faces, plate_faces, read_step_face_names
@@ -254,18 +254,32 @@ def _step_plates(p: Path, shape: Any, faces: Sequence[int] | None, thickness: An
             return None
         name = names.get(index[found.inside_index], "")
         name = name[: -len(".inside")] if name.endswith(".inside") else None
-        if thickness is not None:
-            make_sheet(thickness, k_factor, din_k_factor=din_k_factor)  # the value itself first
-            if abs(float(thickness) - found.thickness) > 1e-6 * found.thickness:
-                raise SheetError(
-                    f"{p}: --thickness={float(thickness)!r} does not match the plate solid {name or ''} in the file, which is "
-                    f"{found.thickness:.9g} thick (faces {index[found.inside_index] + 1} and {index[found.outside_index] + 1}); "
-                    "allowed: its own thickness, or leave --thickness out"
-                )
+        _check_plate_thickness(p, thickness, k_factor, din_k_factor, found.thickness,
+                               f"the plate solid {name or ''} in the file",
+                               (index[found.inside_index] + 1, index[found.outside_index] + 1))
         info = {"name": name, "inside_face": index[found.inside_index] + 1, "outside_face": index[found.outside_index] + 1,
                 "thickness": found.thickness, "spread": found.spread, "side": found.side, "found_by": found.how}
         out.append((info, make_sheet(found.thickness, k_factor, din_k_factor=din_k_factor, side=found.side)))
     return out
+
+
+def _check_plate_thickness(p: Path, thickness: Any, k_factor: Any, din_k_factor: Any, found: float, what: str,
+                           faces: tuple[int, int]) -> None:
+    """A ``--thickness`` given with a plate solid must be the plate's own (to 1e-6 relative).
+
+    Raises:
+        SheetError: a bad value, or one that does not match ``found`` (naming ``what`` and its faces).
+    """
+    from ..sheet import SheetError, make_sheet
+
+    if thickness is None:
+        return
+    make_sheet(thickness, k_factor, din_k_factor=din_k_factor)  # the value itself first
+    if abs(float(thickness) - found) > 1e-6 * found:
+        raise SheetError(
+            f"{p}: --thickness={float(thickness)!r} does not match {what}, which is {found:.9g} thick "
+            f"(faces {faces[0]} and {faces[1]}); allowed: its own thickness, or leave --thickness out"
+        )
 
 
 def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any, k_factor: Any,
@@ -288,14 +302,8 @@ def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any
             exp.Next()
         found = plate_faces(shape) if solids == 1 else None
         if found is not None:
-            if thickness is not None:
-                make_sheet(thickness, k_factor, din_k_factor=din_k_factor)  # the value itself first
-                if abs(float(thickness) - found.thickness) > 1e-6 * found.thickness:
-                    raise SheetError(
-                        f"{p}: --thickness={float(thickness)!r} does not match the plate solid in the file, which is "
-                        f"{found.thickness:.9g} thick (faces {found.inside_index + 1} and {found.outside_index + 1}); "
-                        "allowed: its own thickness, or leave --thickness out"
-                    )
+            _check_plate_thickness(p, thickness, k_factor, din_k_factor, found.thickness, "the plate solid in the file",
+                                   (found.inside_index + 1, found.outside_index + 1))
             plate = {"inside_face": found.inside_index + 1, "outside_face": found.outside_index + 1,
                      "thickness": found.thickness, "spread": found.spread, "side": found.side, "found_by": found.how}
             return make_sheet(found.thickness, k_factor, din_k_factor=din_k_factor, side=found.side), plate
