@@ -119,6 +119,10 @@ def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
     assert all(p["found_by"] == "names" and p["thickness"] == pytest.approx(6.0, rel=1e-6) for p in res["plates"])
     # the STEP faces are fits of the design surfaces (3e-7 T): the same neutral patterns to 1e-6
     assert res["area"] == pytest.approx(rep["flat_pattern"]["area"], rel=1e-6)
+    # a --thickness other than the plates' own is refused, naming the plate
+    rc = main(["unroll", str(out / "model.step"), "--thickness", "5", "--k-factor", "0.44"])
+    err = capsys.readouterr().err
+    assert rc == EXIT_USAGE and "--thickness=5.0 does not match the plate solid bottom in the file" in err, err
 
 
 def test_neutral_patterns_as_for_one_surface() -> None:
