@@ -799,9 +799,10 @@ class _Path:
         near = self.near_corner(lam)
         if near is not None and near.any() and not near.all():  # split: near a meeting corner / elsewhere
             r1, r2 = self.main(lam[near], k), self.main(lam[~near], k)
-            tt = [np.empty(lam.shape) for _ in r1[0]]
-            ss = [np.empty(lam.shape) for _ in r1[1]]
-            for r in range(len(tt)):
+            # k + 1 of each: either part may come from the cache with more derivatives than asked
+            tt = [np.empty(lam.shape) for _ in range(k + 1)]
+            ss = [np.empty(lam.shape) for _ in range(k + 1)]
+            for r in range(k + 1):
                 tt[r][near], tt[r][~near] = r1[0][r], r2[0][r]
                 ss[r][near], ss[r][~near] = r1[1][r], r2[1][r]
             g = np.empty((lam.size, 3))

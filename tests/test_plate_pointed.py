@@ -232,3 +232,23 @@ def test_run_bow_plate_with_a_sheet(tmp_path, capsys) -> None:
     sh = rep["flat_pattern"]["sheet"][0]
     assert math.isfinite(sh["min_bending_radius"])
     assert all(math.isfinite(r["radius_a"]) and math.isfinite(r["radius_b"]) for r in sh["forming"])
+
+
+def test_run_plated_skiff_with_a_pointed_side_panel(tmp_path, capsys) -> None:
+    """Two surfaces, the side loft pointed at the bow, one [sheet] (examples/design_skiff_plated.toml):
+    the shell orientation asks the pointed loft for a, a', a'' on parameters near and far from the
+    corner in turn (cached derivative lists of different lengths once broke the split: IndexError)."""
+    from ght_cad.cli import main
+
+    out = tmp_path / "out"
+    path = Path(__file__).resolve().parents[1] / "examples" / "design_skiff_plated.toml"
+    assert main(["run", str(path), "--out", str(out)]) == 0, capsys.readouterr().err
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["flat_pattern"]["errors"]["max"] <= 1e-12
+    plate = rep["plate"]
+    assert plate["valid"] and plate["solids"] == 2
+    assert [r["surface"] for r in plate["surfaces"]] == ["bottom", "side"]
+    assert abs(plate["volume"] / plate["volume_closed_form"] - 1.0) <= 1e-6
+    (joint,) = plate["joints"]  # the chine; the side panel's zero ruling at the bow has no direction
+    assert joint["surfaces"] == ["bottom", "side"] and joint["kind"] in ("gap", "overlap", "mixed (gap, overlap)")
+    assert all(math.isfinite(joint[k]) for k in ("outside_edge_distance_max", "fold_angle_deg_max"))

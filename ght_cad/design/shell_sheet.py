@@ -295,7 +295,8 @@ def rail_joints(builts: Sequence[BuiltSurface], sheets: Sequence[SurfaceSheet], 
     ``d = |T_i m_i - T_j m_j|`` (distance between the plates' outside edges), fold angle
     ``∠(m_i, m_j)``, and the kind: ``overlap`` where the other surface turns towards the material
     (``m_i · w_j > 0``, ``w_j`` the unit direction into surface ``j`` across the rail), ``gap``
-    where it turns away, ``flush`` within 1e-9."""
+    where it turns away, ``flush`` within 1e-9 (points on a zero-length ruling, a pointed end, have
+    no direction across the rail and are left out of the kind)."""
     from ..sheet import ruling_normal
 
     out = []
@@ -311,12 +312,17 @@ def rail_joints(builts: Sequence[BuiltSurface], sheets: Sequence[SurfaceSheet], 
             tl = np.linalg.norm(t, axis=1)
             th = t / np.where(tl > 0, tl, 1.0)[:, None]
             w = g - th * np.einsum("ij,ij->i", g, th)[:, None]
-            w /= np.linalg.norm(w, axis=1)[:, None]
+            wl = np.linalg.norm(w, axis=1)
+            # a zero-length ruling (a pointed end, where the rails meet) has no direction across the
+            # rail: NaN there, left out of the kind below (distance and fold angle need none)
+            ok = wl > 1e-12 * max(float(wl.max(initial=0.0)), 1e-300)
+            w = np.where(ok[:, None], w / np.where(ok, wl, 1.0)[:, None], np.nan)
             rows.append((m, w, sh.thickness))
         (mi, wi, Ti), (mj, wj, Tj) = rows
         d = np.linalg.norm(Ti * mi - Tj * mj, axis=1)
         fold = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", mi, mj), -1.0, 1.0)))
         turn = 0.5 * (np.einsum("ij,ij->i", mi, wj) + np.einsum("ij,ij->i", mj, wi))
+        turn = turn[np.isfinite(turn)]
         kinds = np.where(turn > 1e-9, "overlap", np.where(turn < -1e-9, "gap", "flush"))
         uniq = sorted(set(kinds.tolist()))
         k = int(np.argmax(d))
