@@ -191,6 +191,12 @@ class TargetLock:
 
     def _busy(self, fd: int, waited: float | None = None) -> FolderBusy:
         pid, owner = _read_owner(fd)
+        # the holder writes "<pid> <command>" right after it took the lock (truncate, then write):
+        # a refusal in that window would name nobody, so read again for up to 1 s
+        t_end = time.monotonic() + 1.0
+        while pid is None and time.monotonic() < t_end:
+            time.sleep(0.02)
+            pid, owner = _read_owner(fd)
         who = f"pid {pid}" if pid is not None else "a process that is starting"
         if owner:
             who += f": {owner}"
