@@ -102,3 +102,22 @@ def test_sheet_flags_on_a_design_file_are_refused(capsys, tmp_path) -> None:
     assert rc == EXIT_USAGE and "[sheet]" in capsys.readouterr().err
     rc = main(["unroll", str(p), "--forming-png", str(tmp_path / "c.png")])
     assert rc == EXIT_USAGE and "--forming-png needs a sheet thickness" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("side", ["normal", "reverse"])
+def test_plate_step_of_a_run_unrolls_to_the_runs_neutral_pattern(tmp_path, capsys, side) -> None:
+    """`ght-cad run` with a [sheet] writes its plate to model.step with named faces; `ght-cad unroll
+    model.step --k-factor K` finds the inside face by its name, so the neutral pattern is the run's
+    on either side. By geometry alone (the smaller face is the inside) the material on the concave
+    side measured K from the wrong face: the duct's pattern came out 2.4 % short."""
+    design = (Path(__file__).resolve().parents[1] / "examples" / "design_duct.toml").read_text()
+    p = tmp_path / "duct.toml"
+    p.write_text(design + f'\n[sheet]\nthickness = 20\nk_factor = 0.3\nside = "{side}"\n')
+    out = tmp_path / "out"
+    assert main(["run", str(p), "--out", str(out)]) == EXIT_OK, capsys.readouterr().err
+    run_area = json.loads((out / "report.json").read_text())["flat_pattern"]["area"]
+    capsys.readouterr()
+    rc, res, err = _run(["unroll", str(out / "model.step"), "--k-factor", "0.3"], capsys)
+    assert rc == EXIT_OK, err
+    assert res["plate"]["found_by"] == "names"
+    assert res["area"] == pytest.approx(run_area, rel=1e-8)  # the STEP faces are fits (3e-7 T)

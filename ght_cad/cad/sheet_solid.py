@@ -495,7 +495,9 @@ def plate_faces(shape: Any, names: dict[int, str] | None = None, *, rtol: float 
     """Find the inside/outside faces of a plate solid (module doc), or None if it is no plate.
 
     By names: faces named ``inside`` and ``outside`` (or ``<plate>.inside`` and ``<plate>.outside``
-    of one plate name). Else geometrically: among pairs of the
+    of one plate name), when they lie at a constant distance (as below; the names then also say
+    which is the inside, right where the geometric rule is not: material on the concave side).
+    Else geometrically: among pairs of the
     largest faces (each at least a quarter of the largest's area), the pair whose points lie at a
     constant distance (spread <= ``rtol`` × size, distance > 0) from the other's surface; the face
     with the smaller area is the inside (the concave side of a bend).
@@ -519,21 +521,22 @@ def plate_faces(shape: Any, names: dict[int, str] | None = None, *, rtol: float 
         n_in = sum(1 for v in names.values() if plate_of(v, "inside") is not None)
         if len(both) == 1 and n_in == 1:
             pairs.append((ins[both[0]], outs[both[0]], "names"))
-    if not pairs:
-        big = sorted(range(len(faces)), key=lambda k: -areas[k])
-        big = [k for k in big if areas[k] >= 0.25 * areas[big[0]]][:6]
-        for i in range(len(big)):
-            for j in range(i + 1, len(big)):
-                a, b = big[i], big[j]
-                inner, outer = (a, b) if areas[a] <= areas[b] else (b, a)
-                pairs.append((inner, outer, "geometry"))
+    # then by geometry (also when the named pair is not at a constant distance: names written by
+    # another tool, or an OCCT-thickened plate whose faces were told apart wrongly)
+    big = sorted(range(len(faces)), key=lambda k: -areas[k])
+    big = [k for k in big if areas[k] >= 0.25 * areas[big[0]]][:6]
+    for i in range(len(big)):
+        for j in range(i + 1, len(big)):
+            a, b = big[i], big[j]
+            inner, outer = (a, b) if areas[a] <= areas[b] else (b, a)
+            pairs.append((inner, outer, "geometry"))
     for inner, outer, how in pairs:
         d, sign = _offset_distance(faces[inner], faces[outer])
         if d.size == 0:
             continue
         T = float(np.mean(d))
         spread = float(np.ptp(d))
-        if T > 1e-9 * size and (how == "names" or spread <= rtol * size):
+        if T > 1e-9 * size and spread <= rtol * size:
             return PlateFaces(faces[inner], faces[outer], inner, outer, T, spread, how,
                               "normal" if sign > 0 else "reverse", {"areas": (areas[inner], areas[outer])})
     return None
