@@ -60,6 +60,32 @@ def _face_points(face, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.array([s.Value(float(a), float(b)).Coord() for a, b in zip(u, v)])
 
 
+def check_inside_outside(plate, loft, sheet, U: np.ndarray, V: np.ndarray, size: float):
+    """Inside face on the design surface, outside on ``S + σT n`` at matched parameters (an upper
+    bound of the distance to the surface): within 1e-6 min(size, T) and 1e-6 T. Returns
+    ``(X, n, d_in, d_out)``."""
+    T, sig = sheet.thickness, sheet.sign
+    X = loft.evaluate(U, V)
+    n = ruling_normal(loft, U, 0)[0]
+    d_in = float(np.linalg.norm(_face_points(plate.inside, U, V) - X, axis=1).max())
+    d_out = float(np.linalg.norm(_face_points(plate.outside, U, V) - (X + sig * T * n), axis=1).max())
+    assert d_in <= 1e-6 * min(size, T)
+    assert d_out <= 1e-6 * T
+    return X, n, d_in, d_out
+
+
+def check_outside_at_thickness(plate, U: np.ndarray, V: np.ndarray, T: float) -> None:
+    """The outside face's points at (U, V) lie at distance T (to 1e-6 T) from the inside face's
+    surface (OCCT projection: independent of the parametrization)."""
+    inner = BRep_Tool.Surface_s(plate.inside)
+    dist = []
+    for p in _face_points(plate.outside, U, V):
+        proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*p), inner)
+        assert proj.NbPoints() > 0
+        dist.append(proj.LowerDistance())
+    assert np.max(np.abs(np.array(dist) - T)) <= 1e-6 * T
+
+
 def _abs_turn(loft, sheet) -> float:
     """``(T²/2) ∫ |2H| dA = (T²/2) ∫ |ω| |g| du`` (ω = n'·e, module doc of ght_cad.plate)."""
     from ght_cad.curve import integrate
@@ -85,27 +111,13 @@ def check_plate(loft, sheet: Sheet) -> dict:
     lam = _params(loft)
     vv = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
     U, V = np.repeat(lam, vv.size), np.tile(vv, lam.size)
-    X = loft.evaluate(U, V)
-    n = ruling_normal(loft, U, 0)[0]
-    # inside on the design surface, outside on S + σT n (matched parameters: an upper bound of
-    # the distance to the surface)
-    d_in = float(np.linalg.norm(_face_points(plate.inside, U, V) - X, axis=1).max())
-    d_out = float(np.linalg.norm(_face_points(plate.outside, U, V) - (X + sig * T * n), axis=1).max())
-    assert d_in <= 1e-6 * min(size, T)
-    assert d_out <= 1e-6 * T
+    X, n, d_in, d_out = check_inside_outside(plate, loft, sheet, U, V, size)
     # the walls: c(u) + t n(u), t = σT × the face's second parameter
     for wall, c in ((plate.edges[0], loft.a(U)), (plate.edges[2], loft.b(U))):
         assert np.linalg.norm(_face_points(wall, U, V) - (c + (sig * T * V)[:, None] * n), axis=1).max() <= 1e-6 * T
     # independently of the parametrization: the outside face's points lie at distance T from the
     # inside face's surface (OCCT projection; inner rulings of every piece)
-    inner = BRep_Tool.Surface_s(plate.inside)
-    keep = (V > 0) & (V < 1)
-    dist = []
-    for p in _face_points(plate.outside, U[keep], V[keep]):
-        proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*p), inner)
-        assert proj.NbPoints() > 0
-        dist.append(proj.LowerDistance())
-    assert np.max(np.abs(np.array(dist) - T)) <= 1e-6 * T
+    check_outside_at_thickness(plate, U[(V > 0) & (V < 1)], V[(V > 0) & (V < 1)], T)
     # volume: OCCT (adaptive, and the default rule on the C0-split copy) against the closed form
     Vc = plate_volume(loft, sheet)
     assert plate.closed_form_volume == Vc

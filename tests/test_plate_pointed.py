@@ -22,8 +22,6 @@ from hypothesis import strategies as st
 pytest.importorskip("OCP")
 
 from OCP.BRep import BRep_Tool  # noqa: E402
-from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf  # noqa: E402
-from OCP.gp import gp_Pnt  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.occ import is_valid  # noqa: E402
@@ -33,6 +31,7 @@ from ght_cad.loft import developable_loft  # noqa: E402
 from ght_cad.plate import plate_volume  # noqa: E402
 from ght_cad.sheet import Sheet, SheetError, bending_radius, check_offset, ruling_normal  # noqa: E402
 from ght_cad.unroll import unroll  # noqa: E402
+from tests.test_plate_fans import _size, check_inside_outside, check_outside_at_thickness  # noqa: E402
 
 SHEER = np.array([[0, -900, 1200], [1500, -1000, 1250], [3000, -700, 1350], [4200, 0, 1500]], float)
 CHINE = np.array([[0, -700, 300], [1500, -800, 350], [3000, -500, 700], [4200, 0, 1500]], float)
@@ -47,20 +46,11 @@ def bow(both: bool = False, chine: np.ndarray | None = None, sheer: np.ndarray |
     return developable_loft(GHTCurve(c), GHTCurve(s))
 
 
-def _size(loft) -> float:
-    u = np.linspace(0.0, 1.0, 65)
-    p = np.vstack([loft.a(u), loft.b(u)])
-    return float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
-
-
-def _face_points(face, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    s = BRep_Tool.Surface_s(face)
-    return np.array([s.Value(float(a), float(b)).Coord() for a, b in zip(u, v)])
 
 
 def check_pointed_plate(loft, sheet: Sheet) -> dict:
     """Valid solid, no end wall at a point, inside on S, outside at T, volume = closed form."""
-    T, sig = sheet.thickness, sheet.sign
+    T = sheet.thickness
     plate = plate_solid(loft, sheet)
     assert is_valid(plate.solid)
     pointed = plate.data.pointed
@@ -72,21 +62,10 @@ def check_pointed_plate(loft, sheet: Sheet) -> dict:
     lam = np.linspace(0.0, 1.0, 41)
     vv = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
     U, V = np.repeat(lam, vv.size), np.tile(vv, lam.size)
-    X = loft.evaluate(U, V)
-    n = ruling_normal(loft, U, 0)[0]
-    d_in = float(np.linalg.norm(_face_points(plate.inside, U, V) - X, axis=1).max())
-    d_out = float(np.linalg.norm(_face_points(plate.outside, U, V) - (X + sig * T * n), axis=1).max())
-    assert d_in <= 1e-6 * min(size, T)
-    assert d_out <= 1e-6 * T
+    check_inside_outside(plate, loft, sheet, U, V, size)
     # outside at distance T from the inside face's surface, independently of the parametrization
-    inner = BRep_Tool.Surface_s(plate.inside)
     keep = (V > 0) & (V < 1) & (U > 0) & (U < 1)
-    dist = []
-    for p in _face_points(plate.outside, U[keep], V[keep]):
-        proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*p), inner)
-        assert proj.NbPoints() > 0
-        dist.append(proj.LowerDistance())
-    assert np.max(np.abs(np.array(dist) - T)) <= 1e-6 * T
+    check_outside_at_thickness(plate, U[keep], V[keep], T)
     Vc = plate_volume(loft, sheet)
     assert abs(plate.volume / Vc - 1) <= 1e-6
     return {"plate": plate, "V": plate.volume, "Vc": Vc}
