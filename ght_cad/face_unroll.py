@@ -37,6 +37,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ._vec import unique_inverse
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, measure_panel
 from .ruled import RuledSurface
 from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles, metric_stencil
@@ -229,7 +230,7 @@ class FaceRuledSurface(RuledSurface):
             return self.ev.value(u, v)
         # the ends at the distinct t only (points along one ruling share them: a ruling edge's
         # samples, the metric stencil's v steps, the bend lines' two ends)
-        tu, inv = np.unique(t, return_inverse=True)
+        tu, inv = unique_inverse(t)
         m = tu.size
         ue, ve = self.uv(np.concatenate([tu, tu]), np.concatenate([np.zeros(m), np.ones(m)]))
         n = np.size(u)

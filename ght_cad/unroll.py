@@ -36,6 +36,7 @@ from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from ._vec import cross as _cross
 from ._vec import dot as _dot
 from ._vec import norm as _norm
+from ._vec import unique_inverse as _unique_inverse
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from .ruled import RuledSurface
 
@@ -95,13 +96,18 @@ class _PanelSeries:
         self.coefs = coefs  # (P, deg+1, m)
         self.offsets = offsets  # (P, m) value at each panel's left end (integrals) or None
 
-    def __call__(self, u: np.ndarray) -> np.ndarray:
+    def __call__(self, u: np.ndarray, ascending: bool = False) -> np.ndarray:
+        """The series at ``u`` (n, m); ``ascending``: ``u`` is sorted (the map's distinct
+        parameters), its panels are then contiguous runs found by one ``searchsorted`` of the
+        panel ends, with no per-point panel index."""
         u = np.asarray(u, dtype=float).ravel()
+        P = self.edges.size - 1
+        if ascending and P <= 64 and u.size > 4 * P:
+            return self._ascending(u)
         idx = np.minimum(np.maximum(np.searchsorted(self.edges, u, side="right") - 1, 0), self.edges.size - 2)  # np.clip, without its overhead
         lo, hi = self.edges[idx], self.edges[idx + 1]
         x = np.minimum(np.maximum((2.0 * u - lo - hi) / (hi - lo), -1.0), 1.0)
         out = np.empty((u.size, self.coefs.shape[2]))
-        P = self.edges.size - 1
         if P <= 64 and u.size > 4 * P:
             # few panels: T_j(x) by the three-term recurrence, then one small product per panel
             T = np.empty((self.coefs.shape[1], u.size))
@@ -126,6 +132,40 @@ class _PanelSeries:
                 out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
         if self.offsets is not None:
             out += self.offsets[idx]
+        return out
+
+    def _ascending(self, u: np.ndarray) -> np.ndarray:
+        """:meth:`__call__` of sorted ``u``: the same arithmetic on contiguous runs per panel
+        (panel p holds ``edges[p] <= u < edges[p + 1]``, the end panels continued outside)."""
+        edges = self.edges.tolist()
+        P = len(edges) - 1
+        bounds = [0, *np.searchsorted(u, self.edges[1:-1], side="left").tolist(), u.size]
+        x = np.empty(u.size)
+        for p in range(P):
+            s, e = bounds[p], bounds[p + 1]
+            if e > s:
+                lo, hi = edges[p], edges[p + 1]
+                xs = x[s:e]
+                np.multiply(u[s:e], 2.0, out=xs)
+                xs -= lo
+                xs -= hi
+                xs /= hi - lo
+                np.minimum(np.maximum(xs, -1.0, out=xs), 1.0, out=xs)
+        T = np.empty((self.coefs.shape[1], u.size))
+        T[0] = 1.0
+        if T.shape[0] > 1:
+            T[1] = x
+        x2 = 2.0 * x
+        for j in range(2, T.shape[0]):
+            np.multiply(x2, T[j - 1], out=T[j])
+            T[j] -= T[j - 2]
+        out = np.empty((u.size, self.coefs.shape[2]))
+        for p in range(P):
+            s, e = bounds[p], bounds[p + 1]
+            if e > s:
+                np.matmul(T[:, s:e].T, self.coefs[p], out=out[s:e])
+                if self.offsets is not None:
+                    out[s:e] += self.offsets[p]
         return out
 
 
@@ -285,9 +325,9 @@ class RuledDevelopment:
         uu, vv = uu.ravel(), vv.ravel()
         # L, φ and A depend on u only: evaluated once per distinct u (points along one ruling, a
         # ruling edge's samples or a difference stencil's v steps, share them)
-        tu, inv = np.unique(uu, return_inverse=True) if uu.size > 64 else (uu, None)
+        tu, inv = _unique_inverse(uu) if uu.size > 64 else (uu, None)
         L = self.surface.ruling_lengths(tu)
-        r = self._phiA(tu)  # the same values as phi(tu), directrix(tu)
+        r = self._phiA(tu, ascending=inv is not None)  # the same values as phi(tu), directrix(tu)
         ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
         A = r[:, 1:3] @ self._R.T + self._t
         LD = L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)
