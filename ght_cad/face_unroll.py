@@ -37,8 +37,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ._vec import norm as _norm
+from ._vec import stack as _stack
 from ._vec import unique_inverse
-from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, measure_panel
+from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, _unit_samples, measure_panel
 from .ruled import RuledSurface
 from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles, metric_stencil
 
@@ -578,8 +580,8 @@ def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: float, u_breaks: np.ndarray
     cuts = np.sort(np.concatenate([lo[:, None], np.where(inside, br, hi[:, None]), hi[:, None]], axis=1), axis=1)
     a, b = cuts[:, :-1], cuts[:, 1:]
     m = 0.5 * (a + b)
-    a = np.stack([a, m], axis=2).reshape(n, -1)  # halves [a, m], [m, b]
-    b = np.stack([m, b], axis=2).reshape(n, -1)
+    a = _stack([a, m], axis=2).reshape(n, -1)  # halves [a, m], [m, b]
+    b = _stack([m, b], axis=2).reshape(n, -1)
     owner = np.repeat(np.arange(n), a.shape[1])
     a, b = a.ravel(), b.ravel()
     keep = b > a
@@ -786,12 +788,12 @@ class ClosedFormMap:
         """``F(u, v)``, shape (n, 2)."""
         u, v = broadcast_uv(u, v)
         if self.kind == "plane":
-            return np.stack([u, v], axis=1)
+            return _stack([u, v], axis=1)
         if self.kind == "cylinder":
-            return np.stack([self.R * u, v], axis=1)
+            return _stack([self.R * u, v], axis=1)
         rho = self.R / self.s + v
         ang = self.s * u
-        return np.stack([rho * np.cos(ang), rho * np.sin(ang)], axis=1)
+        return _stack([rho * np.cos(ang), rho * np.sin(ang)], axis=1)
 
 
 class _RuledFaceMap:
@@ -951,7 +953,7 @@ def unroll_face_data(
     bends = np.zeros((0, 2, 2))
     g3 = gf = np.zeros(0)
     if ruled_dir is not None:
-        tt = np.linspace(0.0, 1.0, 129)
+        tt = _unit_samples(129)
         tb = np.arange(1, rulings + 1) / (rulings + 1)
 
         def ends(t: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -965,7 +967,7 @@ def unroll_face_data(
         ua, va, ub, vb = ends(tt)
         n = tt.size
         p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
-        g3 = np.linalg.norm(p3[:n] - p3[n:], axis=1)
+        g3 = _norm(p3[:n] - p3[n:])
     # the map's points in one call (it is pointwise; its per-call overhead dominated): the
     # edges' outline samples, the ruling ends and bend lines, the metric's stencil
     mU, mV, mhu, mhv = _metric_grid(bounds)
@@ -976,7 +978,7 @@ def unroll_face_data(
         ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
         if rulings and len(sampled) == sum(len(lp) for lp in loops):
             m = ts.size
-            pts = np.stack(edge_uv, axis=1).reshape(len(sampled), m, 2)
+            pts = _stack(edge_uv, axis=1).reshape(len(sampled), m, 2)
             if ruled_dir == "u":
                 pts = pts[..., ::-1]
             first = np.cumsum([0] + [len(lp) for lp in loops])
@@ -996,10 +998,10 @@ def unroll_face_data(
         _seed_edge_samples(sampled, ts, fmap(*edge_uv))
     if ruled_dir is not None:
         pf = fmap(*ruling_uv)
-        gf = np.linalg.norm(pf[:n] - pf[n:2 * n], axis=1)
+        gf = _norm(pf[:n] - pf[n:2 * n])
         if rulings:
             k = ca.size
-            bends = np.stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
+            bends = _stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
     area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"), u1 - u0)
     panel = FlatPanel(
         label=label,
@@ -1095,7 +1097,7 @@ def _edge_sample_uv(loops: list[list[BoundaryEdge]], loops_uv: list[list[tuple[C
     all edges' (u, v) there, concatenated (edge by edge)."""
     edges = [(e, uvf) for loop, luv in zip(loops, loops_uv) for e, (uvf, _) in zip(loop, luv)
              if hasattr(e.flat_fn, "seed")]
-    t = np.linspace(0.0, 1.0, samples)
+    t = _unit_samples(samples)
     if not edges or samples < 2:
         return [], t, (np.zeros(0), np.zeros(0))
     uvs = [uvf(t) for _, uvf in edges]
@@ -1149,7 +1151,7 @@ def _seed_edge_samples(edges: list[BoundaryEdge], t: np.ndarray, flat: np.ndarra
 def _loop_points(loop: list[tuple[Callable, Callable]], n: int) -> np.ndarray:
     """(u, v) points of a loop, ``n`` per edge (end points excluded), shape (m, 2)."""
     t = (np.arange(n) + 0.5) / n
-    return np.concatenate([np.stack([np.asarray(x, dtype=float) for x in uvf(t)], axis=1) for uvf, _ in loop])
+    return np.concatenate([_stack([np.asarray(x, dtype=float) for x in uvf(t)], axis=1) for uvf, _ in loop])
 
 
 def _check_holes_inside(loops_uv: list[list[tuple[Callable, Callable]]], label: str) -> None:

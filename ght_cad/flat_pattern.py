@@ -29,6 +29,8 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from .errors import GHTError
+from ._vec import einsum as _einsum
+from ._vec import stack as _stack
 from .io import atomic_path, write_text_atomic
 
 __all__ = [
@@ -74,7 +76,7 @@ MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
 
 def _chords(p: np.ndarray) -> float:
     d = p[1:] - p[:-1]
-    return float(np.sum(np.sqrt(np.einsum("ij,ij->i", d, d))))
+    return float(np.sum(np.sqrt(_einsum("ij,ij->i", d, d))))
 
 
 @functools.lru_cache(maxsize=8)
@@ -140,7 +142,7 @@ def _romberg_pairs(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     for step in (4, 2, 1):
         q = P[:, ::step]
         d = q[:, 1:] - q[:, :-1]
-        ls.append(np.sqrt(np.einsum("eij,eij->ei", d, d)).sum(axis=1))
+        ls.append(np.sqrt(_einsum("eij,eij->ei", d, d)).sum(axis=1))
     l1, l2, l4 = ls
     r1 = (4 * l2 - l1) / 3
     r2 = (4 * l4 - l2) / 3
@@ -419,13 +421,21 @@ class FlatPanel:
         """Lower-left and upper-right corners of the outline (``loops``: :meth:`loop_polylines`
         when already made)."""
         pts = np.concatenate(self.loop_polylines() if loops is None else loops, axis=0)
-        return pts.min(axis=0), pts.max(axis=0)
+        return points_bbox(pts)
 
     def map(self, u: Any, v: Any) -> np.ndarray:
         """Flat image of surface parameters (u, v) in pattern coordinates."""
         if self.development is None:
             raise GHTError(f"panel {self.label!r} has no development map")
         return self.development.map(u, v) + self.offset
+
+
+def points_bbox(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(pts.min(axis=0), pts.max(axis=0))`` of (n, d) points (the same values), column by
+    column: numpy's reduction across the rows of an (n, 2) array costs 27 µs for 1,000 points, a
+    column's 1-D reduction 1 µs."""
+    cols = [pts[:, k] for k in range(pts.shape[1])]
+    return np.array([c.min() for c in cols]), np.array([c.max() for c in cols])
 
 
 def _point_in_polygon(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
@@ -459,7 +469,7 @@ def _sagitta(loop: np.ndarray) -> float:
     with np.errstate(divide="ignore", invalid="ignore"):
         dist = np.abs(ac[:, 0] * (b - a)[:, 1] - ac[:, 1] * (b - a)[:, 0]) / n
         u, v = b - a, c - b
-        turn = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), np.einsum("ij,ij->i", u, v))
+        turn = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), _einsum("ij,ij->i", u, v))
     smooth = (turn < math.radians(10)) & (n > 0)
     return float(np.max(dist[smooth]) / 4) if smooth.any() else 0.0
 
@@ -483,14 +493,14 @@ def clip_segments(segments: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
     P, Q = segments[:, 0], segments[:, 1]
     R = Q - P  # (k, 2)
     sag = max(_sagitta(lp) for lp in loops)
-    dt = np.minimum(1e-3, 8.0 * sag / np.maximum(np.sqrt(np.einsum("ij,ij->i", R, R)), 1e-300))[:, None]
+    dt = np.minimum(1e-3, 8.0 * sag / np.maximum(np.sqrt(_einsum("ij,ij->i", R, R)), 1e-300))[:, None]
     # P + t R = A + w S: with 2-D cross products x × y = x_0 y_1 - x_1 y_0 (as matrix products)
-    Sp = np.stack([S[:, 1], -S[:, 0]])  # (2, m): x @ Sp = x × S
-    Rp = np.stack([R[:, 1], -R[:, 0]])  # (2, k)
+    Sp = _stack([S[:, 1], -S[:, 0]])  # (2, m): x @ Sp = x × S
+    Rp = _stack([R[:, 1], -R[:, 0]])  # (2, k)
     den = R @ Sp  # R × S, (k, m)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = (np.einsum("ij,ji->i", A, Sp)[None, :] - P @ Sp) / den  # ((A - P) × S) / (R × S)
-        w = ((A @ Rp).T - np.einsum("ij,ji->i", P, Rp)[:, None]) / den  # ((A - P) × R) / (R × S)
+        t = (_einsum("ij,ji->i", A, Sp)[None, :] - P @ Sp) / den  # ((A - P) × S) / (R × S)
+        w = ((A @ Rp).T - _einsum("ij,ji->i", P, Rp)[:, None]) / den  # ((A - P) × R) / (R × S)
     sel = (np.abs(den) > 1e-300) & (t > dt) & (t < 1 - dt) & (w >= 0) & (w <= 1)
     crossing = sel.any(axis=1)
     out: list[tuple[int, np.ndarray]] = []  # (segment index, piece): keeps the input order
@@ -524,7 +534,7 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
         if _outline_serves_length(e.samples) and not e.breaks:
             groups.setdefault(e.samples, []).append(e)
     for es in groups.values():
-        R, R2 = _romberg_pairs(np.stack([e.flat for e in es]))
+        R, R2 = _romberg_pairs(_stack([e.flat for e in es]))
         pairs.update({id(e): (float(a), float(b)) for e, a, b in zip(es, R, R2)})
     for li, loop in enumerate(panel.loops):
         for e in loop:
@@ -626,8 +636,8 @@ def _polyline_param(poly: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.n
     """Distance of pts to polyline and fractional sample index of the nearest point."""
     a, b = poly[:-1], poly[1:]
     ab = b - a
-    den = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
-    t = np.clip(np.einsum("kij,ij->ki", pts[:, None, :] - a[None], ab) / den, 0, 1)
+    den = np.maximum(_einsum("ij,ij->i", ab, ab), 1e-300)
+    t = np.clip(_einsum("kij,ij->ki", pts[:, None, :] - a[None], ab) / den, 0, 1)
     proj = a[None] + t[..., None] * ab[None]
     dist = np.linalg.norm(pts[:, None, :] - proj, axis=2)
     j = np.argmin(dist, axis=1)
@@ -685,7 +695,7 @@ def _shared_edge_candidates(boxes: np.ndarray, radii: np.ndarray) -> list[np.nda
     b = np.concatenate([np.asarray(h, dtype=np.intp) for h in hits]) if n else np.zeros(0, np.intp)
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     keep = lo != hi
-    pairs = np.unique(np.stack([lo[keep], hi[keep]], axis=1), axis=0) if keep.any() else np.zeros((0, 2), np.intp)
+    pairs = np.unique(_stack([lo[keep], hi[keep]], axis=1), axis=0) if keep.any() else np.zeros((0, 2), np.intp)
     starts = np.searchsorted(pairs[:, 0], np.arange(n + 1))
     return [pairs[starts[i]:starts[i + 1], 1] for i in range(n)]
 
@@ -764,7 +774,7 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
                 lo, hi = panel.bbox()
                 tick = min(tick_all, 0.1 * float(np.min(hi - lo)))  # a narrow panel gets smaller marks
                 pos, tan = _interp_polyline(edge.flat + panel.offset, s)
-                nrm = np.stack([-tan[:, 1], tan[:, 0]], axis=1)
+                nrm = _stack([-tan[:, 1], tan[:, 0]], axis=1)
                 probe = pos[2] + 2 * tick * nrm[2]
                 if not _inside(probe[None], loops)[0]:
                     nrm = -nrm
@@ -1002,7 +1012,7 @@ class FlatPattern:
             The SVG text.
         """
         pts = np.concatenate(self.outlines, axis=0)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        lo, hi = points_bbox(pts)
         span = float(np.max(hi - lo))
         m = 0.03 * span if margin is None else float(margin)
         W, H = float(hi[0] - lo[0]) + 2 * m, float(hi[1] - lo[1]) + 2 * m

@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 
 from .errors import GHTError
+from ._vec import einsum as _einsum
+from ._vec import stack as _stack
 
 __all__ = ["NurbsSurface", "NurbsCurve", "expand_knots"]
 
@@ -86,8 +88,8 @@ class NurbsSurface:
             rows = su[:, None] - self.pu + np.arange(self.pu + 1)[None, :]  # (nsu, a)
             cols = sv[:, None] - self.pv + np.arange(self.pv + 1)[None, :]  # (nsv, b)
             win = cw[rows[:, None, :, None], cols[None, :, None, :]]  # (nsu, nsv, a, b, 4)
-            pt = np.einsum("sea,stabk->stebk", Mu, win)
-            pt = np.einsum("tfb,stebk->stefk", Mv, pt)
+            pt = _einsum("sea,stabk->stebk", Mu, win)
+            pt = _einsum("tfb,stebk->stefk", Mv, pt)
             cu, hu = 0.5 * (self.U[su] + self.U[su + 1]), 0.5 * (self.U[su + 1] - self.U[su])
             cv, hv = 0.5 * (self.V[sv] + self.V[sv + 1]), 0.5 * (self.V[sv + 1] - self.V[sv])
             self.patches = (self.U[su], cu, hu, self.V[sv], cv, hv,
@@ -175,7 +177,7 @@ class NurbsSurface:
             (sv - self.pv)[:, None, None] + np.arange(B)[None, None, :])
         poles = np.take(net.reshape(-1, 4), idx.ravel(), axis=0).reshape(n, A * B, 4)
         w = (Nu[:, :, None] * Nv[:, None, :]).reshape(n, A * B)
-        return np.einsum("nj,njk->nk", w, poles)
+        return _einsum("nj,njk->nk", w, poles)
 
     def eval(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         """``[S]``, ``[S, S_u, S_v]`` or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` for ``order`` 0, 1, 2
@@ -249,10 +251,10 @@ class NurbsSurface:
         K = 3 if self.weight is not None else 4
         if starts_u.size == 1:  # one u-span: no per-point copy of its coefficients
             P = pt.reshape(1, starts_v.size, A, B, 4)[0][..., :K]  # (v-span, e, f, k)
-            G = [np.ascontiguousarray(np.einsum("ie,sefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
+            G = [np.ascontiguousarray(_einsum("ie,sefk->skif", T, P)) for T in Tu]  # (v-span, k, i, f)
         else:
             P = pt.reshape(starts_u.size, starts_v.size, A, B, 4)[iu][..., :K]  # (i, v-span, e, f, k)
-            G = [np.ascontiguousarray(np.einsum("ie,isefk->skif", T, P)) for T in Tu]
+            G = [np.ascontiguousarray(_einsum("ie,isefk->skif", T, P)) for T in Tu]
         ms, mv = s.size, v.size
         if K == 3 and self.pv == 1 and starts_v.size == 1:
             # degree 1 in v: S_u = U0 + y U1 (y = the patch's Chebyshev variable, T_1(y) = y) and
@@ -260,13 +262,13 @@ class NurbsSurface:
             # C0 = U0 × S_v, C1 = U1 × S_v, a = |C0|², b = 2 C0·C1, c = |C1|², per s only
             U0, U1 = G[1][0][..., 0], G[1][0][..., 1]  # (k, i)
             Sv = G[0][0][..., 1] / hv[0]
-            C0 = np.stack([U0[1] * Sv[2] - U0[2] * Sv[1], U0[2] * Sv[0] - U0[0] * Sv[2], U0[0] * Sv[1] - U0[1] * Sv[0]])
-            C1 = np.stack([U1[1] * Sv[2] - U1[2] * Sv[1], U1[2] * Sv[0] - U1[0] * Sv[2], U1[0] * Sv[1] - U1[1] * Sv[0]])
+            C0 = _stack([U0[1] * Sv[2] - U0[2] * Sv[1], U0[2] * Sv[0] - U0[0] * Sv[2], U0[0] * Sv[1] - U0[1] * Sv[0]])
+            C1 = _stack([U1[1] * Sv[2] - U1[2] * Sv[1], U1[2] * Sv[0] - U1[0] * Sv[2], U1[0] * Sv[1] - U1[1] * Sv[0]])
             scale = 1.0 / (self.weight * self.weight)  # type: ignore[operator]
-            abc = np.stack([np.einsum("ki,ki->i", C0, C0), 2.0 * np.einsum("ki,ki->i", C0, C1),
-                            np.einsum("ki,ki->i", C1, C1)], axis=1) * scale  # (i, 3)
+            abc = _stack([_einsum("ki,ki->i", C0, C0), 2.0 * _einsum("ki,ki->i", C0, C1),
+                            _einsum("ki,ki->i", C1, C1)], axis=1) * scale  # (i, 3)
             y = Tv[0][:, 1]
-            r = abc @ np.stack([np.ones_like(y), y, y * y])  # a + b y + c y² on the grid, one product
+            r = abc @ _stack([np.ones_like(y), y, y * y])  # a + b y + c y² on the grid, one product
             return np.sqrt(np.maximum(r, 0.0, out=r), out=r)
         keys = ((1, 0), (0, 1)) if K == 3 else ((0, 0), (1, 0), (0, 1))
         spans = np.unique(iv)
@@ -321,9 +323,9 @@ class NurbsSurface:
             return out
         P = np.take(pt, iu * starts_v.size + iv, axis=0).reshape(u.size, self.pu + 1, self.pv + 1, 4)
         for ku in range(order + 1):
-            tmp = np.einsum("ne,nefk->nfk", Tu[ku], P)
+            tmp = _einsum("ne,nefk->nfk", Tu[ku], P)
             for kv in range(order + 1 - ku):
-                out[(ku, kv)] = np.einsum("nf,nfk->nk", Tv[kv], tmp)
+                out[(ku, kv)] = _einsum("nf,nfk->nk", Tv[kv], tmp)
         return out
 
 
@@ -377,7 +379,7 @@ def _cheb_basis(U: np.ndarray, p: int, spans: np.ndarray) -> np.ndarray:
     _, lev = _basis(U, p, uk, 0)
     N = lev[0].reshape(spans.size, p + 1, p + 1)  # (s, node k, a)
     T = np.cos(np.outer(k, np.pi * (k + 0.5) / (p + 1)))  # T_e(x_k), (e, k)
-    M = (2.0 / (p + 1)) * np.einsum("ek,ska->sea", T, N)
+    M = (2.0 / (p + 1)) * _einsum("ek,ska->sea", T, N)
     M[:, 0, :] *= 0.5
     return M
 
@@ -535,7 +537,7 @@ class NurbsCurve:
                 out.append(np.zeros((x.size, self.cw.shape[1])))
                 continue
             idx = (span - self.p)[:, None] + np.arange(lev[k].shape[1])[None, :]
-            out.append(np.einsum("na,nak->nk", lev[k], np.take(net, idx, axis=0)))
+            out.append(_einsum("na,nak->nk", lev[k], np.take(net, idx, axis=0)))
         return out
 
     def value(self, x: np.ndarray) -> np.ndarray:

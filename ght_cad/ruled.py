@@ -11,6 +11,7 @@ analytic derivatives; measures, sampling and conversion are shared.
 
 from __future__ import annotations
 
+import functools
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -73,6 +74,16 @@ def _unit(v: np.ndarray) -> np.ndarray:
 #: relative size of ``|a' × g|`` (against ``|a'| |g|``) below which the normal at that end of the
 #: ruling is undefined (a singular point of the boundary curve, e.g. a' = 0 at an end)
 SINGULAR_NORMAL_TOL = 1e-10
+
+
+@functools.lru_cache(maxsize=8)
+def _theta_parameters(nodes: int, samples: int) -> np.ndarray:
+    """The developability's parameters: the ``nodes`` Gauss–Legendre nodes on [0, 1], then
+    ``samples`` uniform ones (ends included); made once per pair (read-only)."""
+    t, _ = gauss_legendre(nodes)
+    uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
+    uu.flags.writeable = False
+    return uu
 
 
 def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -253,7 +264,7 @@ class RuledSurface(ABC):
                 "Gauss–Legendre nodes"
             )
         t, w = gauss_legendre(nodes)
-        uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
+        uu = _theta_parameters(nodes, samples)
         # the quadrature nodes are the first entries of uu: one evaluation of a', b', g (a face's
         # boundary jets are kept per parameter array) and one of θ serve the integrals, θ_max and
         # the residual
@@ -268,7 +279,7 @@ class RuledSurface(ABC):
 
     def ruling_lengths(self, u: Any) -> np.ndarray:
         """``|b(u) - a(u)|``."""
-        return np.linalg.norm(self.ruling(u), axis=-1)
+        return _norm(self.ruling(u))
 
 
 class CurvePairRuledSurface(RuledSurface):

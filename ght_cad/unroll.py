@@ -34,6 +34,8 @@ import numpy as np
 from .curve import gauss_legendre, integrate
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from ._vec import cross as _cross
+from ._vec import einsum as _einsum
+from ._vec import stack as _stack
 from ._vec import dot as _dot
 from ._vec import norm as _norm
 from ._vec import unique_inverse as _unique_inverse
@@ -68,12 +70,12 @@ _EDGES0 = np.linspace(0.0, 1.0, 5)
 
 def _chebint(c: np.ndarray) -> np.ndarray:
     """``∫_{-1}^x`` of the series ``c`` (P, N+1, m) along axis 1: (P, N+2, m)."""
-    return np.einsum("ij,pjm->pim", _INT, c)
+    return _einsum("ij,pjm->pim", _INT, c)
 
 
 def _coefficients(f: np.ndarray) -> np.ndarray:
     """Chebyshev coefficients of samples ``f`` (P, N+1, m) at the first-kind nodes."""
-    c = (2.0 / (_N + 1)) * np.einsum("kj,pkm->pjm", _V, f)
+    c = (2.0 / (_N + 1)) * _einsum("kj,pkm->pjm", _V, f)
     c[:, 0, :] *= 0.5
     return c
 
@@ -250,15 +252,15 @@ class RuledDevelopment:
             h = 0.5 * (hi - lo)
             uu = (0.5 * (lo + hi))[:, None] + h[:, None] * _X[None, :]
             fr = _frame(surface, uu.ravel())
-            stage1 = np.stack([fr["w"], fr["p"], fr["q"]], axis=-1).reshape(P, _N + 1, 3)
+            stage1 = _stack([fr["w"], fr["p"], fr["q"]], axis=-1).reshape(P, _N + 1, 3)
             c1 = _coefficients(stage1)
             # φ at the nodes: integrate w spectrally, panel offsets by cumulative sums
             cw = _chebint(c1[:, :, :1] * h[:, None, None])
-            tot_w = np.einsum("pjm,j->pm", cw, np.ones(_N + 2))  # value at x = +1 (T_j(1) = 1)
+            tot_w = _einsum("pjm,j->pm", cw, np.ones(_N + 2))  # value at x = +1 (T_j(1) = 1)
             off_w = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1]
-            phi = np.einsum("kj,pjm->pkm", _VI, cw)[:, :, 0] + off_w[:, None]
-            D = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
-            Dp = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
+            phi = _einsum("kj,pjm->pkm", _VI, cw)[:, :, 0] + off_w[:, None]
+            D = _stack([np.cos(phi), np.sin(phi)], axis=-1)
+            Dp = _stack([-np.sin(phi), np.cos(phi)], axis=-1)
             Ap = stage1[:, :, 1:2] * D + stage1[:, :, 2:3] * Dp
             c2 = _coefficients(Ap)
             size = float(np.sum(np.abs(c1[:, 0, 1:]).max(axis=1) * 2 * h)) + float(fr["L"].max())
@@ -276,7 +278,7 @@ class RuledDevelopment:
         #: max over the final nodes of |d'·n| L (0 on a developable: d' lies in the tangent plane)
         self.normal_turning_max = float(np.max(np.abs(fr["wn"]) * fr["L"]))
         cA = _chebint(c2 * h[:, None, None])
-        totA = np.einsum("pjm,j->pm", cA, np.ones(_N + 2))
+        totA = _einsum("pjm,j->pm", cA, np.ones(_N + 2))
         offA = np.concatenate([np.zeros((1, 2)), np.cumsum(totA, axis=0)])[:-1]
         offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
         self._phi = _PanelSeries(edges, cw, offw)
@@ -301,7 +303,7 @@ class RuledDevelopment:
         r = self._phiA(uu)
         ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
         A = r[:, 1:3] @ self._R.T + self._t
-        pts = np.concatenate([A, A + L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)])
+        pts = np.concatenate([A, A + L[:, None] * _stack([np.cos(ph), np.sin(ph)], axis=-1)])
         self._t = -pts.min(axis=0)
 
     def phi(self, u: Any) -> np.ndarray:
@@ -312,7 +314,7 @@ class RuledDevelopment:
     def ruling_direction(self, u: Any) -> np.ndarray:
         """Unit flat ruling direction ``D(u)``, shape (n, 2)."""
         ph = self.phi(u)
-        return np.stack([np.cos(ph), np.sin(ph)], axis=-1)
+        return _stack([np.cos(ph), np.sin(ph)], axis=-1)
 
     def directrix(self, u: Any) -> np.ndarray:
         """Flat image ``A(u)`` of the directrix, shape (n, 2)."""
@@ -330,7 +332,7 @@ class RuledDevelopment:
         r = self._phiA(tu, ascending=inv is not None)  # the same values as phi(tu), directrix(tu)
         ph = r[:, 0] + math.atan2(self._R[1, 0], self._R[0, 0])
         A = r[:, 1:3] @ self._R.T + self._t
-        LD = L[:, None] * np.stack([np.cos(ph), np.sin(ph)], axis=-1)
+        LD = L[:, None] * _stack([np.cos(ph), np.sin(ph)], axis=-1)
         if inv is not None:
             inv = inv.ravel()
             A, LD = A[inv], LD[inv]
@@ -341,7 +343,7 @@ class RuledDevelopment:
         uu = np.atleast_1d(np.asarray(u, float))
         a = self.surface.a(uu)
         g = self.surface.ruling(uu)
-        s = np.einsum("ij,ij->i", np.asarray(points, float) - a, g) / np.einsum("ij,ij->i", g, g)
+        s = _einsum("ij,ij->i", np.asarray(points, float) - a, g) / _einsum("ij,ij->i", g, g)
         return self.map(uu, s)
 
 
@@ -550,7 +552,7 @@ def unroll_ruled(
     ur = (np.arange(1, rulings + 1) / (rulings + 1)) if rulings > 0 else np.zeros(0)
     p0 = dev.map(ur, np.zeros_like(ur))
     p1 = dev.map(ur, np.ones_like(ur))
-    bends = np.stack([p0, p1], axis=1) if ur.size else np.zeros((0, 2, 2))
+    bends = _stack([p0, p1], axis=1) if ur.size else np.zeros((0, 2, 2))
     uu = np.linspace(0.0, 1.0, 129)
     ruling_3d = surface.ruling_lengths(uu)
     ruling_flat = np.linalg.norm(dev.map(uu, np.ones_like(uu)) - dev.map(uu, np.zeros_like(uu)), axis=1)
