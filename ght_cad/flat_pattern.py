@@ -591,16 +591,18 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
 
 
 def _centroid(poly: np.ndarray) -> np.ndarray:
+    """Area centroid of a closed polyline (the label's place), the mean of its vertices when the
+    area vanishes or the centroid lies outside (a crescent)."""
     x, y = poly[:, 0], poly[:, 1]
     nxt = _next(poly)
     x1, y1 = nxt[:, 0], nxt[:, 1]
     cr = x * y1 - x1 * y
     a = 0.5 * cr.sum()
     if abs(a) < 1e-300:
-        return poly.mean(axis=0)
+        return np.array([x.mean(), y.mean()])
     c = np.array([(x + x1) @ cr, (y + y1) @ cr]) / (6 * a)
     if not _inside(c[None, :], [poly])[0]:
-        return poly.mean(axis=0)
+        return np.array([x.mean(), y.mean()])
     return c
 
 

@@ -79,7 +79,7 @@ class NurbsSurface:
         self.cw = cw  # (nu, nv, 4)
         w = cw[..., 3]
         #: the common weight when all weights are equal (a polynomial surface), else None
-        self.weight: float | None = float(w.flat[0]) if np.all(w == w.flat[0]) else None
+        self.weight: float | None = float(w.flat[0]) if (w == w.flat[0]).all() else None
         self._nets: dict[tuple[int, int], np.ndarray] | None = None  # built on first use (:attr:`nets`)
         self.patches: tuple[np.ndarray, ...] | None = None
         su, sv = _spans(self.U, self.pu), _spans(self.V, self.pv)
@@ -95,7 +95,7 @@ class NurbsSurface:
             self.patches = (self.U[su], cu, hu, self.V[sv], cv, hv,
                             np.ascontiguousarray(pt.reshape(su.size * sv.size, -1)))
             #: the patches as a (u-span, e) x (v-span, f, k) matrix (:meth:`_patch_hom`)
-            self.patches_u = np.ascontiguousarray(np.moveaxis(pt, 2, 1).reshape(su.size * (self.pu + 1), -1))
+            self.patches_u = np.ascontiguousarray(pt.transpose(0, 2, 1, 3, 4).reshape(su.size * (self.pu + 1), -1))
             if su.size == 1 and sv.size == 1 and self.weight is not None:
                 #: one polynomial patch: ``S = Σ_ef T_e(x) T_f(y) Q_ef`` with ``Q = P / w`` as an
                 #: ((e, f), xyz) matrix, and the patch's centre and half-widths (:meth:`_poly_patch`)

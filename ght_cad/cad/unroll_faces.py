@@ -58,6 +58,7 @@ from .. import face_unroll as _core
 from ..errors import GHTError
 from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
 from ..flat_pattern import FlatPattern
+from .._vec import stack as _stack
 from ..nurbs import NurbsCurve, NurbsSurface
 from ..unroll import DEFAULT_TOL_DEG
 
@@ -174,16 +175,18 @@ class _SurfEval(SurfaceAdapter):
         derivatives come from the same data through the difference nets)."""
         uu, vv = self._probe()
         if self._nurbs is not None:
-            ours = self._nurbs.eval(uu, vv, 1)
             p, (du, dv) = self._p, self._v[:2]
             rows = []
             for u, v in zip(uu.tolist(), vv.tolist()):
                 self.ad.D1(u, v, p, du, dv)
                 rows.append(p.Coord() + du.Coord() + dv.Coord())
-            a = np.array(rows, dtype=float)
-            theirs = [a[:, 0:3], a[:, 3:6], a[:, 6:9]]
-        else:
-            ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
+            # (point, quantity, xyz): all three quantities compared at once, each to its own scale
+            theirs3 = np.array(rows, dtype=float).reshape(uu.size, 3, 3)
+            ours3 = _stack(self._nurbs.eval(uu, vv, 1), axis=1)
+            err = np.abs(ours3 - theirs3).transpose(1, 0, 2).reshape(3, -1).max(axis=1)
+            scale = np.maximum(np.abs(theirs3).transpose(1, 0, 2).reshape(3, -1).max(axis=1), max(1.0, self.radius))
+            return bool((err <= 1e-12 * scale).all())
+        ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
         for a, b in zip(ours, theirs):
             scale = max(1.0, float(np.abs(b).max()), self.radius)
             if not float(np.abs(a - b).max()) <= 1e-12 * scale:
@@ -392,17 +395,13 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
     formula disagrees with the adaptor's ``Value`` by more than 1e-12 of the curve's size at two
     parameters."""
     kind = c.GetType()
-    if kind == GeomAbs_Line:
+    if kind == GeomAbs_Line:  # gp_Lin(2d)'s parametrization P + p D is its definition: nothing to check
         lin = c.Line()
-        Pc, Dc = lin.Location().Coord(), lin.Direction().Coord()
-        P, D = np.array(Pc), np.array(Dc)
+        P, D = np.array(lin.Location().Coord()), np.array(lin.Direction().Coord())
 
         def f(p: np.ndarray) -> np.ndarray:
             return P + p[:, None] * D
-
-        def f1(x: float) -> list[float]:  # the same formula at one parameter, in plain floats
-            return [a + x * b for a, b in zip(Pc, Dc)]
-        scale = max(1.0, *(abs(x) for x in Pc))
+        return f
     elif kind == GeomAbs_Circle:
         circ = c.Circle()
         ax = circ.Position()
