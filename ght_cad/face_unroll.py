@@ -204,7 +204,8 @@ class FaceRuledSurface(RuledSurface):
         if hit is not None and hit[0] >= order:
             return hit[1]
         tt = np.concatenate([t, t])
-        ss = np.concatenate([np.zeros(t.size), np.ones(t.size)])
+        ss = np.zeros(2 * t.size)
+        ss[t.size:] = 1.0
         u, v = self.uv(tt, ss)
         jet = surface_jet(self.ev, u, v, order)
         if len(self._jets) >= 8:
@@ -236,10 +237,10 @@ class FaceRuledSurface(RuledSurface):
         m = tu.size
         ue, ve = self.uv(np.concatenate([tu, tu]), np.concatenate([np.zeros(m), np.ones(m)]))
         n = np.size(u)
-        p = self.ev.value(np.concatenate([np.ravel(u), ue]), np.concatenate([np.ravel(v), ve]))
+        p = self.ev.value(np.concatenate([np.asarray(u).ravel(), ue]), np.concatenate([np.asarray(v).ravel(), ve]))
         if len(self._jets) >= 8:
             self._jets.pop(next(iter(self._jets)))
-        inv = np.ravel(inv)
+        inv = inv.ravel()
         self._jets[key] = (0, [np.concatenate([p[n:n + m][inv], p[n + m:][inv]])])
         return p[:n]
 
@@ -491,7 +492,7 @@ def face_area(
         i = 0
         for _, _, uu, vv in parts if grid is not None else ():
             m = uu.size
-            if m and np.all(uu == uu[0]):  # an edge along v (u constant): its inner nodes are shared
+            if m and (uu == uu[0]).all():  # an edge along v (u constant): its inner nodes are shared
                 # (none on u = u_lo, where P = 0)
                 s_n, w_n = _inner_nodes_at(float(uu[0]), u_lo, u_breaks, u_span) if uu[0] != u_lo else (np.zeros(0),) * 2
                 if s_n.size:
@@ -755,7 +756,7 @@ class _MapBatch:
     def __init__(self, fmap: Callable[[np.ndarray, np.ndarray], np.ndarray],
                  requests: list[tuple[np.ndarray, np.ndarray]]) -> None:
         self.fmap = fmap
-        reqs = [tuple(np.ravel(x) for x in broadcast_uv(u, v)) for u, v in requests]
+        reqs = [tuple(x.ravel() for x in broadcast_uv(u, v)) for u, v in requests]
         reqs = [r for r in reqs if r[0].size]
         self.done: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         if reqs:
@@ -959,9 +960,9 @@ def unroll_face_data(
         def ends(t: np.ndarray) -> tuple[np.ndarray, ...]:
             if ruled_dir == "v":
                 uu = u0 + t * (u1 - u0)
-                return uu, np.full_like(t, v0), uu, np.full_like(t, v1)
+                return uu, np.full(t.shape, float(v0)), uu, np.full(t.shape, float(v1))
             vv = v0 + t * (v1 - v0)
-            return np.full_like(t, u0), vv, np.full_like(t, u1), vv
+            return np.full(t.shape, float(u0)), vv, np.full(t.shape, float(u1)), vv
 
         # one evaluation of the surface and one of the map for the ruling ends and the bend lines
         ua, va, ub, vb = ends(tt)

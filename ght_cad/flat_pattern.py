@@ -599,10 +599,10 @@ def _centroid(poly: np.ndarray) -> np.ndarray:
     cr = x * y1 - x1 * y
     a = 0.5 * cr.sum()
     if abs(a) < 1e-300:
-        return np.array([x.mean(), y.mean()])
+        return np.array([x.sum(), y.sum()]) / x.size
     c = np.array([(x + x1) @ cr, (y + y1) @ cr]) / (6 * a)
     if not _inside(c[None, :], [poly])[0]:
-        return np.array([x.mean(), y.mean()])
+        return np.array([x.sum(), y.sum()]) / x.size
     return c
 
 

@@ -62,6 +62,8 @@ _VI = np.polynomial.chebyshev.chebvander(_X, _N + 1)  # for evaluating integrate
 #: Chebyshev integration as a matrix: ``_INT @ c`` = ``chebint(c, lbnd=-1)`` (the integral from -1,
 #: degree N + 1), the same linear map without chebint's per-call overhead
 _INT = np.polynomial.chebyshev.chebint(np.eye(_N + 1), lbnd=-1, axis=0)  # (N+2, N+1)
+#: T_j(1) = 1 for the N + 2 terms of an integrated series: its value at a panel's right end
+_ONES = np.ones(_N + 2)
 
 
 #: the initial panel ends (4 equal panels; the surface's breakpoints are added)
@@ -177,7 +179,7 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
     g = surface.ruling(u)
     g1 = surface.ruling(u, 1)
     L = _norm(g)
-    if not np.all(L > 0):
+    if not (L > 0).all():
         i = int(np.argmin(L))
         raise DegenerateGeometryError(
             f"ruling length |b(u) - a(u)| = {L[i]:.3g} at u={u[i]:.6g}: the rulings must have positive length"
@@ -196,7 +198,7 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
         c = np.where(apex[:, None], _cross(b1, d), c)
         scale = np.where(apex, b1l, scale)
     cn = _norm(c)
-    if not np.all(cn > 1e-12 * np.maximum(scale, 1e-300)):
+    if not (cn > 1e-12 * np.maximum(scale, 1e-300)).all():
         i = int(np.argmin(cn / np.maximum(scale, 1e-300)))
         raise DegenerateGeometryError(
             f"the directrix is tangent to the ruling (|a' x d| = {cn[i]:.3g}) at u={u[i]:.6g}; "
@@ -256,11 +258,12 @@ class RuledDevelopment:
             c1 = _coefficients(stage1)
             # φ at the nodes: integrate w spectrally, panel offsets by cumulative sums
             cw = _chebint(c1[:, :, :1] * h[:, None, None])
-            tot_w = _einsum("pjm,j->pm", cw, np.ones(_N + 2))  # value at x = +1 (T_j(1) = 1)
+            tot_w = _einsum("pjm,j->pm", cw, _ONES)  # value at x = +1 (T_j(1) = 1)
             off_w = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1]
             phi = _einsum("kj,pjm->pkm", _VI, cw)[:, :, 0] + off_w[:, None]
-            D = _stack([np.cos(phi), np.sin(phi)], axis=-1)
-            Dp = _stack([-np.sin(phi), np.cos(phi)], axis=-1)
+            cphi, sphi = np.cos(phi), np.sin(phi)
+            D = _stack([cphi, sphi], axis=-1)
+            Dp = _stack([-sphi, cphi], axis=-1)
             Ap = stage1[:, :, 1:2] * D + stage1[:, :, 2:3] * Dp
             c2 = _coefficients(Ap)
             size = float(np.sum(np.abs(c1[:, 0, 1:]).max(axis=1) * 2 * h)) + float(fr["L"].max())
@@ -278,18 +281,17 @@ class RuledDevelopment:
         #: max over the final nodes of |d'·n| L (0 on a developable: d' lies in the tangent plane)
         self.normal_turning_max = float(np.max(np.abs(fr["wn"]) * fr["L"]))
         cA = _chebint(c2 * h[:, None, None])
-        totA = _einsum("pjm,j->pm", cA, np.ones(_N + 2))
+        totA = _einsum("pjm,j->pm", cA, _ONES)
         offA = np.concatenate([np.zeros((1, 2)), np.cumsum(totA, axis=0)])[:-1]
-        offw = np.concatenate([[0.0], np.cumsum(tot_w[:, 0])])[:-1][:, None]
+        offw = off_w[:, None]
         self._phi = _PanelSeries(edges, cw, offw)
         self._A = _PanelSeries(edges, cA, offA)
         #: φ and A as one series (columns φ, A_x, A_y): the map evaluates both at once
         self._phiA = _PanelSeries(edges, np.concatenate([cw, cA], axis=2), np.concatenate([offw, offA], axis=1))
         # rigid placement: a-edge chord along +x, bounding box at the origin (applied in .map)
-        self._R = np.eye(2)
         self._t = np.zeros(2)
         chord = totA.sum(axis=0)  # A(1) - A(0): the panels' integrals (A(0) = 0)
-        if np.linalg.norm(chord) > 1e-9 * max(size, 1e-300):
+        if math.hypot(chord[0], chord[1]) > 1e-9 * max(size, 1e-300):
             ang = -math.atan2(chord[1], chord[0])
         else:
             ang = math.pi / 2 - float(self._phi(np.array([0.0]))[0, 0])
