@@ -42,7 +42,9 @@ from ._vec import stack as _stack
 from ._vec import unique_inverse
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _point_in_polygon, _unit_samples, measure_panel
 from .ruled import RuledSurface
-from .unroll import DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, metric_angles, metric_stencil
+from .ruled import _theta_parameters
+from .unroll import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes, metric_angles,
+                     metric_stencil)
 
 __all__ = [
     "SurfaceAdapter",
@@ -197,8 +199,9 @@ class FaceRuledSurface(RuledSurface):
 
     def _jet(self, t: np.ndarray, order: int) -> list[np.ndarray]:
         """Jets of the surface at both boundaries ``(t, s0)`` and ``(t, s1)`` stacked (2n points), one
-        surface evaluation per parameter array (kept for the last 8 arrays: the quadrature and the
-        developability ask for a, a', b, b' at the same parameters)."""
+        surface evaluation per parameter array (kept for the last 16 arrays: the quadrature and the
+        developability ask for a, a', b, b' at the same parameters; :meth:`prefetch` evaluates
+        several arrays at once)."""
         key = t.tobytes()
         hit = self._jets.get(key)
         if hit is not None and hit[0] >= order:
@@ -208,10 +211,50 @@ class FaceRuledSurface(RuledSurface):
         ss[t.size:] = 1.0
         u, v = self.uv(tt, ss)
         jet = surface_jet(self.ev, u, v, order)
-        if len(self._jets) >= 8:
+        self._keep(key, order, jet)
+        return jet
+
+    def _keep(self, key: bytes, order: int, jet: list[np.ndarray]) -> None:
+        """Remember the boundary jet of one parameter array (the last 16 arrays are kept)."""
+        if key not in self._jets and len(self._jets) >= 16:
             self._jets.pop(next(iter(self._jets)))
         self._jets[key] = (order, jet)
-        return jet
+
+    def prefetch(self, arrays: Sequence[np.ndarray], order: int,
+                 extra: tuple[np.ndarray, np.ndarray] | None = None) -> list[np.ndarray] | None:
+        """The boundary jets (:meth:`_jet`) of several parameter arrays in one surface evaluation,
+        each kept as :meth:`_jet` keeps one (the per-evaluation overhead of a surface, ~25 µs for a
+        B-spline, paid once: the developability's, the quadrature's first and the ruling ends'
+        parameters are known before any of them is asked for); ``extra``: (u, v) points whose
+        jet is evaluated in the same call and returned (the metric grid's partials).
+
+        The points of each array are ``uv(t, 0)`` then ``uv(t, 1)``, the same numbers as
+        :meth:`_jet` makes, so each array's jet is a contiguous slice of the result."""
+        todo = []
+        for t in arrays:
+            t = _flat1(t)
+            hit = self._jets.get(t.tobytes())
+            if t.size and not (hit is not None and hit[0] >= order):
+                todo.append(t)
+        us, vs = [], []
+        for t in todo:
+            ss = np.zeros(2 * t.size)
+            ss[t.size:] = 1.0
+            u, v = self.uv(np.concatenate([t, t]), ss)
+            us.append(u)
+            vs.append(v)
+        if extra is not None:
+            us.append(np.asarray(extra[0], dtype=float).ravel())
+            vs.append(np.asarray(extra[1], dtype=float).ravel())
+        if not us:
+            return None
+        jet = surface_jet(self.ev, np.concatenate(us), np.concatenate(vs), order)
+        i = 0
+        for t in todo:
+            m = 2 * t.size
+            self._keep(t.tobytes(), order, [d[i:i + m] for d in jet])
+            i += m
+        return [d[i:] for d in jet] if extra is not None else None
 
     def uv(self, t: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Face parameters of ruled parameters (t, s) ∈ [0, 1]²."""
@@ -238,10 +281,8 @@ class FaceRuledSurface(RuledSurface):
         ue, ve = self.uv(np.concatenate([tu, tu]), np.concatenate([np.zeros(m), np.ones(m)]))
         n = np.size(u)
         p = self.ev.value(np.concatenate([np.asarray(u).ravel(), ue]), np.concatenate([np.asarray(v).ravel(), ve]))
-        if len(self._jets) >= 8:
-            self._jets.pop(next(iter(self._jets)))
         inv = inv.ravel()
-        self._jets[key] = (0, [np.concatenate([p[n:n + m][inv], p[n + m:][inv]])])
+        self._keep(key, 0, [np.concatenate([p[n:n + m][inv], p[n + m:][inv]])])
         return p[:n]
 
     def _edge(self, t: Any, s: float, derivative: int) -> np.ndarray:
@@ -740,11 +781,13 @@ def _metric_grid(bounds: Bounds) -> tuple[np.ndarray, np.ndarray, float, float]:
 
 
 def _metric(ev: SurfaceAdapter, fmap: Callable, bounds: Bounds,
-            grid: tuple[np.ndarray, np.ndarray, float, float] | None = None) -> dict[str, np.ndarray]:
+            grid: tuple[np.ndarray, np.ndarray, float, float] | None = None,
+            d1: list[np.ndarray] | None = None) -> dict[str, np.ndarray]:
     """Angles between S_u, S_v and F_u, F_v on a 12 x 5 grid (:func:`ght_cad.unroll.metric_angles`;
-    ``grid``: :func:`_metric_grid` of ``bounds`` when already made)."""
+    ``grid``: :func:`_metric_grid` of ``bounds`` when already made; ``d1``: ``[S_u, S_v]`` there
+    when already evaluated)."""
     U, V, hu, hv = grid if grid is not None else _metric_grid(bounds)
-    d = ev.d1(U, V)
+    d = ev.d1(U, V) if d1 is None else d1
     return metric_angles(d[0], d[1], fmap, U, V, hu, hv)
 
 
@@ -872,6 +915,9 @@ def unroll_face_data(
         fsheet = FaceSheet(face, sheet, label)
         ev = fsheet.neutral
     ruled_dir: str | None
+    rs: FaceRuledSurface | None = None
+    mgrid: tuple[np.ndarray, np.ndarray, float, float] | None = None
+    metric_jet: list[np.ndarray] | None = None
     if kind == "plane":
         dmap: Any = ClosedFormMap("plane")
         ruled_dir = None
@@ -904,6 +950,11 @@ def unroll_face_data(
             ruled_dir = best_effort_direction(straight, label)
         info["ruling_direction"] = ruled_dir
         rs = FaceRuledSurface(ev, ruled_dir, bounds)
+        # one surface evaluation for the boundary jets the developability, the quadrature's first
+        # panels and the ruling ends ask for, and for the metric grid's partials
+        mgrid = _metric_grid(bounds)
+        metric_jet = rs.prefetch([_theta_parameters(64, 257), first_nodes(rs.breakpoints), _unit_samples(129)], 1,
+                                 extra=mgrid[:2])
         dd = _check_developable(rs, tol_deg, best_effort, f"face {label!r}")
         info["developability"] = dd.as_dict()
         dev = RuledDevelopment(rs, breakpoints=rs.breakpoints, place=False)  # the panel is placed below
@@ -964,14 +1015,20 @@ def unroll_face_data(
             vv = v0 + t * (v1 - v0)
             return np.full(t.shape, float(u0)), vv, np.full(t.shape, float(u1)), vv
 
-        # one evaluation of the surface and one of the map for the ruling ends and the bend lines
+        # the ruling ends' 3-D lengths from the prefetched boundary jets; one evaluation of the map
+        # for the ruling ends and the bend lines
         ua, va, ub, vb = ends(tt)
         n = tt.size
-        p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
-        g3 = _norm(p3[:n] - p3[n:])
+        if rs is not None:
+            g3 = rs.ruling_lengths(tt)
+        else:  # a cylinder or cone (closed form): one evaluation of the ruling ends
+            p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
+            g3 = _norm(p3[:n] - p3[n:])
+    if mgrid is None:
+        mgrid = _metric_grid(bounds)
     # the map's points in one call (it is pointwise; its per-call overhead dominated): the
     # edges' outline samples, the ruling ends and bend lines, the metric's stencil
-    mU, mV, mhu, mhv = _metric_grid(bounds)
+    mU, mV, mhu, mhv = mgrid
     sampled, ts, edge_uv = _edge_sample_uv(loops, loops_uv, samples)
     clipped = None
     if ruled_dir is not None:
@@ -1011,7 +1068,7 @@ def unroll_face_data(
         ruling_lengths_3d=g3,
         ruling_lengths_flat=gf,
         area_3d=area_3d,
-        metric=_metric(ev, fmap, bounds, (mU, mV, mhu, mhv)),
+        metric=_metric(ev, fmap, bounds, mgrid, None if metric_jet is None else metric_jet[1:3]),
         info=info,
         development=dmap,
     )

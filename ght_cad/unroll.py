@@ -219,6 +219,26 @@ def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
     }
 
 
+def _initial_edges(breakpoints: Sequence[float]) -> np.ndarray:
+    """:class:`RuledDevelopment`'s first panel ends: 4 equal panels, cut at the breakpoints in (0, 1)."""
+    bp = [b for b in breakpoints if 1e-12 < b < 1 - 1e-12]
+    return np.unique(np.concatenate([_EDGES0, bp])) if bp else _EDGES0.copy()
+
+
+def _panel_nodes(edges: np.ndarray) -> np.ndarray:
+    """The Chebyshev nodes of the panels between ``edges``, panel by panel (P (N+1) values)."""
+    lo, hi = edges[:-1], edges[1:]
+    h = 0.5 * (hi - lo)
+    return ((0.5 * (lo + hi))[:, None] + h[:, None] * _X[None, :]).ravel()
+
+
+def first_nodes(breakpoints: Sequence[float] = ()) -> np.ndarray:
+    """The parameters where :class:`RuledDevelopment` with these ``breakpoints`` first evaluates
+    its surface (a caller evaluating boundary jets ahead, :meth:`ght_cad.face_unroll.
+    FaceRuledSurface.prefetch`, gives it these)."""
+    return _panel_nodes(_initial_edges(breakpoints))
+
+
 class RuledDevelopment:
     r"""The development map ``Y(u, v) = A(u) + v L(u) D(u)`` of a ruled surface (see module doc).
 
@@ -246,14 +266,12 @@ class RuledDevelopment:
         place: bool = True,
     ) -> None:
         self.surface = surface
-        bp = [b for b in breakpoints if 1e-12 < b < 1 - 1e-12]
-        edges = np.unique(np.concatenate([_EDGES0, bp])) if bp else _EDGES0.copy()
+        edges = _initial_edges(breakpoints)
         for _ in range(40):
             P = edges.size - 1
             lo, hi = edges[:-1], edges[1:]
             h = 0.5 * (hi - lo)
-            uu = (0.5 * (lo + hi))[:, None] + h[:, None] * _X[None, :]
-            fr = _frame(surface, uu.ravel())
+            fr = _frame(surface, _panel_nodes(edges))
             stage1 = _stack([fr["w"], fr["p"], fr["q"]], axis=-1).reshape(P, _N + 1, 3)
             c1 = _coefficients(stage1)
             # φ at the nodes: integrate w spectrally, panel offsets by cumulative sums
