@@ -296,6 +296,17 @@ class FaceRuledSurface(RuledSurface):
         k = (1 if self.ruled == "v" else 2) if derivative == 1 else (3 if self.ruled == "v" else 4)
         return d[k][part] * (self.t1 - self.t0) ** derivative
 
+    def edge_jets(self, u: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(a', g, g')`` (:meth:`RuledSurface.edge_jets`) from one kept jet (:meth:`_jet`, order 1):
+        the same numbers as :meth:`a` and :meth:`ruling` give."""
+        t = _flat1(u)
+        d = self._jet(t, 1)
+        n = t.size
+        k = 1 if self.ruled == "v" else 2
+        s = self.t1 - self.t0
+        a1, b1 = d[k][:n] * s, d[k][n:] * s
+        return a1, d[0][n:] - d[0][:n], b1 - a1
+
     def a(self, u: Any, derivative: int = 0) -> np.ndarray:
         return self._edge(u, 0.0, derivative)
 

@@ -194,6 +194,13 @@ class RuledSurface(ABC):
         """Ruling vector ``g^(r)(u) = b^(r)(u) - a^(r)(u)`` (not normalized)."""
         return self.b(u, derivative) - self.a(u, derivative)
 
+    def edge_jets(self, u: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(a', g, g')`` at ``u``, each (n, 3), by :meth:`a` and :meth:`ruling` (whose override,
+        e.g. a loft's cancellation-free ruling near a pointed end, is kept): what the development
+        and the developability ask for, in one call (a face's adapter serves them from one kept
+        surface jet)."""
+        return self.a(u, 1), self.ruling(u), self.ruling(u, 1)
+
     def evaluate(self, u: Any, v: Any) -> np.ndarray:
         """Points ``X(u, v) = (1-v) a(u) + v b(u)``; u and v broadcast to a common 1-D shape."""
         uu, us = as_parameter_array(u, "u")
@@ -270,7 +277,7 @@ class RuledSurface(ABC):
         # boundary jets are kept per parameter array) and one of θ serve the integrals, θ_max and
         # the residual
         n = t.size
-        a1, g = self.a(uu, 1), self.ruling(uu)
+        a1, g, _ = self.edge_jets(uu)
         b1 = self.b(uu, 1)
         th, dot = _theta(a1, b1, g)
         _, theta_rms, dd, R = _integrals(th[:n], dot[:n], w)

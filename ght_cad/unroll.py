@@ -175,9 +175,7 @@ class _PanelSeries:
 
 def _frame(surface: RuledSurface, u: np.ndarray) -> dict[str, np.ndarray]:
     """Ruling frame quantities at ``u``: L, L', d, e, n, p = a'·d, q = a'·e, w = d'·e, normal part."""
-    a1 = surface.a(u, 1)
-    g = surface.ruling(u)
-    g1 = surface.ruling(u, 1)
+    a1, g, g1 = surface.edge_jets(u)
     L = _norm(g)
     if not (L > 0).all():
         i = int(np.argmin(L))
