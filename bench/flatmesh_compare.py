@@ -13,7 +13,7 @@ Gauss–Legendre quadrature (``ght_cad.cad.unroll_faces.face_area``).
 
 Times: ours = ``unroll(face)`` (including the distortion report); FreeCAD = meshing and
 unwrapping measured inside the FreeCAD process. FreeCAD runs as a persistent process driven by
-the bench, and blocks of calls alternate: each of ``GHT_BENCH_ROUNDS`` rounds (default 4) gives
+the bench, and blocks of calls alternate: each of ``GHT_BENCH_ROUNDS`` rounds (default 6) gives
 every face ``GHT_BENCH_REPS`` calls (default 5) on one side, then as many on the other (who goes
 first alternates by round). Both sides are so timed on the same machine state, each warm: this
 VM's single-core speed drifts by +-30 % within a minute, which two processes timed one after the
@@ -22,7 +22,8 @@ cost (measured: ours 4.35 ms against 2.9 ms in a block). A side's time is its fa
 all rounds; ``median`` is the median over the rounds of (our fastest / flatmesh's fastest).
 
 Run: ``.venv/bin/python bench/flatmesh_compare.py [--deflection 1e-3]``. Environment:
-``GHT_BENCH_ROUNDS``, ``GHT_BENCH_REPS`` as above; ``GHT_BENCH_TRACE=1`` prints every round's
+``GHT_BENCH_ROUNDS``, ``GHT_BENCH_REPS`` as above; ``GHT_BENCH_CPU`` one CPU both processes are
+pinned to (default -1: not pinned); ``GHT_BENCH_TRACE=1`` prints every round's
 times to stderr.
 """
 
@@ -105,7 +106,9 @@ class FlatmeshServer:
         env = dict(os.environ, GHT_FLATMESH_JOB=str(job))
         self.timeout = timeout
         t0 = time.perf_counter()
+        cpu = _bench_cpu()
         self.proc = subprocess.Popen([freecadcmd, str(HERE / "flatmesh_fc.py")], env=env, cwd=str(work), text=True,
+                                     preexec_fn=(lambda: os.sched_setaffinity(0, {cpu})) if cpu is not None else None,
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self._read()  # {"ready": [...]}
         self.startup = time.perf_counter() - t0
@@ -156,9 +159,20 @@ def _reps() -> int:
     return max(1, int(os.environ.get("GHT_BENCH_REPS", "5")))
 
 
+def _bench_cpu() -> int | None:
+    """The one CPU both sides are pinned to (``GHT_BENCH_CPU``; default -1: not pinned). The calls
+    alternate, so one core can serve both in turn; measured on this VM: pinned, ours is 5-10 %
+    slower (the other process's block evicts our caches between blocks: the tangent face 2.54 ms
+    against 2.31-2.42 unpinned, flatmesh unchanged), so the default leaves each process on the core
+    the scheduler keeps it on."""
+    allowed = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+    want = int(os.environ.get("GHT_BENCH_CPU", "-1"))
+    return want if want >= 0 and want in allowed else None
+
+
 def _rounds() -> int:
-    """Alternating rounds (``GHT_BENCH_ROUNDS``, default 4)."""
-    return max(1, int(os.environ.get("GHT_BENCH_ROUNDS", "4")))
+    """Alternating rounds (``GHT_BENCH_ROUNDS``, default 6)."""
+    return max(1, int(os.environ.get("GHT_BENCH_ROUNDS", "6")))
 
 
 def ours_call(face: Any, count: int = 1) -> tuple[float, Any]:
@@ -282,9 +296,13 @@ def main(argv: list[str] | None = None) -> int:
     if exe is None:
         print("freecadcmd not found: install Debian's freecad-python3", file=sys.stderr)
         return 2
+    cpu = _bench_cpu()
+    if cpu is not None:  # this process and FreeCAD's (pinned at its start) on the same core
+        os.sched_setaffinity(0, {cpu})
     faces = default_faces()
     print(f"relative errors against the exact face (boundary length, area); times in milliseconds, the fastest of "
-          f"{_reps()} alternating calls per face on each side; load average {os.getloadavg()[0]:.1f}")
+          f"{_reps()} alternating calls per face on each side, {_rounds()} rounds, both on "
+          f"{'CPU ' + str(cpu) if cpu is not None else 'any CPU'}; load average {os.getloadavg()[0]:.1f}")
     hdr = (f"{'face':22s} {'defl':>7s} | {'ours err':>9s} {'ours ms':>7s} | {'fm err':>9s} {'fm intr':>9s} "
            f"{'fm edge':>9s} {'nodes':>6s} {'fm ms':>7s} | {'err ratio':>9s} {'t ratio':>7s} {'ours/fm':>7s} {'median':>7s}")
     print(hdr)
