@@ -37,6 +37,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ._vec import cross as _cross
 from ._vec import norm as _norm
 from ._vec import stack as _stack
 from ._vec import unique_inverse
@@ -86,9 +87,13 @@ class SurfaceAdapter:
             (v1 - v0) (S(u, v1) - S(u, v0))`` (rulings along v; u likewise): an extrusion, a
             degree-1 B-spline/Bézier with equal weights across. Then a point's ruling parameter is
             its own (v - v0) / (v1 - v0) and the map needs no projection onto the ruling.
+        fast_density_grid: :meth:`density_grid` (when the adapter has one) costs far less a point
+            on a tensor grid than the partials at scattered points (a B-spline read into the core):
+            :func:`face_area` then integrates whole knot pieces on grids.
     """
 
     kind: str = "other"
+    fast_density_grid: bool = False
     radius: float = 0.0
     semi_angle: float = 0.0
     ruled_hint: str | None = None
@@ -554,10 +559,10 @@ def face_area(
             i += m
         if general.any():
             ug, vg = u[general], v[general]
-            s_all, v_all, w_all, own = _inner_nodes(ug, vg, u_lo, u_breaks, u_span, xg, wg)
-            d = ev.d1(s_all, v_all)
-            f = np.linalg.norm(np.cross(d[0], d[1]), axis=1)
-            P[general] = np.bincount(own, weights=f * w_all, minlength=ug.size)
+            if grid is not None and getattr(ev, "fast_density_grid", False):
+                P[general] = _inner_integrals_by_pieces(ev, ug, vg, u_lo, u_breaks, u_span)
+            else:
+                P[general] = _inner_integrals(ev, ug, vg, u_lo, u_breaks, u_span)
     i = 0
     for k, wdv, uu, _ in parts:
         totals[k] += float(np.sum(P[i:i + uu.size] * wdv))
@@ -612,7 +617,62 @@ def _inner_nodes_at(u: float, u_lo: float, u_breaks: np.ndarray, u_span: float |
     return ((A + h)[:, None] + h[:, None] * xg[None, :]).ravel(), (sign * h[:, None] * wg[None, :]).ravel()
 
 
-def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: float, u_breaks: np.ndarray, u_span: float | None,
+def _inner_integrals(ev: SurfaceAdapter, u: np.ndarray, v: np.ndarray, u_lo: Any, u_breaks: np.ndarray,
+                     u_span: float | None) -> np.ndarray:
+    """``P(u_i, v_i) = ∫_{u_lo}^{u_i} |S_u × S_v|(s, v_i) ds`` point by point (:func:`_inner_nodes`,
+    one evaluation of the partials at all nodes)."""
+    xg, wg = _gauss12()
+    s_all, v_all, w_all, own = _inner_nodes(u, v, u_lo, u_breaks, u_span, xg, wg)
+    if not s_all.size:
+        return np.zeros(u.size)
+    d = ev.d1(s_all, v_all)
+    f = _norm(_cross(d[0], d[1]))
+    return np.bincount(own, weights=f * w_all, minlength=u.size)
+
+
+def _inner_integrals_by_pieces(ev: SurfaceAdapter, u: np.ndarray, v: np.ndarray, u_lo: float,
+                               u_breaks: np.ndarray, u_span: float | None) -> np.ndarray:
+    r""":func:`_inner_integrals` with the same panels, the whole pieces on a grid.
+
+    For ``u_i >= u_lo`` the interval ``[u_lo, u_i]`` cut at the breaks is ``[K_0, K_1], ...,
+    [K_{m_i}, u_i]`` with ``K_0 = u_lo`` and ``K_1 < K_2 < ...`` the breaks: every piece but the
+    last is the same for all points below which it lies, so its nodes ``s_j`` (the same halves and
+    panels) serve all points on one tensor grid ``|S_u × S_v|(s_j, v_i)`` (``ev.density_grid``:
+    each basis series once per s and once per v, about 10x cheaper a point than the partials at
+    scattered points), ``P_i = Σ_{j < m_i} Σ w_j f(s_j, v_i) + ∫_{K_{m_i}}^{u_i}``, the last piece point
+    by point. Points with ``u_i < u_lo`` go point by point. A trimmed B-spline loft face of 5
+    spans: 112,000 scattered partials (48 ms an unroll) became a grid and 12 nodes a point."""
+    out = np.empty(u.size)
+    below = u < u_lo
+    if below.any():
+        out[below] = _inner_integrals(ev, u[below], v[below], u_lo, u_breaks, u_span)
+    up = ~below
+    if not up.any():
+        return out
+    uu, vv = u[up], v[up]
+    br = np.unique(np.asarray(u_breaks, dtype=float))
+    br = br[(br > u_lo) & (br < float(uu.max()))]
+    K = np.concatenate([[float(u_lo)], br])
+    m = np.searchsorted(br, uu, side="left")  # breaks strictly below u_i: the whole pieces
+    total = np.zeros(uu.size)
+    if br.size:
+        nodes = [_inner_nodes_at(float(K[j + 1]), float(K[j]), np.zeros(0), u_span) for j in range(br.size)]
+        s_all = np.concatenate([sn for sn, _ in nodes])
+        w_all = np.concatenate([wn for _, wn in nodes])
+        starts = np.cumsum([0] + [sn.size for sn, _ in nodes[:-1]])
+        step = max(1, int(2_000_000 // max(s_all.size, 1)))  # grid memory: at most ~16 MB at once
+        for a in range(0, uu.size, step):
+            sl = slice(a, a + step)
+            G = ev.density_grid(s_all, vv[sl])  # (nodes, points)
+            S = np.add.reduceat(G * w_all[:, None], starts, axis=0)  # (pieces, points)
+            C = np.concatenate([np.zeros((1, S.shape[1])), np.cumsum(S, axis=0)])
+            total[sl] = C[m[sl], np.arange(S.shape[1])]
+    last = _inner_integrals(ev, uu, vv, K[m], np.zeros(0), u_span)
+    out[up] = total + last
+    return out
+
+
+def _inner_nodes(u: np.ndarray, v: np.ndarray, u_lo: Any, u_breaks: np.ndarray, u_span: float | None,
                  xg: np.ndarray, wg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     r"""Gauss–Legendre nodes of ``P(u_i, v_i) = ∫_{u_lo}^{u_i} f(s, v_i) ds`` for all i at once.
 

@@ -272,6 +272,12 @@ class _SurfEval(SurfaceAdapter):
             return self._nurbs.eval(u, v, min(order, 2))
         return _core.surface_jet(self, u, v, order, own=False)
 
+    @property
+    def fast_density_grid(self) -> bool:
+        """:meth:`density_grid` works on the tensor grid (a B-spline read into the core), not point
+        by point: :func:`ght_cad.face_unroll.face_area` then puts whole pieces on grids."""
+        return self._ax is None and self._nurbs is not None and self._nurbs.patches is not None
+
     def density_grid(self, s: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``|S_u × S_v|`` at every (s_i, v_j), shape (len(s), len(v)) (a B-spline: each basis
         series evaluated once per s and once per v)."""
