@@ -92,6 +92,19 @@ def _clenshaw(c: np.ndarray, x: np.ndarray) -> np.ndarray:
     return c[:, 0, :] + x[:, None] * b1 - b2
 
 
+def _cheb_rows_of(x: np.ndarray, m: int) -> np.ndarray:
+    """``T_j(x)`` for j < m, shape (m, len(x)), by ``T_{j+1} = 2x T_j - T_{j-1}`` along contiguous rows."""
+    T = np.empty((m, x.size))
+    T[0] = 1.0
+    if m > 1:
+        T[1] = x
+    x2 = 2.0 * x
+    for j in range(2, m):
+        np.multiply(x2, T[j - 1], out=T[j])
+        T[j] -= T[j - 2]
+    return T
+
+
 class _PanelSeries:
     """Piecewise Chebyshev series on panels ``edges`` (indefinite integrals or plain values)."""
 
@@ -114,14 +127,7 @@ class _PanelSeries:
         out = np.empty((u.size, self.coefs.shape[2]))
         if P <= 64 and u.size > 4 * P:
             # few panels: T_j(x) by the three-term recurrence, then one small product per panel
-            T = np.empty((self.coefs.shape[1], u.size))
-            T[0] = 1.0
-            if T.shape[0] > 1:
-                T[1] = x
-            x2 = 2.0 * x
-            for j in range(2, T.shape[0]):
-                np.multiply(x2, T[j - 1], out=T[j])
-                T[j] -= T[j - 2]
+            T = _cheb_rows_of(x, self.coefs.shape[1])
             order = np.argsort(idx, kind="stable")
             counts = np.bincount(idx, minlength=P)
             start = 0
@@ -155,14 +161,7 @@ class _PanelSeries:
                 xs -= hi
                 xs /= hi - lo
                 np.minimum(np.maximum(xs, -1.0, out=xs), 1.0, out=xs)
-        T = np.empty((self.coefs.shape[1], u.size))
-        T[0] = 1.0
-        if T.shape[0] > 1:
-            T[1] = x
-        x2 = 2.0 * x
-        for j in range(2, T.shape[0]):
-            np.multiply(x2, T[j - 1], out=T[j])
-            T[j] -= T[j - 2]
+        T = _cheb_rows_of(x, self.coefs.shape[1])
         out = np.empty((u.size, self.coefs.shape[2]))
         for p in range(P):
             s, e = bounds[p], bounds[p + 1]

@@ -45,6 +45,18 @@ def _params(U: np.ndarray, p: int, rng: np.random.Generator, n: int) -> np.ndarr
     return np.r_[a, b, inner, rng.uniform(a, b, n)]
 
 
+def _random_surface(rng: np.random.Generator, pu: int, pv: int, su: int, sv: int, rational: bool
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, NurbsSurface]:
+    """Random knots (su, sv spans), poles in [-50, 50]^3 and weights in [0.5, 2] (rational):
+    ``(U, V, P, w, surface)``."""
+    _, _, U = _knots(rng, pu, su)
+    _, _, V = _knots(rng, pv, sv)
+    nu, nv = U.size - pu - 1, V.size - pv - 1
+    P = rng.uniform(-50, 50, (nu, nv, 3))
+    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
+    return U, V, P, w, NurbsSurface.from_poles(U, V, pu, pv, P, w)
+
+
 def _check(ours: np.ndarray, ref: np.ndarray, what: str) -> None:
     scale = max(1.0, float(np.abs(ref).max()))
     err = float(np.abs(ours - ref).max())
@@ -97,12 +109,8 @@ def _surface_ref(U, V, pu, pv, P, w, u, v):
        sv=st.integers(1, 3), rational=st.booleans())
 def test_surface_matches_scipy(seed: int, pu: int, pv: int, su: int, sv: int, rational: bool) -> None:
     rng = np.random.default_rng(seed)
-    _, _, U = _knots(rng, pu, su)
-    _, _, V = _knots(rng, pv, sv)
-    nu, nv = U.size - pu - 1, V.size - pv - 1
-    P = rng.uniform(-50, 50, (nu, nv, 3))
-    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
-    s = NurbsSurface.from_poles(U, V, pu, pv, P, w)
+    U, V, P, w, s = _random_surface(rng, pu, pv, su, sv, rational)
+    nu, nv = P.shape[:2]
     u, v = _params(U, pu, rng, 30), _params(V, pv, rng, 30)
     m = min(u.size, v.size)
     u, v = u[:m], v[:m]
@@ -185,12 +193,8 @@ def test_face_area_inner_integrals_by_pieces(seed: int, pu: int, pv: int, su: in
     from ght_cad.face_unroll import _inner_integrals, _inner_integrals_by_pieces
 
     rng = np.random.default_rng(seed)
-    _, _, U = _knots(rng, pu, su)
-    _, _, V = _knots(rng, pv, sv)
-    nu, nv = U.size - pu - 1, V.size - pv - 1
-    P = rng.uniform(-50, 50, (nu, nv, 3))
-    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
-    ad = _NurbsAdapter(NurbsSurface.from_poles(U, V, pu, pv, P, w))
+    U, V, _, _, surface = _random_surface(rng, pu, pv, su, sv, rational)
+    ad = _NurbsAdapter(surface)
     a, b = U[pu], U[-pu - 1]
     breaks = np.unique(U[(U > a) & (U < b)])
     u_lo = a if rng.random() < 0.7 else float(rng.uniform(a, b))  # the face's u0, or inside (points below it)
