@@ -398,6 +398,43 @@ def test_batch_sweep(tmp_path):
     assert not (tmp_path / "run").exists()
 
 
+def test_batch_sweep_of_a_plated_two_surface_design(tmp_path):
+    """A ``[sweep]`` over the sheet of a plated design with several surfaces (the skiff of
+    examples/design_skiff_plated.toml: bottom and a side panel pointed at the bow, one [sheet]),
+    run by ``ght-cad batch`` in two processes: the common thickness and the side panel's own
+    (``surfaces.1.sheet.thickness``) in a grid; every variant's plates are valid with volumes
+    within 1e-6 of their closed form, its pattern exact (errors max <= 1e-12), the swept
+    thickness is the one each plate has, and the neutral patterns' areas change with it."""
+    base = (Path(__file__).resolve().parents[1] / "examples" / "design_skiff_plated.toml").read_text()
+    base = base.replace('figures = ["surface", "flat_pattern"]', "figures = []")
+    # the side panel's own sheet (what "surfaces.1.sheet.thickness" sweeps: a key the design has)
+    base = base.replace('curve_a = "chine"\ncurve_b = "sheer"\n', 'curve_a = "chine"\ncurve_b = "sheer"\nsheet = { thickness = 6 }\n')
+    assert "sheet = { thickness = 6 }" in base
+    text = base + '\n[sweep]\n"sheet.thickness" = [4, 6]\n"surfaces.1.sheet.thickness" = [3, 5]\nplot = ["area"]\n'
+    p = tmp_path / "skiff_sweep.toml"
+    p.write_text(text)
+    res = run_batch([p], tmp_path / "out", jobs=2, progress=False)
+    assert res.exit_code == 0, [r.get("error") for r in res.rows]
+    assert [r["name"] for r in res.rows] == [f"skiff-{i}" for i in range(1, 5)]
+    areas = {}
+    for r in res.rows:
+        assert r["status"] == "ok"
+        vals = r["sweep"]["values"]
+        rep = json.loads((tmp_path / "out" / r["name"] / "report.json").read_text())
+        assert rep["flat_pattern"]["errors"]["max"] <= 1e-12
+        plate = rep["plate"]
+        assert plate["valid"] and plate["solids"] == 2
+        assert abs(plate["volume"] / plate["volume_closed_form"] - 1.0) <= 1e-6
+        bottom, side = plate["surfaces"]
+        assert (bottom["surface"], side["surface"]) == ("bottom", "side")
+        assert bottom["thickness"] == vals["sheet.thickness"]
+        assert side["thickness"] == vals["surfaces.1.sheet.thickness"]
+        areas[(vals["sheet.thickness"], vals["surfaces.1.sheet.thickness"])] = r["area"]
+    assert len(set(areas.values())) == 4  # each thickness pair unrolls its own neutral surfaces
+    md = (tmp_path / "out" / "batch.md").read_text()
+    assert "## Sweep of skiff" in md and (tmp_path / "out" / "sweep-skiff.png").read_bytes()[:4] == b"\x89PNG"
+
+
 def test_sweep_expansion_grid_zip_and_errors():
     from ght_cad.sweep import SweepError, expand_sweep
 
