@@ -129,6 +129,45 @@ class SurfaceAdapter:
         return surface_jet(self, u, v, order, own=False)
 
 
+def analytic_jet(kind: str, frame: Sequence[np.ndarray], radius: float, semi_angle: float, u: Any, v: Any,
+                 order: int) -> list[np.ndarray]:
+    r"""``[S, S_u, S_v]`` (order <= 1) or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` of a plane, cylinder or
+    cone from its placement ``frame = (O, X, Y, Z)`` (origin and orthonormal axes, as OCCT's
+    ``gp_Ax3``), by OCCT's own parametrizations (``ElSLib``), shared by the CAD adapters:
+
+    * plane ``S = O + u X + v Y``;
+    * cylinder of radius R: ``S = O + R (cos u X + sin u Y) + v Z``;
+    * cone of reference radius R and semi-angle α: ``S = O + (R + v sin α)(cos u X + sin u Y) + v cos α Z``.
+
+    Raises:
+        GHTError: another ``kind``.
+    """
+    O, X, Y, Z = frame
+    u = np.asarray(u, dtype=float).reshape(-1, 1)
+    v = np.asarray(v, dtype=float).reshape(-1, 1)
+    if kind == "plane":
+        zero = np.zeros((u.shape[0], 3))
+        out = [O + u * X + v * Y, np.broadcast_to(X, zero.shape).copy(), np.broadcast_to(Y, zero.shape).copy()]
+        return out + [zero, zero.copy(), zero.copy()] if order >= 2 else out
+    if kind not in ("cylinder", "cone"):
+        raise GHTError(f"kind={kind!r} has no closed-form evaluation; allowed 'plane', 'cylinder', 'cone'")
+    c, s = np.cos(u), np.sin(u)
+    radial = c * X + s * Y
+    tangent = -s * X + c * Y
+    if kind == "cylinder":
+        R = radius
+        out = [O + R * radial + v * Z, R * tangent, np.broadcast_to(Z, radial.shape).copy()]
+        if order >= 2:
+            out += [-R * radial, np.zeros_like(radial), np.zeros_like(radial)]
+        return out
+    sa, ca = math.sin(semi_angle), math.cos(semi_angle)
+    r = radius + v * sa
+    out = [O + r * radial + (v * ca) * Z, r * tangent, sa * radial + ca * Z]
+    if order >= 2:
+        out += [-r * radial, np.zeros_like(radial), sa * tangent]
+    return out
+
+
 def surface_jet(ev: Any, u: np.ndarray, v: np.ndarray, order: int, own: bool = True) -> list[np.ndarray]:
     """``ev.jet(u, v, order)`` when the adapter has one (``own``), else from ``value``/``d1``/``d2``
     (adapters that are not :class:`SurfaceAdapter` subclasses, e.g. a sheet's offset surface)."""

@@ -1,7 +1,7 @@
 """The FreeCAD adapter reads B-spline surfaces and curves into the core NURBS evaluator
 (``freecadcmd -t freecad.ght_workbench.tests.fc_nurbs``: paths taken, jet/density_grid vs
 FreeCAD's getDN to 1e-12, the old point-by-point path, periodic and disagreeing surfaces fall back
-to FreeCAD), and its flat outlines equal the OCP adapter's on the same faces (BREP files the
+to FreeCAD; planes, cylinders and cones by the core's closed forms), and its flat outlines equal the OCP adapter's on the same faces (BREP files the
 FreeCAD run wrote) to 1e-12 of the pattern's size."""
 
 from __future__ import annotations
@@ -21,8 +21,9 @@ CASES = ("rational_cylinder", "drilled_rational_cylinder", "tangent_dev_bspline"
 @pytest.fixture(scope="module")
 def fc_out(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("fc_nurbs")
-    text = run_fc_unittest("freecad.ght_workbench.tests.fc_nurbs", out, 7, timeout=300)
+    text = run_fc_unittest("freecad.ght_workbench.tests.fc_nurbs", out, 8, timeout=300)
     for name in ("test_rational_bspline_cylinder_reads_into_core", "test_periodic_bspline_surface_stays_on_freecad",
+                 "test_plane_cylinder_cone_evaluated_in_numpy",
                  "test_disagreeing_reading_falls_back_to_freecad", "test_flat_pattern_feature_uses_the_core_evaluator"):
         assert name in text, f"{name} did not run"
     return out

@@ -209,29 +209,9 @@ class _SurfEval(SurfaceAdapter):
         return self._nurbs.c0_knots(direction) if self._nurbs is not None else np.zeros(0)
 
     def _analytic(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
-        """[S, S_u, S_v, S_uu, S_vv, S_uv] (up to ``order``) of a plane, cylinder or cone."""
-        O, X, Y, Z = self._ax  # type: ignore[misc]
-        u = np.asarray(u, dtype=float)[:, None]
-        v = np.asarray(v, dtype=float)[:, None]
-        if self.kind == "plane":
-            zero = np.zeros((u.shape[0], 3))
-            out = [O + u * X + v * Y, np.broadcast_to(X, zero.shape).copy(), np.broadcast_to(Y, zero.shape).copy()]
-            return out + [zero, zero.copy(), zero.copy()] if order >= 2 else out
-        c, s = np.cos(u), np.sin(u)
-        radial = c * X + s * Y
-        tangent = -s * X + c * Y
-        if self.kind == "cylinder":
-            R = self.radius
-            out = [O + R * radial + v * Z, R * tangent, np.broadcast_to(Z, radial.shape).copy()]
-            if order >= 2:
-                out += [-R * radial, np.zeros_like(radial), np.zeros_like(radial)]
-            return out
-        sa, ca = math.sin(self.semi_angle), math.cos(self.semi_angle)
-        r = self.radius + v * sa
-        out = [O + r * radial + (v * ca) * Z, r * tangent, sa * radial + ca * Z]
-        if order >= 2:
-            out += [-r * radial, np.zeros_like(radial), sa * tangent]
-        return out
+        """[S, S_u, S_v, S_uu, S_vv, S_uv] (up to ``order``) of a plane, cylinder or cone
+        (:func:`ght_cad.face_unroll.analytic_jet`)."""
+        return _core.analytic_jet(self.kind, self._ax, self.radius, self.semi_angle, u, v, order)  # type: ignore[arg-type]
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self._ax is not None:

@@ -36,7 +36,8 @@ import FreeCAD as App
 import Part
 
 from ght_cad.errors import GHTError
-from ght_cad.face_unroll import EdgeData, FaceData, SurfaceAdapter, chain_loop, fd_derivative, surface_jet, unroll_face_data
+from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, surface_jet,
+                                 unroll_face_data)
 from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
@@ -156,6 +157,18 @@ def read_curve(c: Any, dim: int, p0: float, p1: float) -> _CurveEval | None:
     return out
 
 
+def _placement(s: Any, kind: str) -> tuple[np.ndarray, ...] | None:
+    """``(O, X, Y, Z)`` of a FreeCAD plane, cylinder or cone: origin ``Position`` (plane) or
+    ``Center``, axes the columns of its ``Rotation`` (None when FreeCAD does not give them)."""
+    try:
+        O = s.Position if kind == "plane" else s.Center
+        rot = s.Rotation
+        axes = [rot.multVec(App.Vector(*e)) for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+    except Exception:  # pragma: no cover - a FreeCAD without these attributes: evaluate by FreeCAD
+        return None
+    return tuple(np.array([float(p.x), float(p.y), float(p.z)]) for p in [O, *axes])
+
+
 class FreeCADSurface(SurfaceAdapter):
     """A FreeCAD ``face.Surface`` as :class:`ght_cad.face_unroll.SurfaceAdapter`.
 
@@ -164,9 +177,12 @@ class FreeCADSurface(SurfaceAdapter):
     1 with 2 poles across. Non-periodic B-spline and Bézier surfaces are read once into the core's
     vectorized evaluator (:func:`read_surface`, :class:`ght_cad.nurbs.NurbsSurface`) when it
     agrees with FreeCAD's ``value``/``getDN`` at four points to 1e-12 of the size (derivatives
-    relative to their own size); ``path`` says which evaluation is used: ``"nurbs"`` or
-    ``"freecad"`` (points by ``value(u, v)`` and partials by ``getDN(u, v, i, j)`` one by one;
-    location included: ``face.Surface`` is already placed). ``fast=False`` forces the latter.
+    relative to their own size); planes, cylinders and cones are evaluated in numpy by OCCT's
+    formulas (:func:`ght_cad.face_unroll.analytic_jet`) from their placement (``Center`` or
+    ``Position``, ``Rotation``), after the same agreement check. ``path`` says which evaluation is
+    used: ``"nurbs"``, ``"analytic"`` or ``"freecad"`` (points by ``value(u, v)`` and partials by
+    ``getDN(u, v, i, j)`` one by one; location included: ``face.Surface`` is already placed).
+    ``fast=False`` forces the latter.
     """
 
     def __init__(self, face: "Part.Face", fast: bool = True) -> None:
@@ -175,6 +191,7 @@ class FreeCADSurface(SurfaceAdapter):
         self.type_name = type(s).__name__
         self.kind = _KINDS.get(self.type_name, "other")
         self._nurbs: NurbsSurface | None = None
+        self._ax: tuple[np.ndarray, ...] | None = None
         self.path = "freecad"
         if self.kind in ("cylinder", "cone"):
             self.radius = float(s.Radius)
@@ -194,6 +211,23 @@ class FreeCADSurface(SurfaceAdapter):
                     self._nurbs, self.path = nurbs, "nurbs"
         elif self.kind == "extrusion":
             self.affine_ruled = True  # C(u) + v D
+        if fast and self.kind in ("plane", "cylinder", "cone"):
+            ax = _placement(s, self.kind)
+            if ax is not None and self._agrees_analytic(ax):
+                self._ax, self.path = ax, "analytic"
+
+    def _agrees_analytic(self, ax: tuple[np.ndarray, ...]) -> bool:
+        """The closed form from ``ax`` matches FreeCAD's ``value`` and ``getDN`` (first and second
+        partials) at four points to 1e-12 of their size (radius included in the size)."""
+        uu = np.array([0.0, 1.3, 2.9, 5.1])
+        vv = np.array([0.0, 0.7, -1.9, 3.4])
+        ours = analytic_jet(self.kind, ax, self.radius, self.semi_angle, uu, vv, 2)
+        theirs = [self._value_fc(uu, vv)] + self._dn(uu, vv, ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1)))
+        for a, b in zip(ours, theirs):
+            scale = max(1.0, float(np.abs(b).max()), self.radius)
+            if not float(np.abs(a - b).max()) <= 1e-12 * scale:
+                return False
+        return True
 
     def _agrees(self, nurbs: NurbsSurface) -> bool:
         """``nurbs`` matches FreeCAD's ``value`` and ``getDN`` (first partials) at four points of
@@ -214,7 +248,12 @@ class FreeCADSurface(SurfaceAdapter):
         out = [tuple(val(a, b)) for a, b in zip(np.ravel(u).tolist(), np.ravel(v).tolist())]
         return np.array(out, dtype=float).reshape(-1, 3)
 
+    def _analytic(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        return analytic_jet(self.kind, self._ax, self.radius, self.semi_angle, u, v, order)  # type: ignore[arg-type]
+
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self._ax is not None:
+            return self._analytic(u, v, 0)[0]
         if self._nurbs is not None:
             return self._nurbs.eval(u, v, 0)[0]
         return self._value_fc(u, v)
@@ -225,17 +264,23 @@ class FreeCADSurface(SurfaceAdapter):
         return [np.array([tuple(dn(a, b, i, j)) for a, b in zip(uu, vv)], dtype=float).reshape(-1, 3) for i, j in orders]
 
     def d1(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        if self._ax is not None:
+            return self._analytic(u, v, 1)[1:3]
         if self._nurbs is not None:
             return self._nurbs.eval(u, v, 1)[1:3]
         return self._dn(u, v, ((1, 0), (0, 1)))
 
     def d2(self, u: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        if self._ax is not None:
+            return self._analytic(u, v, 2)
         if self._nurbs is not None:
             return self._nurbs.eval(u, v, 2)
         return [self.value(u, v)] + self._dn(u, v, ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1)))
 
     def jet(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         """``[S]``, ``[S, S_u, S_v]`` or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` (order 0, 1, 2) in one pass."""
+        if self._ax is not None:
+            return self._analytic(u, v, order)[: (1, 3, 6)[min(order, 2)]]
         if self._nurbs is not None:
             return self._nurbs.eval(u, v, min(order, 2))
         return surface_jet(self, u, v, order, own=False)
