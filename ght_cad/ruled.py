@@ -45,7 +45,8 @@ class Developability:
         theta_rms: ``sqrt(∫ θ(u)^2 du)`` in degrees.
         dd: degree of developability ``∫ cos θ(u) du`` (1 is exactly developable).
         R: smooth objective ``∫_0^1 (1 - n_a · n_b) du`` (Gauss–Legendre).
-        residual_max: ``max |det(a', g, g')| / (|a'| |g| |g'|)`` (scale-free residual).
+        residual_max: ``max |det(a', g, g')| / (|a'| |g| |g'|)`` (scale-free residual) over the parameters
+            where both normals are defined (θ not NaN).
     """
 
     theta_max: float
@@ -94,7 +95,8 @@ def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, n
     the normal at that end is the limit of the surface normal along the ruling: ``X_u × X_v =
     (a' + v g') × g → v (g' × g)``, so ``n_a = g'×g/|g'×g|`` and likewise ``n_b = -g'×g/|g'×g|``
     with ``g' = b' - a'``. Where a normal is still undefined (``|a'×g| <= SINGULAR_NORMAL_TOL
-    |a'||g|``, both tangents vanish, or a zero ruling) θ and the dot product are NaN; callers
+    |a'||g|``, both tangents vanish, or a zero ruling: ``|g| <= SINGULAR_NORMAL_TOL max(|a'|, |b'|)``,
+    e.g. a pointed end whose end poles differ by rounding) θ and the dot product are NaN; callers
     ignore those parameters.
     """
     gl = _norm(g)
@@ -118,7 +120,9 @@ def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, n
     else:
         ok = gl > 0
     la, lb = _norm(ca), _norm(cb)
-    ok &= (la > tol_g * a1l) & (lb > tol_g * b1l) & (gl > 0)
+    # a ruling shorter than SINGULAR_NORMAL_TOL of the boundary speeds is a point (a pointed end
+    # read back from a B-spline face: 2e-13 on a 500 mm ruling, its direction rounding noise)
+    ok &= (la > tol_g * a1l) & (lb > tol_g * b1l) & (gl > SINGULAR_NORMAL_TOL * np.maximum(a1l, b1l))
     with np.errstate(divide="ignore", invalid="ignore"):
         na = ca / la[..., None]
         nb = cb / lb[..., None]
@@ -281,8 +285,11 @@ class RuledSurface(ABC):
         b1 = self.b(uu, 1)
         th, dot = _theta(a1, b1, g)
         _, theta_rms, dd, R = _integrals(th[:n], dot[:n], w)
-        theta_max = float(np.fmax.reduce(th)) if np.isfinite(th).any() else math.nan  # undefined normals (NaN) skipped
-        res = float(np.max(np.abs(_residual(a1, g, b1 - a1))))
+        fin = np.isfinite(th)
+        theta_max = float(np.fmax.reduce(th)) if fin.any() else math.nan  # undefined normals (NaN) skipped
+        # the residual where the normals are defined (at a zero-length ruling it is noise / noise)
+        res_all = np.abs(_residual(a1, g, b1 - a1))
+        res = float(res_all[fin].max()) if fin.any() else float(res_all.max())
         return Developability(theta_max, theta_rms, dd, R, res)
 
     def ruling_lengths(self, u: Any) -> np.ndarray:

@@ -231,3 +231,40 @@ def test_run_plated_skiff_with_a_pointed_side_panel(tmp_path, capsys) -> None:
     (joint,) = plate["joints"]  # the chine; the side panel's zero ruling at the bow has no direction
     assert joint["surfaces"] == ["bottom", "side"] and joint["kind"] in ("gap", "overlap", "mixed (gap, overlap)")
     assert all(math.isfinite(joint[k]) for k in ("outside_edge_distance_max", "fold_angle_deg_max"))
+
+
+def test_unroll_step_of_a_plain_pointed_loft(tmp_path, capsys) -> None:
+    """The skiff without its sheet written to STEP and read back (``ght-cad unroll model.step``):
+    its side face comes to a point at the bow, where the B-spline's end poles differ by rounding
+    (a ruling of 2e-13 on 500 mm). That ruling's normals are noise and are skipped like an exact
+    zero ruling (θ_max 4.4° there refused the face before); the face unrolls with the fit's
+    distortion (errors max <= 1e-7, measured 5e-9), the ruling lengths measured against a floor
+    of 1e-9 of the longest ruling."""
+    from ght_cad.cli import main
+
+    text = (Path(__file__).resolve().parents[1] / "examples" / "design_skiff_plated.toml").read_text()
+    start = text.index("\n[sheet]\n")
+    text = text[:start + 1] + text[text.index("\n[unroll]\n") + 1:]
+    text = text.replace('figures = ["surface", "flat_pattern"]', "figures = []")
+    design = tmp_path / "skiff_plain.toml"
+    design.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(design), "--out", str(out)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    assert main(["unroll", str(out / "model.step"), "--json"]) == 0, capsys.readouterr().err
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["errors"]["max"] <= 1e-7
+    assert rep["panels"] == 5
+
+
+def test_theta_skips_a_ruling_that_is_rounding_noise() -> None:
+    """θ at a ruling shorter than SINGULAR_NORMAL_TOL of the boundary speeds is NaN (skipped), as
+    at an exact zero ruling; a short but real ruling (1e-6 of the speeds) keeps its θ."""
+    from ght_cad.ruled import _theta
+
+    a1 = np.array([[100.0, 0.0, 0.0]] * 3)
+    b1 = np.array([[90.0, 5.0, 0.0]] * 3)
+    g = np.array([[0.0, 1e-13, 2e-13], [0.0, 0.0, 0.0], [0.0, 1e-4, 0.0]])
+    th, dot = _theta(a1, b1, g)
+    assert np.isnan(th[0]) and np.isnan(th[1]) and np.isnan(dot[0])
+    assert th[2] == pytest.approx(0.0, abs=1e-9)
