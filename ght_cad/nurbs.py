@@ -96,6 +96,10 @@ class NurbsSurface:
                             np.ascontiguousarray(pt.reshape(su.size * sv.size, -1)))
             #: the patches as a (u-span, e) x (v-span, f, k) matrix (:meth:`_patch_hom`)
             self.patches_u = np.ascontiguousarray(pt.transpose(0, 2, 1, 3, 4).reshape(su.size * (self.pu + 1), -1))
+            if self.weight is not None and (su.size > 1 or sv.size > 1):
+                #: a polynomial surface of several patches: the patches' Cartesian coefficients
+                #: ``P / w`` (no homogeneous coordinate to carry or divide by, :meth:`_patch_poly`)
+                self.patches_xyz = np.ascontiguousarray(pt[..., :3].reshape(su.size * sv.size, -1) / self.weight)
             if su.size == 1 and sv.size == 1 and self.weight is not None:
                 #: one polynomial patch: ``S = Σ_ef T_e(x) T_f(y) Q_ef`` with ``Q = P / w`` as an
                 #: ((e, f), xyz) matrix, and the patch's centre and half-widths (:meth:`_poly_patch`)
@@ -191,10 +195,30 @@ class NurbsSurface:
         return [np.concatenate([p[k] for p in parts]) for k in range(len(parts[0]))]
 
     poly_patch: tuple[np.ndarray, float, float, float, float] | None = None
+    patches_xyz: np.ndarray | None = None
+
+    def _patch_poly(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
+        """``[S]`` or ``[S, S_u, S_v]`` of a polynomial surface of several patches: on the knot-span
+        patch of (u, v), ``S = Σ_e Σ_f T_e(x) T_f(y) Q_ef`` with ``Q = P / w`` (:attr:`patches_xyz`),
+        as :meth:`_patch_hom` without the weight channel and the rational quotient."""
+        starts_u, cu, hu, starts_v, cv, hv, _ = self.patches  # type: ignore[misc]
+        iu = np.minimum(np.maximum(np.searchsorted(starts_u, u, side="right") - 1, 0), starts_u.size - 1)
+        iv = np.minimum(np.maximum(np.searchsorted(starts_v, v, side="right") - 1, 0), starts_v.size - 1)
+        Tu = _cheb_t((u - cu[iu]) / hu[iu], self.pu, order, hu[iu])
+        Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, order, hv[iv])
+        P = np.take(self.patches_xyz, iu * starts_v.size + iv, axis=0).reshape(u.size, self.pu + 1, self.pv + 1, 3)
+        tmp0 = _einsum("ne,nefk->nfk", Tu[0], P)
+        out = [_einsum("nf,nfk->nk", Tv[0], tmp0)]
+        if order >= 1:
+            out.append(_einsum("nf,nfk->nk", Tv[0], _einsum("ne,nefk->nfk", Tu[1], P)))
+            out.append(_einsum("nf,nfk->nk", Tv[1], tmp0))
+        return out
 
     def _eval(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         if self.poly_patch is not None and order <= 1:
             return self._poly_patch(u, v, order)
+        if self.patches_xyz is not None and order <= 1:
+            return self._patch_poly(u, v, order)
         if self.patches is not None and order <= 1:
             return _rational(self._patch_hom(u, v, order), order)
         su, Nu = _basis(self.U, self.pu, u, order)
