@@ -564,11 +564,11 @@ def measure_panel(panel: FlatPanel) -> DistortionReport:
             e.densify()
     area_rel = abs(panel.area_flat - panel.area_3d) / panel.area_3d
     g3, gf = panel.ruling_lengths_3d, panel.ruling_lengths_flat
-    # relative to the ruling's length, a ruling shorter than 1e-9 of the longest (a pointed end
-    # read back from a B-spline face: 2e-13 on 500 mm, measured twice with different rounding)
-    # relative to that floor; a zero-length ruling by its absolute error
+    # relative to the ruling's length; a ruling shorter than 1e-6 of the longest (1 µm on a metre:
+    # a pointed end read back from a B-spline face, 2e-13 on 500 mm, whose two measurements differ
+    # by rounding, 1e-13) relative to that floor; a zero-length ruling by its absolute error
     gmax = float(g3.max()) if g3.size else 0.0
-    ruling_rel = np.abs(gf - g3) / np.where(g3 > 0, np.maximum(g3, 1e-9 * gmax), 1.0)
+    ruling_rel = np.abs(gf - g3) / np.where(g3 > 0, np.maximum(g3, 1e-6 * gmax), 1.0)
     m = panel.metric
     ang = np.degrees(np.abs(m["angle_flat"] - m["angle_3d"])) if m else np.zeros(0)
     stretch = (m["yu_len"] / m["xu_len"] - 1.0) if m else np.zeros(0)
