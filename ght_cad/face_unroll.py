@@ -129,6 +129,19 @@ class SurfaceAdapter:
         return surface_jet(self, u, v, order, own=False)
 
 
+def jets_agree(ours: Sequence[np.ndarray], theirs: Sequence[np.ndarray], floor: float = 1.0,
+               rtol: float = 1e-12) -> bool:
+    """A kernel's surface read into numpy checked against the kernel's own evaluation: every
+    quantity ``k`` (point, partials) agrees to ``rtol`` of its own size,
+    ``max |ours_k - theirs_k| <= rtol max(floor, max |theirs_k|)`` (NaN disagrees); all quantities
+    equal-shaped, compared in one pass."""
+    a, b = _stack(list(ours)), _stack(list(theirs))
+    q = a.shape[0]
+    err = np.abs(a - b).reshape(q, -1).max(axis=1)
+    scale = np.maximum(np.abs(b).reshape(q, -1).max(axis=1), floor)
+    return bool((err <= rtol * scale).all())
+
+
 def analytic_jet(kind: str, frame: Sequence[np.ndarray], radius: float, semi_angle: float, u: Any, v: Any,
                  order: int) -> list[np.ndarray]:
     r"""``[S, S_u, S_v]`` (order <= 1) or ``[S, S_u, S_v, S_uu, S_vv, S_uv]`` of a plane, cylinder or
@@ -250,13 +263,16 @@ class FaceRuledSurface(RuledSurface):
         hit = self._jets.get(key)
         if hit is not None and hit[0] >= order:
             return hit[1]
-        tt = np.concatenate([t, t])
-        ss = np.zeros(2 * t.size)
-        ss[t.size:] = 1.0
-        u, v = self.uv(tt, ss)
+        u, v = self._ends_uv(t)
         jet = surface_jet(self.ev, u, v, order)
         self._keep(key, order, jet)
         return jet
+
+    def _ends_uv(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Face parameters of both boundaries at ``t``: ``uv(t, 0)`` then ``uv(t, 1)`` (2n points)."""
+        ss = np.zeros(2 * t.size)
+        ss[t.size:] = 1.0
+        return self.uv(np.concatenate([t, t]), ss)
 
     def _keep(self, key: bytes, order: int, jet: list[np.ndarray]) -> None:
         """Remember the boundary jet of one parameter array (the last 16 arrays are kept)."""
@@ -282,9 +298,7 @@ class FaceRuledSurface(RuledSurface):
                 todo.append(t)
         us, vs = [], []
         for t in todo:
-            ss = np.zeros(2 * t.size)
-            ss[t.size:] = 1.0
-            u, v = self.uv(np.concatenate([t, t]), ss)
+            u, v = self._ends_uv(t)
             us.append(u)
             vs.append(v)
         if extra is not None:

@@ -331,7 +331,7 @@ class NurbsSurface:
         iv = np.minimum(np.maximum(np.searchsorted(starts_v, v, side="right") - 1, 0), starts_v.size - 1)
         Tu = _cheb_t((u - cu[iu]) / hu[iu], self.pu, order, hu[iu])
         Tv = _cheb_t((v - cv[iv]) / hv[iv], self.pv, order, hv[iv])
-        nsu, nsv, A, B = starts_u.size, starts_v.size, self.pu + 1, self.pv + 1
+        nsu, nsv, B = starts_u.size, starts_v.size, self.pv + 1
         out = {}
         if nsu == 1 and nsv == 1:
             # one patch (a Bézier surface, a B-spline without interior knots): plain 2-D products

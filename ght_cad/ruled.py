@@ -281,14 +281,14 @@ class RuledSurface(ABC):
         # boundary jets are kept per parameter array) and one of θ serve the integrals, θ_max and
         # the residual
         n = t.size
-        a1, g, _ = self.edge_jets(uu)
+        a1, g, g1 = self.edge_jets(uu)
         b1 = self.b(uu, 1)
         th, dot = _theta(a1, b1, g)
         _, theta_rms, dd, R = _integrals(th[:n], dot[:n], w)
         fin = np.isfinite(th)
         theta_max = float(np.fmax.reduce(th)) if fin.any() else math.nan  # undefined normals (NaN) skipped
         # the residual where the normals are defined (at a zero-length ruling it is noise / noise)
-        res_all = np.abs(_residual(a1, g, b1 - a1))
+        res_all = np.abs(_residual(a1, g, g1))
         res = float(res_all[fin].max()) if fin.any() else float(res_all.max())
         return Developability(theta_max, theta_rms, dd, R, res)
 

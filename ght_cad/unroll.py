@@ -114,32 +114,26 @@ class _PanelSeries:
         self.offsets = offsets  # (P, m) value at each panel's left end (integrals) or None
 
     def __call__(self, u: np.ndarray, ascending: bool = False) -> np.ndarray:
-        """The series at ``u`` (n, m); ``ascending``: ``u`` is sorted (the map's distinct
-        parameters), its panels are then contiguous runs found by one ``searchsorted`` of the
-        panel ends, with no per-point panel index."""
+        """The series at ``u`` (n, m). With few panels (many points a panel) the points are taken in
+        ascending order (``ascending``: ``u`` is sorted already, the map's distinct parameters), so
+        each panel's are a contiguous run (:meth:`_ascending`); else Clenshaw per point."""
         u = np.asarray(u, dtype=float).ravel()
         P = self.edges.size - 1
-        if ascending and P <= 64 and u.size > 4 * P:
-            return self._ascending(u)
+        if P <= 64 and u.size > 4 * P:
+            if ascending:
+                return self._ascending(u)
+            order = np.argsort(u, kind="stable")
+            out = np.empty((u.size, self.coefs.shape[2]))
+            out[order] = self._ascending(u[order])
+            return out
         idx = np.minimum(np.maximum(np.searchsorted(self.edges, u, side="right") - 1, 0), self.edges.size - 2)  # np.clip, without its overhead
         lo, hi = self.edges[idx], self.edges[idx + 1]
         x = np.minimum(np.maximum((2.0 * u - lo - hi) / (hi - lo), -1.0), 1.0)
         out = np.empty((u.size, self.coefs.shape[2]))
-        if P <= 64 and u.size > 4 * P:
-            # few panels: T_j(x) by the three-term recurrence, then one small product per panel
-            T = _cheb_rows_of(x, self.coefs.shape[1])
-            order = np.argsort(idx, kind="stable")
-            counts = np.bincount(idx, minlength=P)
-            start = 0
-            for p in np.nonzero(counts)[0].tolist():
-                sel = order[start:start + counts[p]]
-                start += counts[p]
-                out[sel] = T[:, sel].T @ self.coefs[p]
-        else:
-            step = 8192
-            for s in range(0, u.size, step):
-                sl = slice(s, s + step)
-                out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
+        step = 8192
+        for s in range(0, u.size, step):
+            sl = slice(s, s + step)
+            out[sl] = _clenshaw(self.coefs[idx[sl]], x[sl])
         if self.offsets is not None:
             out += self.offsets[idx]
         return out

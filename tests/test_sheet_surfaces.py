@@ -128,8 +128,6 @@ def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
 def test_neutral_patterns_as_for_one_surface() -> None:
     """Each panel is its surface's neutral pattern exactly as a single [surface] unrolls it."""
     from ght_cad.design import unroll_surfaces
-    from ght_cad.design.shell_sheet import apply_sheets
-    from ght_cad.plate import plate_volume  # noqa: F401  (the closed form the run reports)
     from ght_cad.sheet import OffsetRuledSurface
     from ght_cad.unroll import ruled_area, unroll
 

@@ -58,7 +58,6 @@ from .. import face_unroll as _core
 from ..errors import GHTError
 from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
 from ..flat_pattern import FlatPattern
-from .._vec import stack as _stack
 from ..nurbs import NurbsCurve, NurbsSurface
 from ..unroll import DEFAULT_TOL_DEG
 
@@ -180,18 +179,9 @@ class _SurfEval(SurfaceAdapter):
             for u, v in zip(uu.tolist(), vv.tolist()):
                 self.ad.D1(u, v, p, du, dv)
                 rows.append(p.Coord() + du.Coord() + dv.Coord())
-            # (point, quantity, xyz): all three quantities compared at once, each to its own scale
-            theirs3 = np.array(rows, dtype=float).reshape(uu.size, 3, 3)
-            ours3 = _stack(self._nurbs.eval(uu, vv, 1), axis=1)
-            err = np.abs(ours3 - theirs3).transpose(1, 0, 2).reshape(3, -1).max(axis=1)
-            scale = np.maximum(np.abs(theirs3).transpose(1, 0, 2).reshape(3, -1).max(axis=1), max(1.0, self.radius))
-            return bool((err <= 1e-12 * scale).all())
-        ours, theirs = self.d2(uu, vv), self._occ_d2(uu, vv)
-        for a, b in zip(ours, theirs):
-            scale = max(1.0, float(np.abs(b).max()), self.radius)
-            if not float(np.abs(a - b).max()) <= 1e-12 * scale:
-                return False
-        return True
+            a = np.array(rows, dtype=float)
+            return _core.jets_agree(self._nurbs.eval(uu, vv, 1), [a[:, 0:3], a[:, 3:6], a[:, 6:9]], max(1.0, self.radius))
+        return _core.jets_agree(self.d2(uu, vv), self._occ_d2(uu, vv), max(1.0, self.radius))
 
     def _set_axes(self, ax3: Any) -> None:
         """Numpy evaluation from ``(O, X, Y, Z)`` after checking it against OCCT at three points."""

@@ -36,8 +36,8 @@ import FreeCAD as App
 import Part
 
 from ght_cad.errors import GHTError
-from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, surface_jet,
-                                 unroll_face_data)
+from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, jets_agree,
+                                 surface_jet, unroll_face_data)
 from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
@@ -223,11 +223,7 @@ class FreeCADSurface(SurfaceAdapter):
         vv = np.array([0.0, 0.7, -1.9, 3.4])
         ours = analytic_jet(self.kind, ax, self.radius, self.semi_angle, uu, vv, 2)
         theirs = [self._value_fc(uu, vv)] + self._dn(uu, vv, ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1)))
-        for a, b in zip(ours, theirs):
-            scale = max(1.0, float(np.abs(b).max()), self.radius)
-            if not float(np.abs(a - b).max()) <= 1e-12 * scale:
-                return False
-        return True
+        return jets_agree(ours, theirs, max(1.0, self.radius))
 
     def _agrees(self, nurbs: NurbsSurface) -> bool:
         """``nurbs`` matches FreeCAD's ``value`` and ``getDN`` (first partials) at four points of
@@ -235,13 +231,8 @@ class FreeCADSurface(SurfaceAdapter):
         u0, u1, v0, v1 = nurbs.bounds
         uu = np.array([u0, 0.5 * (u0 + u1), 0.3 * u0 + 0.7 * u1, u1])
         vv = np.array([v0, 0.6 * v0 + 0.4 * v1, v1, 0.2 * v0 + 0.8 * v1])
-        ours = nurbs.eval(uu, vv, 1)
         theirs = [self._value_fc(uu, vv)] + self._dn(uu, vv, ((1, 0), (0, 1)))
-        for a, b in zip(ours, theirs):
-            scale = max(1.0, float(np.abs(b).max()))
-            if not float(np.abs(a - b).max()) <= 1e-12 * scale:
-                return False
-        return True
+        return jets_agree(nurbs.eval(uu, vv, 1), theirs)
 
     def _value_fc(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         val = self.s.value
