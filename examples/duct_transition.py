@@ -59,7 +59,7 @@ def main(out_dir: str | Path = "out") -> dict[str, Any]:
     from ght_cad.cad.developable_faces import face_developability, joint_normal_deviation, shell_faces
     from ght_cad.cad.occ import is_valid, write_step
 
-    from ght_cad import unroll
+    from ght_cad.unroll import unroll_composite
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -67,13 +67,17 @@ def main(out_dir: str | Path = "out") -> dict[str, Any]:
     shell = duct.to_shell()
     step = write_step(shell, out / "duct_transition.step")
     joint = duct.joints()[0]
-    pattern = unroll(duct.segments, units="m")  # both segments as one flat piece
+    # both strips as one flat blank: they meet G2, so the second is placed across the joint ruling
+    pattern = unroll_composite(duct.segments, units="m", labels=["first", "second"], join=True, join_label="duct")
     dxf = out / "duct_transition_flat.dxf"
     pattern.export_dxf(dxf)
     return {
         "step": str(step),
         "dxf": str(dxf),
         "flat_errors": dict(pattern.errors),
+        "flat_panels": len(pattern.panels),
+        "flat_area": pattern.area,
+        "strip_areas_3d": [p["area_3d"] for p in pattern.panels[0].info.get("parts", [])],
         "valid": is_valid(shell),
         "faces": len(shell_faces(shell)),
         "theta_max_exact_deg": max(d.theta_max for d in duct.developability()),

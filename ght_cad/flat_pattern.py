@@ -42,6 +42,7 @@ __all__ = [
     "romberg_length",
     "layout_panels",
     "mark_shared_edges",
+    "shared_edge_pairs",
     "INSUNITS",
     "SVG_UNITS",
 ]
@@ -706,28 +707,21 @@ def _shared_edge_candidates(boxes: np.ndarray, radii: np.ndarray) -> list[np.nda
     return [pairs[starts[i]:starts[i + 1], 1] for i in range(n)]
 
 
-def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int:
-    """Give boundary edges shared in 3-D by two panels matching marks (in place).
+def shared_edge_pairs(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> list[tuple[int, BoundaryEdge, int, BoundaryEdge]]:
+    """Boundary edges shared in 3-D by two panels (or the two sides of a seam in one panel).
 
-    Two edges (of different panels, or the two sides of a seam in one panel) match when every 3-D sample of each lies within ``rel_tol`` · model size (plus the
-    polyline sagitta) of the other. Both get a label ``E<k>`` and ticks across the edge at the
-    points of 3-D arc-length fraction 0.2, 0.25, 0.5, 0.75 (the same 3-D points on both panels;
-    the double tick near the start makes the joining direction unambiguous). Ticks reach
-    ``tick = min(0.02 × largest panel extent, 0.1 × smallest extent of this panel)`` to each side
-    of the edge; the label, ``1.5 tick`` high, sits ``3 tick`` inside the panel.
-
-    Edges are paired greedily in boundary order (edge i with the first unpaired j > i that
-    matches). Candidate pairs come from a k-d tree over the edges' bounding boxes
-    (:func:`_shared_edge_candidates`), so the cost grows like ``n log n`` with the number of edges
-    for panels spread in space; the pairs are exactly those of testing all pairs.
+    Two edges match when every 3-D sample of each lies within ``rel_tol`` · model size (plus the
+    polyline sagitta) of the other. Edges are paired greedily in boundary order (edge i with the
+    first unpaired j > i that matches). Candidate pairs come from a k-d tree over the edges'
+    bounding boxes (:func:`_shared_edge_candidates`), so the cost grows like ``n log n`` with the
+    number of edges for panels spread in space; the pairs are exactly those of testing all pairs.
 
     Returns:
-        Number of shared edges found.
+        ``(panel index, edge, panel index, edge)`` per shared edge, in boundary order.
     """
     allpts = np.concatenate([e.xyz for p in panels for lp in p.loops for e in lp], axis=0)
     size = float(np.max(allpts.max(axis=0) - allpts.min(axis=0)))
-    k = 0
-    tick_all = 0.02 * max(float(np.max(hi - lo)) for lo, hi in (p.bbox() for p in panels))
+    pairs: list[tuple[int, BoundaryEdge, int, BoundaryEdge]] = []
     items = [(pi, e) for pi, p in enumerate(panels) for lp in p.loops for e in lp]
     sags = [_sagitta3(e.xyz) for _, e in items]
     used: set[int] = set()
@@ -769,26 +763,47 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
             d21, _ = _polyline_param(e1.xyz, e2.xyz)
             if d21.max() > tol:
                 continue
-            k += 1
             used.update((i, j))
-            cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(e1.xyz, axis=0), axis=1))])
-            frac_idx = np.interp(np.array(MARK_FRACTIONS) * cum[-1], cum, np.arange(len(cum)))
-            p3, _ = _interp_polyline(e1.xyz, frac_idx)
-            _, s2 = _polyline_param(e2.xyz, p3)
-            for panel, edge, s in ((panels[pi], e1, frac_idx), (panels[pj], e2, s2)):
-                loops = panel.loop_polylines()
-                lo, hi = panel.bbox()
-                tick = min(tick_all, 0.1 * float(np.min(hi - lo)))  # a narrow panel gets smaller marks
-                pos, tan = _interp_polyline(edge.flat + panel.offset, s)
-                nrm = _stack([-tan[:, 1], tan[:, 0]], axis=1)
-                probe = pos[2] + 2 * tick * nrm[2]
-                if not _inside(probe[None], loops)[0]:
-                    nrm = -nrm
-                for q, nv in zip(pos, nrm):
-                    panel.marks.append(np.array([q - tick * nv, q + tick * nv]))
-                tp = pos[2] + 3 * tick * nrm[2]
-                panel.texts.append((float(tp[0]), float(tp[1]), f"E{k}", 1.5 * tick))
-    return k
+            pairs.append((pi, e1, pj, e2))
+    return pairs
+
+
+def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int:
+    """Give boundary edges shared in 3-D by two panels matching marks (in place).
+
+    The edges of :func:`shared_edge_pairs` (every 3-D sample of each within ``rel_tol`` · model
+    size, plus the polyline sagitta, of the other). Both get a label ``E<k>`` and ticks across the
+    edge at the points of 3-D arc-length fraction 0.2, 0.25, 0.5, 0.75 (the same 3-D points on
+    both panels; the double tick near the start makes the joining direction unambiguous). Ticks
+    reach ``tick = min(0.02 × largest panel extent, 0.1 × smallest extent of this panel)`` to each
+    side of the edge; the label, ``1.5 tick`` high, sits ``3 tick`` inside the panel.
+
+    Returns:
+        Number of shared edges found.
+    """
+    pairs = shared_edge_pairs(panels, rel_tol)
+    if not pairs:
+        return 0
+    tick_all = 0.02 * max(float(np.max(hi - lo)) for lo, hi in (p.bbox() for p in panels))
+    for k, (pi, e1, pj, e2) in enumerate(pairs, start=1):
+        cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(e1.xyz, axis=0), axis=1))])
+        frac_idx = np.interp(np.array(MARK_FRACTIONS) * cum[-1], cum, np.arange(len(cum)))
+        p3, _ = _interp_polyline(e1.xyz, frac_idx)
+        _, s2 = _polyline_param(e2.xyz, p3)
+        for panel, edge, s in ((panels[pi], e1, frac_idx), (panels[pj], e2, s2)):
+            loops = panel.loop_polylines()
+            lo, hi = panel.bbox()
+            tick = min(tick_all, 0.1 * float(np.min(hi - lo)))  # a narrow panel gets smaller marks
+            pos, tan = _interp_polyline(edge.flat + panel.offset, s)
+            nrm = _stack([-tan[:, 1], tan[:, 0]], axis=1)
+            probe = pos[2] + 2 * tick * nrm[2]
+            if not _inside(probe[None], loops)[0]:
+                nrm = -nrm
+            for q, nv in zip(pos, nrm):
+                panel.marks.append(np.array([q - tick * nv, q + tick * nv]))
+            tp = pos[2] + 3 * tick * nrm[2]
+            panel.texts.append((float(tp[0]), float(tp[1]), f"E{k}", 1.5 * tick))
+    return len(pairs)
 
 
 class FlatPattern:

@@ -731,8 +731,11 @@ def unroll_composite(
     gap: float | None = None,
     sheet: Any = None,
     marks_on: str = "pattern",
+    join: bool = False,
+    join_label: str | None = None,
 ) -> FlatPattern:
-    """Unroll several surfaces/faces into one pattern: one labelled panel per face.
+    """Unroll several surfaces/faces into one pattern: one labelled panel per face, or with
+    ``join`` one blank per set of surfaces that meet tangentially.
 
     Panels are laid side by side along +x (``gap`` between bounding boxes, default 5% of the
     largest panel). Boundary edges shared in 3-D by two panels (same points within 1e-6 of the
@@ -751,9 +754,15 @@ def unroll_composite(
             parameters, so panels whose neutral surfaces part along a shared rail (plates of
             surfaces meeting at an angle: the offsets ``±K T n`` differ there) still get their
             marks, at the same rail points (ruled parts; faces keep their own edges).
+        join: ruled parts that share a whole boundary edge and meet there at G1 or smoother
+            (tangent half-planes within ``tol_deg`` of each other, on opposite sides) become one
+            panel (:func:`ght_cad.join_panels.join_panels`: every part developed as on its own,
+            placed by the rigid motion that continues its neighbour across the shared edge, the
+            joint a bend line or marks); parts meeting at an angle (chines) stay apart with marks.
+        join_label: the label of a blank made of all parts (default: the labels joined by ``+``).
 
     Returns:
-        FlatPattern with one panel per part; ``.report`` aggregates all panels.
+        FlatPattern with one panel per part (per blank with ``join``); ``.report`` aggregates all panels.
 
     Raises:
         GHTError: an empty list, a label count that does not match, an unknown ``marks_on``.
@@ -771,11 +780,17 @@ def unroll_composite(
     if marks_on not in ("pattern", "design"):
         raise GHTError(f"marks_on={marks_on!r} is not allowed; allowed: 'pattern', 'design'")
     panels: list[FlatPanel] = []
+    conormals: list[Any] = []  # per panel, for join: the inward conormals of its design surface's edges
     swap: list[tuple[Any, np.ndarray]] = []  # (edge, design points) for marks_on="design"
     for part, lab, sh in zip(parts, labels, sheets):
         pat = unroll(part, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units, label=lab,
                      sheet=sh)
         panels.extend(pat.panels)
+        if join:
+            from .join_panels import ruled_conormals
+
+            ruled = isinstance(part, RuledSurface) and len(pat.panels) == 1
+            conormals.extend([ruled_conormals(part) if ruled else None] * len(pat.panels))
         if marks_on == "design" and sh is not None and not sh.is_zero and isinstance(part, RuledSurface):
             for pn in pat.panels:
                 for e in pn.loops[0]:
@@ -788,10 +803,17 @@ def unroll_composite(
     for e, pts in swap:
         e.xyz = pts
     try:
+        if join:  # matched on the same edges as the marks (the design's with marks_on="design")
+            from .join_panels import join_panels
+
+            panels = join_panels(panels, conormals, tol_deg=tol_deg, label=join_label)
         mark_shared_edges(panels)
     finally:
         for (e, _), old in zip(swap, kept):
             e.xyz = old
+        if swap:  # a blank's edges carry the design points they were matched on: their own again
+            for e in (e for p in panels if "joints" in p.info for lp in p.loops for e in lp):
+                e.xyz = None
     layout_panels(panels, gap)
     return FlatPattern(panels, units=units)
 

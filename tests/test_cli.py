@@ -424,8 +424,10 @@ def test_export_json_is_a_report_with_units_and_the_flat_pattern(tmp_path: Path,
     """``export D.toml r.json`` next to a DXF: the JSON states the units and the flat pattern's area,
     errors and edge marks, the same numbers as ``run``'s report.json (it had only surface,
     developability and curves). A strip named "Elbow" is a panel, not an edge mark (labels starting
-    with "E" were all counted as edge marks)."""
+    with "E" were all counted as edge marks). One panel per strip (`[unroll] panels = "per-surface"`;
+    joined, the strips are one blank labelled with the design's name and nothing to mark)."""
     text = (EXAMPLES / "design_duct_two_strips.toml").read_text().replace('name = "quarter"', 'name = "Elbow"')
+    text = text.replace("[unroll]\n", '[unroll]\npanels = "per-surface"\n')
     design = tmp_path / "two.toml"
     design.write_text(text)
     rc, res, err = run_json(["export", str(design), str(tmp_path / "p.dxf"), str(tmp_path / "r.json")], capsys)

@@ -285,22 +285,66 @@ def test_two_strip_design_end_to_end(tmp_path: Path) -> None:
     assert r["brep"] == {**r["brep"], "valid": True, "faces": 2, "shape": "shell", "shared_edges": 1}
     shape = read_step(out / "model.step")
     assert is_valid(shape) and shared_edge_count(shape) == 1
-    # pattern: one panel per strip, areas = strip areas (independent quadrature) to 1e-9
+    # pattern (issue 23): the strips meet G2, so ONE blank labelled with the design's name whose
+    # flat area is the sum of the strips' 3-D areas (independent quadrature) to 1e-12; the joint
+    # ruling is a bend line, no cut edge is left to mark
+    from ght_cad.unroll import ruled_area as ruled_area_adaptive
+
     comp = build_surface(load_design(EXAMPLES / "design_duct_two_strips.toml")).surface
     panels = r["flat_pattern"]["panels"]
-    assert [p["label"] for p in panels] == ["quarter", "second-quarter"]
-    for p, seg in zip(panels, comp.segments):
-        assert math.isclose(p["area_flat"], ruled_area(seg), rel_tol=1e-9), (p, ruled_area(seg))
-    assert r["flat_pattern"]["edge_marks"] == ["E1"]
+    assert [p["label"] for p in panels] == ["duct-two-strips"]
+    strips = sum(ruled_area_adaptive(seg) for seg in comp.segments)
+    assert math.isclose(panels[0]["area_flat"], strips, rel_tol=1e-12), (panels[0], strips)
+    assert math.isclose(panels[0]["area_flat"], sum(ruled_area(seg) for seg in comp.segments), rel_tol=1e-9)
+    assert r["flat_pattern"]["errors"]["max"] < 1e-12
+    assert r["flat_pattern"]["edge_marks"] == []
     doc = ezdxf.readfile(out / "flat_pattern.dxf")
     msp = doc.modelspace()
     outlines = [e for e in msp if e.dxftype() == "LWPOLYLINE" and e.dxf.layer == "OUTLINE"]
-    assert len(outlines) == 2 and all(e.closed for e in outlines)
-    assert len([e for e in msp if e.dxftype() == "LINE" and e.dxf.layer == "BEND"]) == 2 * 10
+    assert len(outlines) == 1 and outlines[0].closed
+    assert len([e for e in msp if e.dxftype() == "LINE" and e.dxf.layer == "BEND"]) == 2 * 10 + 1  # + the joint
     texts = [e.dxf.text for e in msp if e.dxftype() == "TEXT"]
-    assert texts.count("E1") == 2 and "quarter" in texts and "second-quarter" in texts
+    assert texts == ["duct-two-strips"]
     md = (out / "report.md").read_text()
     assert "| quarter → second-quarter | G2 | G2 | yes |" in md
+
+
+def test_two_strip_design_per_surface_panels_and_joined_blank_agree(tmp_path: Path) -> None:
+    """`[unroll] panels = "per-surface"` keeps one panel per strip (labelled by strip, areas = the
+    strips' 3-D areas to 1e-9, the joint ruling marked E1 on both); the default blank's area is the
+    sum of those panels' flat areas to 1e-12 and its outline is one simple loop whose boundary edges
+    are the panels' outer edges less the joint (same lengths to 1e-12)."""
+    from ght_cad.design import build_surface, ruled_area, unroll_surface
+    from ght_cad.join_panels import outline_self_overlap
+
+    per = parse_design_text(TWO_STRIPS.replace("[unroll]\n", '[unroll]\npanels = "per-surface"\n'), "two.toml")
+    assert per.unroll.panels == "per-surface" and parse_design_text(TWO_STRIPS, "two.toml").unroll.panels == "joined"
+    built = build_surface(per)
+    apart = unroll_surface(built)
+    assert [p.label for p in apart.panels] == ["quarter", "second-quarter"]
+    for p, seg in zip(apart.panels, built.surface.segments):
+        assert math.isclose(p.area_flat, ruled_area(seg), rel_tol=1e-9)
+    assert [t[2] for t in apart.labels].count("E1") == 2
+    blank = unroll_surface(build_surface(parse_design_text(TWO_STRIPS, "two.toml")))
+    (pn,) = blank.panels
+    assert math.isclose(pn.area_flat, sum(p.area_flat for p in apart.panels), rel_tol=1e-12)
+    assert outline_self_overlap(pn.loop_polylines()[0]) == 0
+    lengths = {f"{p.label}:{e.name}": e.length_flat for p in apart.panels for e in p.loops[0]}
+    joined = {e.name: e.length_flat for e in pn.loops[0]}
+    assert set(joined) == set(lengths) - {"quarter:ruling u=1", "second-quarter:ruling u=0"}
+    for k, v in joined.items():
+        assert math.isclose(v, lengths[k], rel_tol=1e-12), k
+    (j,) = pn.info["joints"]
+    assert j["kind"] == "bend line" and j["tangency_deg"] < 1e-9 and j["fit"] < 1e-12
+
+
+def test_unroll_panels_bad_value_exit_2(tmp_path: Path, capsys) -> None:
+    f = tmp_path / "bad.toml"
+    f.write_text(TWO_STRIPS.replace("[unroll]\n", '[unroll]\npanels = "one"\n'))
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unroll.panels" in err[0] and "joined, per-surface" in err[0] and "bad.toml" in err[0]
+    assert not (tmp_path / "o").exists()
 
 
 @pytest.mark.parametrize("order, normalize", [("G1", "false"), ("G3", "false"), ("G2", "true")])

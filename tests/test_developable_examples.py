@@ -46,4 +46,7 @@ def test_duct_transition(tmp_path):
     assert is_valid(shape) and len(shell_faces(shape)) == 2
     assert max(joint_normal_deviation(shape)) <= 1e-6
     assert report["flat_errors"]["max"] <= 1e-9
+    # one blank of both strips (issue 23): its area is the sum of the strips' 3-D areas
+    assert report["flat_panels"] == 1 and len(report["strip_areas_3d"]) == 2
+    assert abs(report["flat_area"] - sum(report["strip_areas_3d"])) <= 1e-12 * report["flat_area"]
     assert sorted(tmp_path.iterdir()) == sorted([Path(report["step"]), Path(report["dxf"])])  # only its own files

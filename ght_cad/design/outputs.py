@@ -150,7 +150,9 @@ def export_step(built: BuiltSurface | Sequence[BuiltSurface], path: str | os.Pat
 def unroll_surface(built: BuiltSurface) -> Any:
     """Flat pattern of the built surface (:func:`ght_cad.unroll`).
 
-    A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
+    A composite's strips (joined G1..G3) are one blank labelled with the design's name
+    (``[unroll] panels = "joined"``, the default; :func:`ght_cad.join_panels.join_panels`) or one
+    panel per strip (``"per-surface"``). A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
     distortion is then in the pattern's errors.
     """
     from ..unroll import unroll
@@ -162,7 +164,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                                 samples=d.unroll.samples, units=d.units, labels=[g.name for g in d.surface.segments or []],
-                                sheet=sheet)
+                                sheet=sheet, join=d.unroll.panels == "joined", join_label=d.name[:24])
     best_effort = d.surface is not None and d.surface.type == "curves"
     return unroll(built.surface, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                   samples=d.unroll.samples, units=d.units, label=d.name[:24], sheet=sheet)
@@ -230,7 +232,9 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     """Flat pattern of a design's surfaces: :func:`unroll_surface` of a single surface; for several,
     one labelled panel per surface (per strip for a composite: ``<surface>.<strip>``) on one sheet
     (:func:`ght_cad.unroll.unroll_composite`: panels laid side by side, matching edge marks ``E<k>``
-    on the edges two panels share in 3-D, e.g. a common rail)."""
+    on the edges two panels share in 3-D, e.g. a common rail). With ``[unroll] panels = "joined"``
+    (the default) surfaces and strips meeting at G1 or smoother along a whole shared edge are one
+    blank (:func:`ght_cad.join_panels.join_panels`); sharp chines stay separate panels with marks."""
     if len(builts) == 1:
         return unroll_surface(builts[0])
     from ..unroll import unroll_composite
@@ -252,13 +256,14 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
             labels.append(b.design.name)
             sheets.append(sh)
     best_effort = any(b.design.surface is not None and b.design.surface.type == "curves" for b in builts)
+    join = {"join": d.unroll.panels == "joined"}  # a blank's label: its surfaces' names joined by "+"
     if all(s is None for s in sheets):  # no [sheet]: as before
         return unroll_composite(parts, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                                samples=d.unroll.samples, units=d.units, labels=labels)
+                                samples=d.unroll.samples, units=d.units, labels=labels, **join)
     # [sheet]: every panel its surface's neutral surface; edge marks matched on the design edges (the
     # neutral surfaces of two plates meeting at an angle part along their shared rail)
     return unroll_composite(parts, best_effort=best_effort, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                            samples=d.unroll.samples, units=d.units, labels=labels, sheet=sheets, marks_on="design")
+                            samples=d.unroll.samples, units=d.units, labels=labels, sheet=sheets, marks_on="design", **join)
 
 
 def pattern_report(pattern: Any) -> dict[str, Any]:

@@ -167,6 +167,12 @@ class UnrollSpec:
     tol_deg: float = 0.01
     #: points per boundary edge of the outline polylines (the DXF/SVG outline is that polygon)
     samples: int = 257
+    #: "joined": strips/surfaces meeting at G1 or smoother are one blank; "per-surface": one panel each
+    panels: str = "joined"
+
+
+#: the values of ``[unroll] panels``
+PANELS_CHOICES = ("joined", "per-surface")
 
 
 @dataclass
@@ -521,10 +527,11 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     unroll = UnrollSpec()
     ut = ck.table(data, "unroll", "unroll")
     if ut is not None:
-        ck.keys(ut, "unroll", ("rulings", "tol_deg", "samples"))
+        ck.keys(ut, "unroll", ("rulings", "tol_deg", "samples", "panels"))
         unroll = UnrollSpec(ck.integer(ut, "rulings", "unroll", 16, lo=0, hi=1000),
                             ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True),
-                            ck.integer(ut, "samples", "unroll", 257, lo=9, hi=20001))
+                            ck.integer(ut, "samples", "unroll", 257, lo=9, hi=20001),
+                            ck.string(ut, "panels", "unroll", "joined", choices=PANELS_CHOICES))
 
     # sheet (spec 6.1)
     sheet = None
