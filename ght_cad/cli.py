@@ -160,6 +160,14 @@ def _fmt_point(pt: list[Any]) -> str:
     return ",".join(f"{x:g}" if isinstance(x, (int, float)) else repr(x) for x in pt)
 
 
+def _out_path(text: str) -> str:
+    """``--out``'s value: an empty path is refused (it would silently mean the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r} is an empty path; allowed: a folder or file path "
+                                         "(use '.' for the current folder)")
+    return text
+
+
 def _check_suffix(option: str, value: str | os.PathLike | None, allowed: Sequence[str]) -> None:
     """Raise :class:`UsageError` unless ``value`` (if given) ends in one of ``allowed`` (case-insensitive)."""
     if value is None:
@@ -663,7 +671,7 @@ def build_parser() -> argparse.ArgumentParser:
         "optimization -> B-rep -> STEP, DXF and SVG flat patterns, PNG figures, JSON and Markdown report.",
         epilog=_EPILOG,
     )
-    sp.add_argument("--out", required=True, metavar="DIR", help="output folder (created; files are replaced atomically)")
+    sp.add_argument("--out", required=True, metavar="DIR", type=_out_path, help="output folder (created; files are replaced atomically)")
     sp.add_argument("--quick", action="store_true", help="fewer optimizer iterations (for smoke tests)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     add_wait_options(sp)
@@ -682,7 +690,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_EPILOG,
     )
     design_arg(sp)
-    sp.add_argument("--out", metavar="DIR", help="output folder (default: <DESIGN file name without .toml>-out in the current folder)")
+    sp.add_argument("--out", metavar="DIR", type=_out_path,
+                    help="output folder (default: <DESIGN file name without .toml>-out in the current folder)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     add_wait_options(sp)
     common(sp)
@@ -807,7 +816,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_EPILOG,
     )
     sp.add_argument("designs", nargs="+", metavar="DESIGN.toml", help="design files (docs/design-files.md)")
-    sp.add_argument("--out", required=True, metavar="DIR", help="batch folder (created)")
+    sp.add_argument("--out", required=True, metavar="DIR", type=_out_path, help="batch folder (created)")
     sp.add_argument("--jobs", type=int, metavar="N", help="local worker processes (default: the machine's cores)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786 (needs pip install 'ght_cad[dask]'; "
@@ -829,7 +838,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="shape parameters of one panel, each in [-1, 1] (repeatable; default four panels)",
     )
     sp.add_argument("--derivative", type=int, default=0, choices=(0, 1, 2, 3), help="derivative order")
-    sp.add_argument("--out", required=True, metavar="PNG", help="PNG file to write")
+    sp.add_argument("--out", required=True, metavar="PNG", type=_out_path, help="PNG file to write")
     common(sp)
     sp.set_defaults(func=cmd_plot_basis)
     return p

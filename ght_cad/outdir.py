@@ -2,7 +2,8 @@
 
 Every ght_cad writer that puts results on disk goes through this module (``ght-cad run``/``demo``/
 ``batch`` folders, the single-file outputs of ``curve``/``surface``/``unroll``/``export``, the
-FreeCAD workbench's exports). Three mechanisms, all plain ``os``/``fcntl`` (no third-party code):
+FreeCAD workbench's exports). Three mechanisms, all plain ``os`` with ``fcntl`` locks (``msvcrt``
+on Windows; a platform with neither is refused with a :class:`~ght_cad.errors.GHTError`):
 
 **Locks.** A run that writes a folder (or a file) first takes an exclusive ``fcntl.flock`` on a
 lock file beside it, ``.<name>.ght-cad-lock``, which holds the owner's pid and command line. A
@@ -11,9 +12,14 @@ is refused with :class:`FolderBusy` (a :class:`~ght_cad.errors.GHTError`: exit c
 command line) naming the target and the other process. The kernel drops a flock when its
 process dies, so a killed run (SIGKILL, OOM) never leaves a stuck lock; the lock file itself is
 removed on release (a waiter that locked the removed file notices the changed inode and retries).
+Lock files are created exclusively and opened with ``O_NOFOLLOW``; an existing one must be a plain
+file with one link: a symbolic or hard link planted at that name (to another user's file, say) is
+refused and never written through.
 
 **Staging folders.** Results are computed into ``.<name>.<pid>-<random>.ght-cad-tmp`` beside the
-target, with a lock file ``.lock`` inside that the live process holds. A later run tells a dead
+target (inside the target when that is an existing folder on another file system than its
+parent -- a mount point, or a link to a folder elsewhere -- so that every final rename stays on
+one file system), with a lock file ``.lock`` inside that the live process holds. A later run tells a dead
 run's folder from a live one: the lock is free (its process is gone), or there is no lock yet
 and the pid in the name does not exist. :func:`sweep_dead` removes dead runs' folders (also the
 pid-less ``.<name>.<random>.ght-cad-tmp`` and ``.ght-cad-export.<random>`` folders of earlier
@@ -42,7 +48,6 @@ Typical use::
 from __future__ import annotations
 
 import errno
-import fcntl
 import json
 import os
 import re
@@ -54,6 +59,15 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from .errors import GHTError
+
+try:  # POSIX
+    import fcntl
+except ImportError:  # pragma: no cover - Windows (msvcrt below) or an exotic platform
+    fcntl = None  # type: ignore[assignment]
+try:  # Windows
+    import msvcrt
+except ImportError:
+    msvcrt = None  # type: ignore[assignment]
 
 __all__ = [
     "FolderBusy",
@@ -112,6 +126,8 @@ def _pid_alive(pid: int) -> bool:
     """True if a process ``pid`` exists (a zombie counts as existing)."""
     if pid <= 0:
         return False
+    if os.name == "nt":  # pragma: no cover - os.kill(pid, 0) would send CTRL_C_EVENT there: assume alive
+        return True
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -145,13 +161,76 @@ def _write_owner(fd: int) -> None:
 
 
 def _try_flock(fd: int) -> bool:
+    """Take an exclusive lock on the open file ``fd`` without blocking; False if another holds it.
+
+    ``fcntl.flock`` on POSIX, ``msvcrt.locking`` of the first byte on Windows (both dropped by the
+    kernel when the process dies).
+
+    Raises:
+        GHTError: the platform has neither (named, instead of an ImportError at import).
+    """
+    _check_lock_support()
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        else:
+            os.lseek(fd, 0, os.SEEK_SET)
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
         return True
     except OSError as exc:
-        if exc.errno in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
+        if exc.errno in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK, errno.EDEADLK):
             return False
         raise
+
+
+def _check_lock_support() -> None:
+    """Raise a :class:`GHTError` (exit code 2, one line) on a platform with neither lock call."""
+    if fcntl is None and msvcrt is None:
+        raise GHTError(f"ght-cad cannot lock output folders on this platform ({sys.platform}: neither fcntl "
+                       "nor msvcrt is available); allowed: a POSIX system or Windows")
+
+
+#: ``O_NOFOLLOW`` where the platform has it (a symbolic link at a lock file's name is never followed)
+_O_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+def _open_lock_file(path: Path) -> int:
+    """Open (creating it exclusively if missing) the lock file ``path`` for reading and writing.
+
+    Never follows a symbolic link and never opens anything but a plain file with one link, so a
+    link planted at ``path`` (to another user's file) is never written through.
+
+    Raises:
+        GHTError: ``path`` is a symbolic link, a hard link, or not a plain file (named).
+        OSError: the folder is not writable, ... (the caller names the target).
+    """
+    import stat
+
+    for _ in range(100):
+        try:
+            return os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | _O_NOFOLLOW | _O_CLOEXEC, 0o644)
+        except FileExistsError:
+            pass
+        try:
+            if not _O_NOFOLLOW and os.path.islink(path):  # pragma: no cover - no O_NOFOLLOW (Windows)
+                raise OSError(errno.ELOOP, "a symbolic link", str(path))
+            fd = os.open(path, os.O_RDWR | _O_NOFOLLOW | _O_CLOEXEC)
+        except FileNotFoundError:  # removed by its holder meanwhile: create it again
+            continue
+        except OSError as exc:
+            if exc.errno in (errno.ELOOP, errno.EMLINK) or os.path.islink(path):
+                raise GHTError(f"lock file {path} is a symbolic link, which ght-cad never writes through; "
+                               "allowed: remove it (ght-cad's lock files are plain files)") from None
+            raise
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink != 1:
+            os.close(fd)
+            what = "not a plain file" if not stat.S_ISREG(st.st_mode) else f"a file with {st.st_nlink} hard links"
+            raise GHTError(f"lock file {path} is {what}, which ght-cad never writes into; "
+                           "allowed: remove it (ght-cad's lock files are plain files with one link)")
+        return fd
+    raise GHTError(f"lock file {path} keeps appearing and disappearing; allowed: try again")  # pragma: no cover
 
 
 # ---------------------------------------------------------------------------------------------
@@ -211,6 +290,7 @@ class TargetLock:
         """Take the lock (waiting if asked); raises :class:`FolderBusy` or ``GHTError``."""
         if self.fd is not None:
             return self
+        _check_lock_support()  # before anything is created
         parent = self.path.parent
         try:
             parent.mkdir(parents=True, exist_ok=True)
@@ -221,7 +301,7 @@ class TargetLock:
         told = False
         while True:
             try:
-                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+                fd = _open_lock_file(self.path)
             except OSError as exc:
                 raise GHTError(f"cannot lock {self.target} (lock file {self.path}): {exc.strerror or exc}; "
                                "allowed: a writable folder") from None
@@ -299,8 +379,10 @@ class StagingDir:
         self.path = Path(tempfile.mkdtemp(prefix=f".{label}.{os.getpid()}-", suffix=STAGING_SUFFIX, dir=self.parent))
         self.lock_file = self.path / _STAGING_LOCK
         try:
-            self.fd: int | None = os.open(self.lock_file, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
-            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            self.fd: int | None = os.open(self.lock_file, os.O_RDWR | os.O_CREAT | os.O_EXCL | _O_NOFOLLOW | _O_CLOEXEC,
+                                          0o644)
+            if not _try_flock(self.fd):  # pragma: no cover - a file this process just created
+                raise OSError(errno.EAGAIN, "staging lock taken", str(self.lock_file))
             _write_owner(self.fd)
         except BaseException:
             shutil.rmtree(self.path, ignore_errors=True)
@@ -344,7 +426,7 @@ def is_dead(folder: str | os.PathLike) -> bool:
     pid = int(m.group(1)) if m else None
     lock = folder / _STAGING_LOCK
     try:
-        fd = os.open(lock, os.O_RDWR)
+        fd = os.open(lock, os.O_RDWR | _O_NOFOLLOW | _O_CLOEXEC)
     except FileNotFoundError:
         return pid is None or not _pid_alive(pid)
     except OSError:
@@ -493,6 +575,7 @@ class OutputFolder:
 
     def __init__(self, out_dir: str | os.PathLike, *, wait: bool = False, timeout: float | None = None,
                  on_wait: Callable[[FolderBusy], None] | None = None) -> None:
+        _refuse_empty(out_dir, "output folder")
         self.out = Path(out_dir)
         self.wait = wait
         self.timeout = timeout
@@ -503,7 +586,13 @@ class OutputFolder:
         self.committed: list[str] | None = None
 
     def open(self) -> "OutputFolder":
-        """Lock, sweep and stage (what ``__enter__`` does)."""
+        """Lock, sweep and stage (what ``__enter__`` does).
+
+        The staging folder goes beside the output folder, or inside it when the output folder
+        exists on another file system than its parent (a mount point, a link to a folder
+        elsewhere), so that :meth:`commit`'s renames never cross file systems. An existing
+        output folder must be writable (probed by creating and removing a file in it).
+        """
         out = self.out
         if out.exists() and not out.is_dir():
             raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
@@ -514,10 +603,15 @@ class OutputFolder:
                                    hint="run again with --wait (waits until it has finished), or choose another --out",
                                    on_wait=self.on_wait).acquire()
             sweep_dead(parent)
+            where = parent
             if out.is_dir():
+                _probe_writable(out)
+                if _other_device(out, parent):
+                    where = out
+                    sweep_dead(out)
                 _remove_part_leftovers(out)
             try:
-                self.stage = StagingDir(parent, out.name)
+                self.stage = StagingDir(where, out.name)
             except OSError as exc:
                 raise GHTError(
                     f"cannot create the output folder {out}: {exc.strerror or exc}"
@@ -567,9 +661,9 @@ class OutputFolder:
                 self.made_parents = []
                 self.committed = names
                 return names
-            except OSError:
+            except OSError as exc:
                 if not out.is_dir():
-                    raise
+                    raise _folder_error(out, exc) from None
                 # a folder appeared meanwhile (made by hand): fall through to the file moves
                 if not by_report:
                     os.unlink(self.stage.path / MANIFEST_NAME)
@@ -580,9 +674,21 @@ class OutputFolder:
                 raise GHTError(f"cannot write {out / n}: it is a folder; allowed: a file path "
                                "(remove or rename the folder)")
         previous = read_manifest(out)
-        write_manifest(out, set(previous) | set(names), pending=True)
-        for n in names:
-            os.replace(self.stage.path / n, out / n)
+        manifest = out / MANIFEST_NAME
+        try:
+            before = manifest.read_bytes() if manifest.is_file() and not manifest.is_symlink() else None
+        except OSError:
+            before = None
+        moved = 0
+        try:
+            write_manifest(out, set(previous) | set(names), pending=True)
+            for n in names:
+                os.replace(self.stage.path / n, out / n)
+                moved += 1
+        except OSError as exc:
+            if moved == 0:  # nothing of this run reached the folder: leave it as it was
+                _restore_file(manifest, before)
+            raise _folder_error(out, exc) from None
         for n in sorted(set(previous) - set(names)):
             p = out / n
             try:
@@ -623,6 +729,60 @@ class OutputFolder:
         self.close(failed=exc_type is not None)
 
 
+def _refuse_empty(path: str | os.PathLike, what: str) -> None:
+    """An empty path (``--out ""``) means no folder at all, not the current folder: refuse it."""
+    if not os.fspath(path).strip():
+        raise GHTError(f"{what} path {os.fspath(path)!r} is empty; allowed: a folder path (use '.' for the current folder)")
+
+
+def _probe_writable(folder: Path) -> None:
+    """Create and remove a file in ``folder``; a read-only or unwritable folder is refused (named).
+
+    (``os.access`` is not enough: it says yes to root in a folder of mode 0555 on a read-only mount.)
+    """
+    try:
+        fd, name = tempfile.mkstemp(prefix=".ght-cad-probe.", dir=folder)
+        os.close(fd)
+        os.unlink(name)
+    except OSError as exc:
+        raise GHTError(f"output folder {folder} is not writable ({exc.strerror or exc}); "
+                       "allowed: a folder this user can write on a writable file system") from None
+
+
+def _other_device(folder: Path, parent: Path) -> bool:
+    """True if ``folder`` (followed if a link) lies on another file system than ``parent``."""
+    try:
+        return os.stat(folder).st_dev != os.stat(parent).st_dev
+    except OSError:
+        return False
+
+
+def _restore_file(path: Path, content: bytes | None) -> None:
+    """Put ``path`` back as it was (``content`` None: it did not exist); best effort."""
+    try:
+        if content is None:
+            if path.is_file() and not path.is_symlink():
+                path.unlink()
+        else:
+            from .io import write_bytes_atomic
+
+            write_bytes_atomic(path, content)
+    except OSError:  # pragma: no cover - the folder just failed us; the manifest still covers our files
+        pass
+
+
+#: errors of the place the files go (not of ght-cad): a refusal naming the folder (exit code 2)
+_PLACE_ERRNOS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.EXDEV, errno.ENOSPC, getattr(errno, "EDQUOT", -1)}
+
+
+def _folder_error(folder: Path, exc: OSError) -> Exception:
+    """A :class:`GHTError` naming ``folder`` for a read-only, full or foreign place; else ``exc`` itself."""
+    if exc.errno in _PLACE_ERRNOS:
+        return GHTError(f"cannot write into output folder {folder}: {exc.strerror or exc}; "
+                        "allowed: a writable folder with free space")
+    return exc
+
+
 class StagedFiles:
     """Several single output files written all or nothing (``curve``/``surface``/``unroll``/``export``).
 
@@ -649,6 +809,8 @@ class StagedFiles:
         self.map: dict[Path, Path] = {}
         self.locks: list[TargetLock] = []
         try:
+            for t in targets:
+                _refuse_empty(t, "output file")
             paths = [Path(t) for t in targets]
             for t in paths:
                 if t.exists() and t.is_dir():

@@ -121,6 +121,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     from ..progress import progress_enabled
 
     t_start = time.perf_counter()
+    if not os.fspath(out_dir).strip():  # Path("") would be the current folder
+        raise GHTError(f"output folder path {os.fspath(out_dir)!r} is empty; allowed: a folder path")
     out = Path(out_dir)
     want_files = set(design.outputs.files)
     want_figs = set(design.outputs.figures)
