@@ -1,0 +1,250 @@
+"""Import direction of TODAY's flat layout: the stepping stone to the layered sub-packages (issue 27).
+
+Every import of every module of ``ght_cad`` and of the FreeCAD workbench is read with ``ast``
+(function-local imports included: they are the ones that break the layering quietly) and resolved
+to a module. Each module has a layer, lowest first:
+
+=========  ====================================================================================
+core       errors, validation, small vector kernels, atomic files, output folders, progress
+curves     seeds, basis, curves, continuity, composites, analysis, planes, B-splines, NURBS,
+           patches, plotting
+surfaces   ruled surfaces, developables, the loft, sheet, plate, unrolling, flat patterns
+optimize   ``ght_cad.optimize`` (optimizers, problems, Pareto, pipeline)
+facade     the package ``ght_cad`` itself (its ``__init__`` re-exports)
+kernel     CAD adapters: ``ght_cad.cad`` (OCP/build123d/cadquery), the FreeCAD workbench
+app        CLI, design files, batch, sweeps, demo
+=========  ====================================================================================
+
+An import may go to the same or a lower layer. The imports that go UP today (the core calling
+the kernel adapters lazily, the loft importing its optimization problem, ...) and the import
+cycles of today are listed below as explicit allow-lists: a new upward import or a new cycle fails
+this test, and so does an entry that no longer exists (remove it: the list only shrinks). The
+package moves of issue 27 are to empty both lists; this module is then renamed to test the
+sub-packages' order instead.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+WORKBENCH = ROOT / "freecad_workbench" / "freecad"
+
+LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
+
+_LAYER_OF = {
+    "core": ["errors", "_validate", "_vec", "io", "outdir", "progress"],
+    "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
+               "patch", "plotting"],
+    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern"],
+    "optimize": ["optimize"],
+    "kernel": ["cad"],
+    "app": ["cli", "design", "batch", "sweep", "demo"],
+}
+
+#: Imports from a lower layer into a higher one that exist today: (importer, imported).
+ALLOWED_UPWARD = {
+    # curves -> kernel: the patch's to_face
+    ("ght_cad.patch", "ght_cad.cad.occ"),
+    # surfaces -> kernel: to_face and the unroll dispatch of CAD faces (issue 27: a registry)
+    ("ght_cad.developable", "ght_cad.cad.developable_faces"),
+    ("ght_cad.loft", "ght_cad.cad.developable_faces"),
+    ("ght_cad.unroll", "ght_cad.cad.unroll_faces"),
+    ("ght_cad.flat_pattern", "ght_cad.cad.unroll_faces"),
+    # surfaces -> optimize: the loft's own optimization problem (issue 27: move it to optimize)
+    ("ght_cad.loft", "ght_cad.optimize.problems"),
+    # optimize -> kernel: the pipeline's B-rep and STEP output
+    ("ght_cad.optimize.pipeline", "ght_cad.cad.developable_faces"),
+    ("ght_cad.optimize.pipeline", "ght_cad.cad.occ"),
+}
+
+#: The import cycles (strongly connected components) of today, function-local imports counted.
+KNOWN_CYCLES = [
+    # unrolling: the core dispatches CAD faces to the OCP adapter, which uses the core again
+    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.cad.unroll_faces"},
+    # developables: to_face through the OCP adapter
+    {"ght_cad.developable", "ght_cad.cad.developable_faces"},
+    # the application: batch runs designs, design files read STEP through batch's helpers, the CLI
+    # runs both, and the demo (which the CLI runs) runs a design
+    {"ght_cad.batch", "ght_cad.cli", "ght_cad.demo", "ght_cad.design", "ght_cad.design.step_input"},
+]
+
+
+# -- reading the imports ---------------------------------------------------------------------------
+
+def modules() -> dict[str, tuple[Path, bool]]:
+    """Every module: dotted name -> (file, is a package). Workbench modules keep their import name."""
+    out: dict[str, tuple[Path, bool]] = {}
+    for base, top in ((ROOT, ROOT / "ght_cad"), (WORKBENCH, WORKBENCH / "ght_workbench")):
+        for f in sorted(top.rglob("*.py")):
+            parts = list(f.relative_to(base).with_suffix("").parts)
+            is_pkg = parts[-1] == "__init__"
+            if is_pkg:
+                parts = parts[:-1]
+            out[".".join(parts)] = (f, is_pkg)
+    return out
+
+
+def imports_of(source: str, name: str, is_pkg: bool, known: set[str]) -> set[str]:
+    """The project modules ``source`` (module ``name``) imports, at any depth of the code.
+
+    ``from X import y`` counts as importing ``X.y`` when that is a module, else ``X``; an import
+    of a module inside a package counts as the module (not the package).
+    """
+    package = name if is_pkg else name.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(source)):
+        targets: list[str] = []
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            targets = [f"{mod}.{a.name}" if f"{mod}.{a.name}" in known else mod for a in node.names]
+        for t in targets:
+            while t and t not in known:
+                t = t.rpartition(".")[0]
+            if t and t != name:
+                found.add(t)
+    return found
+
+
+def import_graph() -> dict[str, set[str]]:
+    mods = modules()
+    known = set(mods)
+    return {m: imports_of(f.read_text(encoding="utf-8"), m, is_pkg, known) for m, (f, is_pkg) in mods.items()}
+
+
+def layer(module: str) -> str:
+    if module == "ght_cad":
+        return "facade"
+    if module.startswith("ght_workbench"):
+        return "kernel"
+    first = module.split(".")[1]
+    for name, members in _LAYER_OF.items():
+        if first in members:
+            return name
+    raise AssertionError(f"{module} has no layer: add it to _LAYER_OF in tests/test_import_layers.py")
+
+
+def upward(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
+    return {(a, b) for a, deps in graph.items() for b in deps if LAYERS.index(layer(b)) > LAYERS.index(layer(a))}
+
+
+def cycles(graph: dict[str, set[str]]) -> list[set[str]]:
+    """Strongly connected components with more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[set[str]] = []
+    counter = 0
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph.get(root, ()))))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = counter
+                    counter += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(graph.get(w, ())))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = set()
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.add(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    out.append(comp)
+    return out
+
+
+# -- the checks on made-up code ---------------------------------------------------------------------
+
+def test_reader_counts_function_local_and_relative_imports() -> None:
+    known = {"ght_cad", "ght_cad.errors", "ght_cad.cad", "ght_cad.cad.occ", "ght_cad.design", "ght_cad.design.schema"}
+    src = (
+        "from .errors import GHTError\n"
+        "import numpy as np\n"
+        "def f():\n"
+        "    from .cad import occ\n"
+        "    class C:\n"
+        "        def g(self):\n"
+        "            import ght_cad.design.schema as s\n"
+        "            from .. import something\n"
+    )
+    assert imports_of(src, "ght_cad.patch", False, known) == {"ght_cad.errors", "ght_cad.cad.occ", "ght_cad.design.schema"}
+    assert imports_of("from ..errors import E\nfrom . import schema\n", "ght_cad.design.build", False, known) == {
+        "ght_cad.errors", "ght_cad.design.schema"}
+    assert imports_of("from . import schema\n", "ght_cad.design", True, known) == {"ght_cad.design.schema"}
+
+
+def test_checks_find_an_upward_import_and_a_cycle() -> None:
+    graph = {"ght_cad.curve": {"ght_cad.errors", "ght_cad.cli"}, "ght_cad.cli": {"ght_cad.curve"}, "ght_cad.errors": set()}
+    assert upward(graph) == {("ght_cad.curve", "ght_cad.cli")}
+    assert cycles(graph) == [{"ght_cad.curve", "ght_cad.cli"}]
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []
+
+
+# -- the repository ------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def graph() -> dict[str, set[str]]:
+    return import_graph()
+
+
+def test_every_module_has_a_layer(graph: dict[str, set[str]]) -> None:
+    assert len(graph) > 60, "the module reader found too few modules"
+    for m in graph:
+        layer(m)
+
+
+def test_no_new_upward_import(graph: dict[str, set[str]]) -> None:
+    new = sorted(upward(graph) - ALLOWED_UPWARD)
+    assert not new, (
+        "imports from a lower layer into a higher one (tests/test_import_layers.py): "
+        + "; ".join(f"{a} ({layer(a)}) imports {b} ({layer(b)})" for a, b in new)
+    )
+
+
+def test_allowed_upward_imports_still_exist(graph: dict[str, set[str]]) -> None:
+    gone = sorted(ALLOWED_UPWARD - upward(graph))
+    assert not gone, f"remove these from ALLOWED_UPWARD, they no longer exist: {gone}"
+
+
+def test_no_new_import_cycle(graph: dict[str, set[str]]) -> None:
+    found = cycles(graph)
+    new = [sorted(c) for c in found if not any(c <= k for k in KNOWN_CYCLES)]
+    assert not new, f"new import cycles (function-local imports count): {new}"
+    gone = [sorted(k) for k in KNOWN_CYCLES if not any(k <= c for c in found)]
+    assert not gone, f"these known cycles are gone or smaller, update KNOWN_CYCLES: {gone}"
+
+
+def test_the_freecad_workbench_never_imports_the_ocp_adapters(graph: dict[str, set[str]]) -> None:
+    bad = sorted((a, b) for a, deps in graph.items() if a.startswith("ght_workbench")
+                 for b in deps if b.startswith("ght_cad.cad"))
+    assert not bad, f"the FreeCAD workbench imports OCP adapters: {bad}"
