@@ -39,7 +39,7 @@ _LAYER_OF = {
     "core": ["errors", "_validate", "_vec", "io", "outdir", "progress"],
     "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
-    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern"],
+    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "join_panels"],
     "optimize": ["optimize"],
     "kernel": ["cad"],
     "app": ["cli", "design", "batch", "sweep", "demo"],
@@ -64,7 +64,8 @@ ALLOWED_UPWARD = {
 #: The import cycles (strongly connected components) of today, function-local imports counted.
 KNOWN_CYCLES = [
     # unrolling: the core dispatches CAD faces to the OCP adapter, which uses the core again
-    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.cad.unroll_faces"},
+    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.join_panels",
+     "ght_cad.cad.unroll_faces"},
     # developables: to_face through the OCP adapter
     {"ght_cad.developable", "ght_cad.cad.developable_faces"},
     # the application: batch runs designs, design files read STEP through batch's helpers, the CLI
