@@ -16,7 +16,14 @@ __all__ = [
     "check_finite_array",
     "check_points",
     "as_parameter_array",
+    "is_real",
 ]
+
+
+def is_real(value: Any) -> bool:
+    """True for a real number of any kind except bool: Python int/float and numpy scalars of
+    every integer and floating dtype (``np.int64`` is not an ``int``, ``np.float32`` not a ``float``)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
 
 
 def _exact(v: float) -> str:

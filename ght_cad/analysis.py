@@ -29,6 +29,7 @@ import numpy as np
 from .composite import CompositeCurve
 from .curve import GHTCurve, curvature_from_derivatives
 from .errors import GHTError
+from ._validate import is_real
 from .io import atomic_path
 
 __all__ = [
@@ -337,7 +338,7 @@ def curvature_comb_plot(
     """
     curve = _check_curve(curve)
     n = _check_samples(samples_per_segment)
-    if scale is not None and not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale >= 0):
+    if scale is not None and not (is_real(scale) and math.isfinite(scale) and scale >= 0):
         raise GHTError(f"scale={scale!r} is not allowed; it must be a finite number >= 0 or None")
     fig, ax = _figure((7, 6))
     _draw_comb(ax, curve, n, scale, show_control_polygon)

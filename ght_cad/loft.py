@@ -37,7 +37,7 @@ from typing import Any, Callable, Mapping, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 
-from ._validate import as_parameter_array
+from ._validate import as_parameter_array, is_real
 from ._vec import cross as _cross3
 from .curve import GHTCurve, gauss_legendre
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
@@ -1467,7 +1467,7 @@ def developable_loft(
     if not (branch == "auto" or (isinstance(branch, (int, np.integer)) and not isinstance(branch, bool) and branch >= 0)):
         raise GHTError(f"branch={branch!r} is not allowed; use 'auto' or a candidate index >= 0")
     for nm, v, lo, hi in (("max_step", max_step, 1e-6, 0.5), ("step_tol", step_tol, 1e-8, 0.1)):
-        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and lo <= v <= hi):
+        if not (is_real(v) and math.isfinite(v) and lo <= v <= hi):
             raise GHTError(f"{nm}={v!r} is not allowed; it must be a number in [{lo:g}, {hi:g}]")
     for nm, v, lo in (("samples", samples, 9), ("boundary_samples", boundary_samples, 17)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
@@ -1720,11 +1720,11 @@ class LoftProblem(Problem):
         for k, v in weights.items():
             if k not in LOFT_OBJECTIVES:
                 raise GHTError(f"loft objective {k!r} is unknown; allowed: {', '.join(LOFT_OBJECTIVES)}")
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+            if not (is_real(v) and math.isfinite(v) and v >= 0):
                 raise GHTError(f"weight {k}={v!r} is not allowed; weights are finite numbers >= 0")
         if not any(v > 0 for v in weights.values()):
             raise GHTError(f"objective={objective!r} has no positive weight")
-        if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin > 0):
+        if not (is_real(margin) and math.isfinite(margin) and margin > 0):
             raise GHTError(f"margin={margin!r} is not allowed; it must be a finite number > 0")
         names = [f"{r}.{p}" for r in ("a", "b") for p in ("mu", "nu", "gamma")]
         super().__init__(names, list(rail_a.shape_parameters) + list(rail_b.shape_parameters), free, bounds)

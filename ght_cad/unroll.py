@@ -33,6 +33,7 @@ import numpy as np
 
 from .curve import gauss_legendre, integrate
 from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ._validate import is_real
 from ._vec import cross as _cross
 from ._vec import einsum as _einsum
 from ._vec import stack as _stack
@@ -709,7 +710,7 @@ def _sheet_arg(sheet: Any, thickness: Any, k_factor: Any, din_k_factor: Any, sid
 
 
 def _check_args(tol_deg: float, rulings: int, samples: int, units: str) -> None:
-    if not (isinstance(tol_deg, (int, float)) and math.isfinite(tol_deg) and tol_deg > 0):
+    if not (is_real(tol_deg) and math.isfinite(tol_deg) and tol_deg > 0):
         raise GHTError(f"tol_deg={tol_deg!r} is not allowed; it must be a finite angle > 0 in degrees")
     if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or rulings < 0:
         raise GHTError(f"rulings={rulings!r} is not allowed; it must be an integer >= 0")

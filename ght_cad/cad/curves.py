@@ -296,16 +296,35 @@ def export_step(objects: Any, path: Any, tol: float | None = None, degree: int =
     return write_step([ght_shape(o, tol, degree) for o in items], path)
 
 
+def _point(p: Any) -> tuple[float, float, float]:
+    """One point as three floats: a build123d ``Vector`` or 2/3 numbers of any kind (Python or
+    numpy scalars of any dtype; build123d's ``Vector`` reads numpy integers as nothing)."""
+    if isinstance(p, Vector):
+        return (p.X, p.Y, p.Z)
+    try:
+        arr = np.asarray(p, dtype=float)
+    except (TypeError, ValueError):
+        raise GHTError(f"control point {p!r} is not a point; use 2 or 3 numbers or a Vector") from None
+    if arr.ndim != 1 or arr.size not in (2, 3):
+        raise GHTError(f"control point {p!r} has shape {arr.shape}; a point has 2 or 3 coordinates")
+    return (float(arr[0]), float(arr[1]), float(arr[2]) if arr.size == 3 else 0.0)
+
+
+def _is_point_list(p: Any) -> bool:
+    if isinstance(p, np.ndarray):
+        return p.ndim == 2
+    return isinstance(p, (list, tuple)) and bool(p) and isinstance(p[0], (list, tuple, Vector, np.ndarray))
+
+
 def _points(pts: Sequence[Any]) -> np.ndarray:
+    """Control points given as separate arguments and/or sequences of points, as an (n, 3) array."""
     flat: list[Any] = []
     for p in pts:
-        if isinstance(p, (list, tuple)) and p and isinstance(p[0], (list, tuple, Vector, np.ndarray)):
-            flat.extend(p)
-        elif isinstance(p, np.ndarray) and p.ndim == 2:
+        if _is_point_list(p):
             flat.extend(list(p))
         else:
             flat.append(p)
-    return np.array([tuple(Vector(*p) if not isinstance(p, Vector) else p) for p in flat], dtype=float)
+    return np.array([_point(p) for p in flat], dtype=float)
 
 
 class GHTBezierLine(BaseEdgeObject):

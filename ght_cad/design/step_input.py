@@ -13,6 +13,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..errors import GHTError
+from .._validate import is_real
 from .schema import DesignError
 
 
@@ -163,7 +164,7 @@ def unroll_step(
         raise DesignError(f"{p}: no such STEP file")
     if units is not None and units not in MM_PER_UNIT:
         raise DesignError(f"{p}: units={units!r} is not allowed; allowed: {', '.join(MM_PER_UNIT)}")
-    if not (isinstance(tol_deg, (int, float)) and math.isfinite(tol_deg) and 0 < tol_deg <= 90):
+    if not (is_real(tol_deg) and math.isfinite(tol_deg) and 0 < tol_deg <= 90):
         raise DesignError(f"{p}: tol_deg={tol_deg!r} is out of range; allowed: a number in (0, 90]")
     if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or not 0 <= rulings <= 1000:
         raise DesignError(f"{p}: rulings={rulings!r} is out of range; allowed: an integer in [0, 1000]")

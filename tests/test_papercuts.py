@@ -1,0 +1,29 @@
+"""Core papercuts of issue 25: numbers from numpy arrays of any dtype."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import ght_cad
+from ght_cad.loft import developable_loft
+
+PLANES = [(-400, 1, 0, 0.5), (-400, 1, 1, 0.5), (-400, 0, 1, 0.5)]
+CUTS = [(0, 0, 0, 1), (-400, 0, 0, 1)]
+
+
+@pytest.mark.parametrize("dtype", [np.int32, np.int64, np.float32], ids=lambda d: np.dtype(d).name)
+def test_core_constructors_take_numpy_numbers(dtype):
+    """Points, planes and options given as numpy arrays/scalars of any dtype give what the same
+    Python numbers give (integer planes scaled by 2 so that they are integers)."""
+    c = ght_cad.GHTCurve(np.array([(0, 0), (4, 3), (8, 0)], dtype=dtype), mu=dtype(1), gamma=dtype(-1))
+    ref = ght_cad.GHTCurve([(0.0, 0.0), (4.0, 3.0), (8.0, 0.0)], mu=1.0, gamma=-1.0)
+    assert c.arc_length() == pytest.approx(ref.arc_length(), rel=1e-15)
+    cone = ght_cad.developable_from_planes(np.array(PLANES, dtype=float) * 2, np.array(CUTS).astype(dtype),
+                                           gamma=dtype(-1))
+    pattern = ght_cad.unroll(cone, tol_deg=dtype(1), rulings=np.int64(4), thickness=dtype(4), k_factor=np.float32(0.5))
+    assert pattern.errors["max"] < 1e-13
+    chine = ght_cad.GHTCurve([(0, -700, 300), (1500, -1050, 200), (3000, -1150, 250), (4500, -950, 450)])
+    sheer = ght_cad.GHTCurve([(0, -900, 1200), (1500, -1250, 1150), (3000, -1300, 1180), (4500, -1100, 1300)])
+    loft = developable_loft(chine, sheer, max_step=np.float32(0.05), step_tol=np.float64(1e-6), samples=np.int32(33))
+    assert loft.report.theta_max_deg < 1e-9
