@@ -27,3 +27,17 @@ def test_core_constructors_take_numpy_numbers(dtype):
     sheer = ght_cad.GHTCurve([(0, -900, 1200), (1500, -1250, 1150), (3000, -1300, 1180), (4500, -1100, 1300)])
     loft = developable_loft(chine, sheer, max_step=np.float32(0.05), step_tol=np.float64(1e-6), samples=np.int32(33))
     assert loft.report.theta_max_deg < 1e-9
+
+
+def test_no_dead_cadquery_plugin_entry_point_and_readme_says_how_to_activate():
+    """cadquery 2.8 loads no plugins from entry points: the plugin is activated by importing
+    ght_cad.cad.cq_plugin, and the metadata must not pretend otherwise."""
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    meta = tomllib.loads((root / "pyproject.toml").read_text())
+    assert "cadquery.plugins" not in meta["project"].get("entry-points", {})
+    readme = (root / "README.md").read_text()
+    assert "import ght_cad.cad.cq_plugin" in readme
+    assert "no entry point" in readme or "loads no plugins" in readme
