@@ -26,9 +26,10 @@ from .errors import (
 )
 from .seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
 
-# ``ght_cad.unroll`` is both a submodule and the stable function of spec section 9: importing the
-# function here binds the package attribute to the function for good (numpy-only, ~30 ms).
-from .unroll import unroll
+# ``ght_cad.unroll`` is the submodule, made callable (its ``__call__`` is the stable function
+# ``unroll`` of spec section 9), so the package attribute is the same object whichever way and in
+# whichever order it is imported (numpy-only, ~30 ms).
+from . import unroll
 
 __version__ = "0.1.0"
 

@@ -820,12 +820,19 @@ def unroll_composite(
 
 
 class _CallableModule(types.ModuleType):
-    """Importing the submodule ``ght_cad.unroll`` rebinds the package attribute ``ght_cad.unroll``
-    to this module, shadowing the stable function name (spec section 9); calling the module
-    therefore calls :func:`unroll`, so ``ght_cad.unroll(surface)`` works either way."""
+    """``ght_cad.unroll`` is this module, and calling it calls :func:`unroll` (the stable function
+    of spec section 9): ``ght_cad.unroll(surface)``, ``from ght_cad import unroll; unroll(surface)``,
+    ``import ght_cad.unroll`` and ``from ght_cad.unroll import unroll_composite`` all work, in any
+    import order. ``__call__`` is :func:`unroll` itself and ``inspect.signature`` gives its
+    signature."""
 
-    def __call__(self, *args: Any, **kwargs: Any) -> FlatPattern:
-        return unroll(*args, **kwargs)
+    __call__ = staticmethod(unroll)
+
+    @property
+    def __signature__(self) -> Any:
+        import inspect
+
+        return inspect.signature(unroll)
 
 
 sys.modules[__name__].__class__ = _CallableModule

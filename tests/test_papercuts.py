@@ -41,3 +41,33 @@ def test_no_dead_cadquery_plugin_entry_point_and_readme_says_how_to_activate():
     readme = (root / "README.md").read_text()
     assert "import ght_cad.cad.cq_plugin" in readme
     assert "no entry point" in readme or "loads no plugins" in readme
+
+
+def test_unroll_is_one_coherent_module_that_can_be_called():
+    """``ght_cad.unroll`` is the submodule and callable as the stable function of spec section 9;
+    every documented spelling works in a fresh interpreter (import order matters)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    code = r"""
+import inspect, types
+import ght_cad.unroll
+import ght_cad.unroll as m
+from ght_cad.unroll import unroll_composite, ruled_area
+from ght_cad import unroll as u
+import ght_cad
+assert isinstance(ght_cad.unroll, types.ModuleType), type(ght_cad.unroll)
+assert m is ght_cad.unroll is u, (m, u)
+assert m.unroll_composite is unroll_composite and m.ruled_area is ruled_area
+assert list(inspect.signature(ght_cad.unroll).parameters)[0] == "surface_or_face"
+cone = ght_cad.developable_from_planes([(-400, 1, 0, 0.5), (-400, 1, 1, 0.5), (-400, 0, 1, 0.5)],
+                                       [(0, 0, 0, 1), (-400, 0, 0, 1)], gamma=-1)
+a, b, c = ght_cad.unroll(cone), u(cone), ght_cad.unroll.unroll(cone)
+assert a.area == b.area == c.area, (a.area, b.area, c.area)
+print("ok")
+"""
+    for first in ("import ght_cad", "import ght_cad.unroll", "from ght_cad.unroll import unroll"):
+        out = subprocess.run([sys.executable, "-c", first + "\n" + code], capture_output=True, text=True, cwd=root)
+        assert out.returncode == 0 and out.stdout.strip() == "ok", (first, out.stderr[-2000:])
