@@ -252,7 +252,12 @@ class RuledSurface(ABC):
             return -(det**2) / w2**2
 
     def developability_residual(self, u: Any) -> np.ndarray:
-        r"""Scale-free residual ``det(a', g, g') / (|a'| |g| |g'|)`` (0 on a developable)."""
+        r"""Scale-free residual ``det(a', g, g') / (|a'| |g| |g'|)`` (0 on a developable).
+
+        Its round-off is relative to the jets, not to ``|g'|``: ``g' = b' - a'`` is known only to
+        ``eps (|a'| + |b'|)``, so on an exact developable ``|R| ≲ C eps (1 + (|a'| + |b'|) / |g'|)``
+        (C = 58 the largest measured), large where the rulings hardly turn (``|g'| -> 0``).
+        """
         uu, _ = as_parameter_array(u, "u")
         return _residual(self.a(uu, 1), self.ruling(uu), self.ruling(uu, 1))
 

@@ -38,6 +38,7 @@ units = "m"
 [surface]
 type = "composite"
 boundary_planes = [[0, 0, 0, 1], [-2.5, -0.15, 0, 1]]
+normalize = true
 
 [[surface.segments]]
 name = "a"
@@ -90,7 +91,7 @@ def rebuild(design_file: Path, shape: dict[str, float]) -> list:
     segs = []
     for i, g in enumerate(surf["segments"]):
         P = np.asarray(g["planes"], dtype=float)
-        if surf.get("normalize", True):
+        if surf.get("normalize", False):
             P = P / np.linalg.norm(P[:, 1:], axis=1, keepdims=True)
         sh = {k: shape[f"{g['name']}.{k}"] for k in ("mu", "nu", "gamma")}
         if i == 0:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 import ght_cad
@@ -115,12 +115,22 @@ def test_normalize_changes_the_weights():
 
 # -- 5.2 general envelopes: round-off developability, analytic derivatives, end properties ---
 @given(shape, shape, shape)
+@example(0.5257984809118228, 0.0, 0.0)  # |g'| = 4.3e-7 at u = 0.34: residual 2.95e-10 at round-off
 @settings(max_examples=20)
 def test_envelope_developable_at_round_off(mu, nu, gamma):
+    """θ_max at round-off; the residual R = det(a', g, g') / (|a'| |g| |g'|) at ITS round-off, which
+    is relative to the scale of the jets, not to |g'|: g' = b' - a' is only known to
+    eps (|a'| + |b'|) absolutely, so |R| <= C eps (1 + (|a'| + |b'|) / |g'|), large where the rulings
+    hardly turn (|g'| -> 0: hypothesis found 2.95e-10 at |g'| = 4.3e-7, |a'| = 2.8). C = 256: the
+    largest C measured over 3,000 random (mu, nu, gamma) was 58."""
     s = ship(mu, nu, gamma)
     dev = s.developability()
     assert dev.theta_max <= ROUND_OFF_DEG, dev
-    assert dev.residual_max <= ROUND_OFF_RES, dev
+    u = ght_cad.ruled._theta_parameters(64, 257)       # the parameters developability() samples
+    a1, g1, b1 = s.a(u, 1), s.ruling(u, 1), s.b(u, 1)
+    floor = 256 * np.finfo(float).eps * (1 + (np.linalg.norm(a1, axis=1) + np.linalg.norm(b1, axis=1)) / np.linalg.norm(g1, axis=1))
+    assert np.all(np.abs(s.developability_residual(u)) <= floor), dev
+    assert dev.residual_max <= floor.max(), dev
     # the tangent plane is constant along each ruling (normals at v = 0, 0.5, 1 agree)
     u = np.linspace(0, 1, 17)
     n0, n1, n2 = (s.normal(u, v) for v in (0.0, 0.5, 1.0))

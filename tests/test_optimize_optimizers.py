@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from ght_cad.errors import GHTError
-from ght_cad.optimize import METHODS, OptimizeResult, differential_evolution, gwo, igwo, minimize, pso, vectorize
+from ght_cad.optimize import METHODS, OptimizeResult, as_bounds, differential_evolution, gwo, igwo, minimize, pso, vectorize
 
 
 def sphere(X: np.ndarray) -> np.ndarray:
@@ -182,8 +182,8 @@ def test_minimize_dispatch_and_errors():
         minimize(sphere, box(2, 1.0), method="bfgs")
     with pytest.raises(GHTError, match="lb=1 >= ub=0"):
         pso(sphere, (np.array([0.0, 1.0]), np.array([1.0, 0.0])))
-    with pytest.raises(GHTError, match="pairs"):
-        pso(sphere, [(0, 1), (0, 1), (0, 1)])
+    with pytest.raises(GHTError, match="shape"):
+        pso(sphere, [(0, 1, 2), (0, 1, 2), (0, 1, 2)])
     with pytest.raises(GHTError, match="pop_size=2"):
         gwo(sphere, box(2, 1.0), pop_size=2)
     with pytest.raises(GHTError, match="max_nfev=3"):
@@ -315,7 +315,13 @@ def test_box_whose_width_overflows_is_refused():
         pso(sphere, ([-1e308, 0.0], [1e308, 1.0]), max_iter=1)
 
 
-def test_two_low_high_pairs_get_a_hint():
-    """[(0, 1), (0, 1)] reads as lb = (0, 1), ub = (0, 1): the error says how bounds are given."""
-    with pytest.raises(GHTError, match=r"lb=0 >= ub=0; need lb < ub \(bounds are \(lb, ub\)"):
-        pso(sphere, [(0, 1), (0, 1)], max_iter=1)
+def test_low_high_pairs_are_read_as_scipy_reads_them():
+    """[(0, 1), (0, 1)] is not a box as (lb, ub) (lb = ub): it is read as scipy's (low, high) pairs;
+    (dim, 2) pairs likewise; a 2 x 2 that is a box under both readings, different ones, is refused."""
+    assert [b.tolist() for b in as_bounds([(0, 1), (0, 1)])] == [[0.0, 0.0], [1.0, 1.0]]
+    assert [b.tolist() for b in as_bounds([(0, 1), (-2, 1), (0, 5)])] == [[0.0, -2.0, 0.0], [1.0, 1.0, 5.0]]
+    assert [b.tolist() for b in as_bounds((np.array([0.0, 1.0]), np.array([2.0, 3.0])))] == [[0.0, 1.0], [2.0, 3.0]]
+    with pytest.raises(GHTError, match=r"ambiguous: as \(lb, ub\) the box is lb=\[0.0, 1.0\], ub=\[2.0, 3.0\]"):
+        pso(sphere, [(0, 1), (2, 3)], max_iter=1)
+    with pytest.raises(GHTError, match=r"lb=1 >= ub=0; need lb < ub \(bounds are \(lb, ub\)"):
+        pso(sphere, [(1, 1), (0, 0)], max_iter=1)

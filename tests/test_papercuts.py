@@ -71,3 +71,70 @@ print("ok")
     for first in ("import ght_cad", "import ght_cad.unroll", "from ght_cad.unroll import unroll"):
         out = subprocess.run([sys.executable, "-c", first + "\n" + code], capture_output=True, text=True, cwd=root)
         assert out.returncode == 0 and out.stdout.strip() == "ok", (first, out.stderr[-2000:])
+
+
+README_CONE = """
+name = "readme-cone"
+units = "mm"
+
+[surface]
+type = "planes"
+planes = [[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]]
+boundary_planes = [[0, 0, 0, 1], [-400, 0, 0, 1]]
+gamma = -1.0
+"""
+
+
+def test_design_files_and_api_share_one_normalize_default():
+    """The README's cone planes copied into a design file give the README's surface: the exact
+    quarter cone frustum (area in closed form), not the +3.3 % non-conical one of unit normals."""
+    from ght_cad.design import build_surface, parse_design_text, surface_area
+
+    api = ght_cad.developable_from_planes(PLANES, CUTS, gamma=-1)
+    design = parse_design_text(README_CONE, "readme-cone.toml")
+    assert design.surface.normalize is False
+    built = build_surface(design).surface
+    # quarter frustum of the cone x^2 + y^2 = ((800 - z) / 2)^2: radii 400 and 200, height 400
+    r1, r2, h = 400.0, 200.0, 400.0
+    exact = 0.25 * np.pi * (r1 + r2) * np.hypot(r1 - r2, h)
+    assert surface_area(built) == pytest.approx(exact, rel=1e-12)
+    assert surface_area(api) == pytest.approx(exact, rel=1e-12)
+    from pathlib import Path
+
+    example = (Path(__file__).resolve().parents[1] / "examples" / "design_duct_two_strips.toml").read_text()
+    assert "\nnormalize = false" in example
+    comp = parse_design_text(example.replace("\nnormalize = false", "\n"), "two-strips-without-normalize.toml")
+    assert comp.surface.normalize is False
+
+
+def test_minimize_takes_scalar_objectives_and_scipy_bounds():
+    """scipy users pass f(x) -> float and a list of (low, high) pairs or scipy.optimize.Bounds;
+    ght_cad.optimize.minimize accepts those as well as population objectives and (lb, ub)."""
+    from scipy.optimize import Bounds, rosen
+
+    from ght_cad.errors import GHTError
+    from ght_cad.optimize import minimize
+
+    target = np.array([0.3, -0.2, 0.5])
+
+    def scalar(x):                      # one point (dim,) -> float, as for scipy.optimize.minimize
+        return float(np.sum((np.asarray(x) - target) ** 2))
+
+    def population(X):
+        return np.sum((X - target) ** 2, axis=1)
+
+    pairs = [(-1.0, 1.0)] * 3
+    for fun in (scalar, population):
+        for bounds in (pairs, Bounds([-1.0] * 3, [1.0] * 3), (np.full(3, -1.0), np.full(3, 1.0)), np.array(pairs)):
+            for method in ("hybrid", "pso"):
+                r = minimize(fun, bounds, method, seed=0, **({"max_iter": 60} if method == "pso" else {}))
+                assert np.allclose(r.x, target, atol=1e-3 if method == "pso" else 1e-6), (fun.__name__, bounds, method, r.x)
+    r = minimize(rosen, [(-2, 2), (-2, 2)], seed=0)                    # scipy's own scalar objective
+    assert np.allclose(r.x, [1.0, 1.0], atol=1e-4)
+    r = minimize(scalar, [(-1, 1)] * 3, vectorized=False, seed=0)     # the kind can be given
+    assert r.fun < 1e-12
+    # two pairs that also read as (lb, ub) and give another box: refused, not guessed
+    with pytest.raises(GHTError, match="ambiguous"):
+        minimize(scalar, [(0.0, 1.0), (2.0, 3.0)])
+    # one reading valid: taken
+    assert minimize(lambda x: float(np.sum(x**2)), [(0.5, 1.0), (0.5, 1.0)], seed=0).fun == pytest.approx(0.5, abs=1e-9)

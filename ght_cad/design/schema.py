@@ -135,7 +135,7 @@ class SurfaceSpec:
     gamma: float = 0.0
     curve_a: str | None = None
     curve_b: str | None = None
-    normalize: bool = True
+    normalize: bool = False
     segments: list[SegmentSpec] | None = None
     orientation: str = "auto"
     name: str | None = None
@@ -674,7 +674,7 @@ def _parse_surface(ck: _Checker, st: dict, path: str, curves: list[CurveSpec]) -
                 if math.hypot(*r[1:]) < 1e-12:
                     raise ck.fail(f"{path}.{key}[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
         shape = {k: ck.number(st, k, path, 0.0, lo=-1.0, hi=1.0) for k in SHAPE_NAMES}
-        normalize = ck.boolean(st, "normalize", path, True)
+        normalize = ck.boolean(st, "normalize", path, False)
         return SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
     if stype == "composite":
         return _parse_composite(ck, st, path, extra)
@@ -737,7 +737,7 @@ def _parse_composite(ck: _Checker, st: dict, path: str = "surface", extra: tuple
         if math.hypot(*r[1:]) < 1e-12:
             raise ck.fail(f"{path}.boundary_planes[{i}]", f"{r} has a zero normal (u1, u2, u3); allowed: a plane "
                           "u0 + u1 x + u2 y + u3 z = 0 with a non-zero normal")
-    normalize = ck.boolean(st, "normalize", path, True)
+    normalize = ck.boolean(st, "normalize", path, False)
     raw = ck.required(st, "segments", path, f"an array of at least 2 tables [[{path}.segments]]")
     if not isinstance(raw, list) or not all(isinstance(x, dict) for x in raw):
         raise ck.fail(f"{path}.segments", f"expected an array of tables [[{path}.segments]], got {_tname(raw)} {_short(raw)}")

@@ -151,56 +151,91 @@ def as_generator(seed: Any) -> np.random.Generator:
     raise GHTError(f"seed={seed!r} is not allowed; use None, an int >= 0 or a numpy.random.Generator")
 
 
+def _check_box(lb: np.ndarray, ub: np.ndarray, form: str) -> str | None:
+    """Why ``lb``/``ub`` are not a box (None: they are), in the words of ``form``."""
+    if not (np.all(np.isfinite(lb)) and np.all(np.isfinite(ub))):
+        return f"bounds lb={lb.tolist()} ub={ub.tolist()} contain non-finite values; a finite box is required"
+    bad = np.nonzero(lb >= ub)[0]
+    if bad.size:
+        i = int(bad[0])
+        return f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub ({form})"
+    with np.errstate(over="ignore"):
+        wide = np.nonzero(~np.isfinite(ub - lb))[0]
+    if wide.size:
+        i = int(wide[0])
+        return f"bounds component {i}: the width ub - lb = {ub[i]:g} - ({lb[i]:g}) overflows; use a finite box"
+    return None
+
+
+_FORMS = "bounds are (lb, ub), two arrays of length dim, or a list of (low, high) pairs"
+
+
 def as_bounds(bounds: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bound arrays from ``(lb, ub)`` or an object with ``.lb``/``.ub``.
+    """Lower and upper bound arrays from ``(lb, ub)``, scipy-style ``(low, high)`` pairs or an
+    object with ``.lb``/``.ub``.
 
     Args:
-        bounds: a pair ``(lb, ub)`` of equal-length 1-D array-likes (scalars allowed for
-            dim 1), or e.g. ``scipy.optimize.Bounds``.
+        bounds: one of
+            * ``(lb, ub)``: two equal-length 1-D array-likes (scalars allowed for dim 1);
+            * a sequence of ``dim`` pairs ``(low, high)`` (scipy's ``minimize``/``differential_evolution``
+              form), e.g. ``[(-1, 1)] * 3``;
+            * ``scipy.optimize.Bounds`` (anything with ``.lb`` and ``.ub``).
+
+            Shape ``(2, dim)`` reads as ``(lb, ub)`` and ``(dim, 2)`` as pairs; a 2 x 2 that is a
+            box either way is ``(lb, ub)`` when given as two numpy arrays, the same box under
+            both readings, or refused as ambiguous (pass ``scipy.optimize.Bounds`` then).
 
     Returns:
         ``(lb, ub)`` as float arrays of shape (dim,), with ``lb < ub`` componentwise.
 
     Raises:
-        GHTError: wrong shape, non-finite values, ``lb >= ub`` or a width ``ub - lb`` that
-            overflows.
+        GHTError: wrong shape, non-finite values, ``lb >= ub``, a width ``ub - lb`` that
+            overflows, or an ambiguous 2 x 2.
     """
     if hasattr(bounds, "lb") and hasattr(bounds, "ub"):
         lb, ub = bounds.lb, bounds.ub
-    else:
         try:
-            lb, ub = bounds
+            lb = np.atleast_1d(np.asarray(lb, dtype=float))
+            ub = np.atleast_1d(np.asarray(ub, dtype=float))
         except (TypeError, ValueError):
-            shape = np.shape(bounds) if not isinstance(bounds, str) else "str"
-            raise GHTError(
-                f"bounds with shape {shape} are not allowed; pass (lb, ub), two arrays of the same length "
-                "(not a list of (low, high) pairs)"
-            ) from None
-    try:
-        lb = np.atleast_1d(np.asarray(lb, dtype=float))
-        ub = np.atleast_1d(np.asarray(ub, dtype=float))
-    except (TypeError, ValueError):
-        raise GHTError(f"bounds={bounds!r} are not numeric; pass (lb, ub), two arrays of numbers") from None
-    if lb.ndim != 1 or ub.shape != lb.shape:
-        raise GHTError(
-            f"bounds have lb shape {lb.shape} and ub shape {ub.shape}; pass (lb, ub) as two 1-D arrays "
-            "of the same length (not a list of (low, high) pairs)"
-        )
-    if lb.size == 0:
+            raise GHTError(f"bounds={bounds!r} are not numeric; {_FORMS}") from None
+        if lb.ndim != 1 or ub.shape != lb.shape:
+            raise GHTError(f"bounds have lb shape {lb.shape} and ub shape {ub.shape}; {_FORMS}")
+        readings = [("(lb, ub)", lb, ub)]
+    else:
+        arrays = isinstance(bounds, (list, tuple)) and len(bounds) == 2 and all(isinstance(b, np.ndarray) for b in bounds)
+        try:
+            A = np.asarray(bounds, dtype=float)
+        except (TypeError, ValueError):
+            shape = "str" if isinstance(bounds, str) else None
+            if shape is None:
+                try:
+                    shape = np.shape(bounds)
+                except ValueError:
+                    shape = "ragged"
+            raise GHTError(f"bounds with shape {shape} are not allowed; {_FORMS}") from None
+        readings = []
+        if A.ndim == 1 and A.size == 2:
+            readings.append(("(lb, ub)", A[:1], A[1:]))
+        elif A.ndim == 2 and A.shape[0] == 2:
+            readings.append(("(lb, ub)", A[0], A[1]))
+        if A.ndim == 2 and A.shape[1] == 2 and not arrays and A.shape[0] >= 1:
+            readings.append(("(low, high) pairs", A[:, 0], A[:, 1]))
+        if not readings:
+            raise GHTError(f"bounds with shape {A.shape} are not allowed; {_FORMS}")
+    if readings[0][1].size == 0:
         raise GHTError("bounds are empty; at least one parameter is needed")
-    if not (np.all(np.isfinite(lb)) and np.all(np.isfinite(ub))):
-        raise GHTError(f"bounds lb={lb.tolist()} ub={ub.tolist()} contain non-finite values; a finite box is required")
-    bad = np.nonzero(lb >= ub)[0]
-    if bad.size:
-        i = int(bad[0])
-        raise GHTError(f"bounds component {i}: lb={lb[i]:g} >= ub={ub[i]:g}; need lb < ub "
-                       "(bounds are (lb, ub), two arrays of length dim, not a list of (low, high) pairs)")
-    with np.errstate(over="ignore"):
-        wide = np.nonzero(~np.isfinite(ub - lb))[0]
-    if wide.size:
-        i = int(wide[0])
-        raise GHTError(f"bounds component {i}: the width ub - lb = {ub[i]:g} - ({lb[i]:g}) overflows; use a finite box")
-    return lb, ub
+    valid = [(name, lb, ub) for name, lb, ub in readings if _check_box(lb, ub, _FORMS) is None]
+    if not valid:
+        raise GHTError(str(_check_box(readings[0][1], readings[0][2], _FORMS)))
+    if len(valid) == 2 and not (np.array_equal(valid[0][1], valid[1][1]) and np.array_equal(valid[0][2], valid[1][2])):
+        raise GHTError(
+            f"bounds={np.asarray(bounds).tolist()} are ambiguous: as (lb, ub) the box is "
+            f"lb={valid[0][1].tolist()}, ub={valid[0][2].tolist()}; as (low, high) pairs it is "
+            f"lb={valid[1][1].tolist()}, ub={valid[1][2].tolist()}; pass scipy.optimize.Bounds(lb, ub) "
+            "or (lb, ub) as two numpy arrays"
+        )
+    return valid[0][1].copy(), valid[0][2].copy()
 
 
 def vectorize(fun: Callable[[np.ndarray], float]) -> Callable[[np.ndarray], np.ndarray]:
@@ -1105,15 +1140,38 @@ METHODS: dict[str, Callable[..., OptimizeResult]] = {
 }
 
 
-def minimize(fun: Objective, bounds: Any, method: str = "hybrid", **options: Any) -> OptimizeResult:
-    """Minimize a population objective with the optimizer ``method`` (``hybrid``, ``pso``, ``gwo``, ``igwo``, ``de``).
+def _is_scalar_objective(fun: Any, lb: np.ndarray, ub: np.ndarray) -> bool:
+    """True when ``fun`` takes one point ``(dim,)`` and returns one number (scipy's ``f(x)``).
+
+    Probe: one call at the box centre with a 1-D point (not counted in ``nfev``). A population
+    objective ``F(X: (pop, dim))`` either fails on a 1-D array or returns an array; an objective
+    with ``value_and_grad`` is a population problem.
+    """
+    if hasattr(fun, "value_and_grad"):
+        return False
+    try:
+        out = fun(0.5 * (lb + ub))
+    except Exception:  # noqa: BLE001 - a population objective refusing a 1-D array
+        return False
+    return np.ndim(out) == 0
+
+
+def minimize(fun: Objective, bounds: Any, method: str = "hybrid", *, vectorized: bool | None = None,
+             **options: Any) -> OptimizeResult:
+    """Minimize an objective over a box with the optimizer ``method`` (``hybrid``, ``pso``, ``gwo``, ``igwo``, ``de``).
 
     Args:
-        fun: population objective ``f(X) -> (pop,)`` (with ``fun.value_and_grad`` the default
-            ``hybrid`` uses exact gradients, else finite differences).
-        bounds: ``(lb, ub)``.
+        fun: population objective ``F(X: (pop, dim)) -> (pop,)`` (with ``fun.value_and_grad`` the
+            default ``hybrid`` uses exact gradients, else finite differences), or a scalar
+            objective ``f(x: (dim,)) -> float`` as for ``scipy.optimize.minimize`` (evaluated
+            point by point through :func:`vectorize`, ``F(X)_k = f(X_k)``).
+        bounds: ``(lb, ub)``, a list of ``(low, high)`` pairs or ``scipy.optimize.Bounds``
+            (:func:`as_bounds`).
         method: optimizer name (case-insensitive; ``"i-gwo"`` is accepted for ``"igwo"``); the
             default ``"hybrid"`` is Sobol' starts + L-BFGS-B finishes (:func:`hybrid`).
+        vectorized: True: ``fun`` is a population objective; False: a scalar one; None (default):
+            told apart by one call at the box centre with a 1-D point (a scalar result means
+            scalar; an exception or an array means population; not counted in ``nfev``).
         **options: passed on (``pop_size``, ``max_iter``, ``max_nfev``, ``tol``, ``target``,
             ``seed``, ``callback``, ``x0``, method-specific options).
 
@@ -1121,10 +1179,17 @@ def minimize(fun: Objective, bounds: Any, method: str = "hybrid", **options: Any
         OptimizeResult.
 
     Raises:
-        GHTError: unknown method name, or any error of the chosen optimizer.
+        GHTError: unknown method name, bad bounds, or any error of the chosen optimizer.
     """
     key = str(method).lower().replace("-", "").replace("_", "")
     key = {"differentialevolution": "de"}.get(key, key)
     if key not in METHODS:
         raise GHTError(f"method={method!r} is unknown; choose one of {', '.join(METHODS)}")
-    return METHODS[key](fun, bounds, **options)
+    if vectorized not in (None, True, False):
+        raise GHTError(f"vectorized={vectorized!r} is not allowed; use None (detect), True (population) or False (f(x))")
+    if not callable(fun):
+        raise GHTError(f"fun={fun!r} is not callable; pass F(X: (pop, dim)) -> (pop,) or f(x: (dim,)) -> float")
+    lb, ub = as_bounds(bounds)
+    if vectorized is False or (vectorized is None and _is_scalar_objective(fun, lb, ub)):
+        fun = vectorize(fun)
+    return METHODS[key](fun, (lb, ub), **options)
