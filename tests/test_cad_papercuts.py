@@ -54,3 +54,109 @@ def test_cadquery_bezier_takes_numpy_points(dtype):
     exact = GHTCurve(POINTS, mu=0.25).arc_length()
     edge = cq.Workplane("XY").ghtBezier(np.array(POINTS, dtype=dtype), mu=np.float32(0.25)).val()
     assert edge.Length() == pytest.approx(exact, rel=1e-7)
+
+
+# -- transformed shapes carry transformed (or no) ght metadata -------------------------------
+def _edge_points(edge, t):
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    ad = BRepAdaptor_Curve(edge.wrapped)
+    return np.array([[p.X(), p.Y(), p.Z()] for p in (ad.Value(float(x)) for x in t)])
+
+
+def _xyz(p):
+    p = np.atleast_2d(p)
+    return np.hstack([p, np.zeros((p.shape[0], 3 - p.shape[1]))])
+
+
+def _moves():
+    from build123d import Axis, Location, Plane
+
+    return {
+        "moved": (lambda e: e.moved(Location((3, -2, 5), (1, 1, 0), 30)), 1.0),
+        "rotate": (lambda e: e.rotate(Axis.Z, 40), 1.0),
+        "rotate transform": (lambda e: e.rotate(Axis.X, 25, transform=True), 1.0),
+        "translate": (lambda e: e.translate((1, 2, 3)), 1.0),
+        "mirror": (lambda e: e.mirror(Plane.YZ), 1.0),
+        "scale": (lambda e: e.scale(2.5), 2.5),
+        "located": (lambda e: e.located(Location((0, 0, 7), (0, 0, 1), 90)), 1.0),
+        "Location *": (lambda e: Location((4, 0, 0), (0, 1, 0), 15) * e, 1.0),
+        "locate in place": (lambda e: e.locate(Location((1, 1, 1))), 1.0),
+    }
+
+
+@pytest.mark.parametrize("make", ["GHTBezierLine 2-D", "ght_edge 3-D"])
+def test_moved_edges_carry_their_transformed_curve_and_bspline(make):
+    """A moved/rotated/mirrored/scaled ght edge used to keep the untransformed ght_bspline and
+    ght_curve: now both describe the edge where it is, with the deviation scaled."""
+    from ght_cad.bspline import BSplineCurveData
+    from ght_cad.cad.curves import ght_edge
+
+    curve = (GHTCurve([(0, 0), (4, 3), (8, 0)], mu=0.3, gamma=-0.5) if make.startswith("GHTBezier")
+             else GHTCurve([(0, 0, 0), (4, 3, 1), (8, 0, 2), (9, 4, 0)], mu=0.3, nu=-0.4, gamma=0.2))
+    edge = GHTBezierLine(curve) if make.startswith("GHTBezier") else ght_edge(curve)
+    if make.startswith("GHTBezier"):
+        assert edge.ght_curve is curve
+    data0 = edge.ght_bspline
+    t = np.linspace(0, 1, 33)
+    for name, (move, s) in _moves().items():
+        work = GHTBezierLine(curve) if name == "locate in place" and make.startswith("GHTBezier") else (
+            ght_edge(curve) if name == "locate in place" else edge)
+        moved = move(work)
+        pts = _edge_points(moved, t)                        # edge parameter = curve parameter t
+        data = moved.ght_bspline
+        assert isinstance(data, BSplineCurveData)
+        assert data.max_deviation == pytest.approx(s * data0.max_deviation, rel=1e-12), name
+        assert np.abs(_xyz(data.evaluate(t)) - pts).max() <= 1e-9 * s * 10, name     # the edge's own B-spline
+        if make.startswith("GHTBezier"):
+            assert np.abs(_xyz(moved.ght_curve.evaluate(t)) - pts).max() <= data.max_deviation * (1 + 1e-6), name
+        if name != "locate in place":                        # the original is untouched
+            assert edge.ght_bspline is data0
+    assert copy_of(edge).ght_bspline is data0
+
+
+def copy_of(shape):
+    import copy
+
+    return copy.copy(shape)
+
+
+def test_nonuniform_scale_drops_the_metadata_and_loft_drops_its_core_object():
+    from build123d import Axis, Edge, Location
+
+    from ght_cad.cad.curves import ght_edge
+    from ght_cad.cad.loft import developable_loft
+
+    e = ght_edge(GHTCurve([(0, 0, 0), (4, 3, 1), (8, 0, 2)], mu=0.3))
+    squashed = e.scale((1.0, 2.0, 0.5))
+    assert getattr(squashed, "ght_bspline", None) is None
+    with pytest.raises(AttributeError, match="ght_bspline"):
+        squashed.ght_bspline
+    inlet = Edge.make_circle(100, start_angle=0, end_angle=180)
+    outlet = Edge.make_circle(60, start_angle=0, end_angle=180).moved(Location((0, 0, 150)))
+    half = developable_loft(inlet, outlet)
+    assert half.ght_loft is not None and half.ght_max_deviation > 0
+    turned = half.rotate(Axis.Z, 90)
+    assert getattr(turned, "ght_loft", None) is None                     # a core object in the old place
+    assert turned.ght_max_deviation == half.ght_max_deviation
+    grown = half.scale(2.0)
+    assert grown.ght_max_deviation == pytest.approx(2 * half.ght_max_deviation, rel=1e-12)
+    P = np.vstack([d.poles.reshape(-1, 3) for d in turned.ght_bspline])
+    P0 = np.vstack([d.poles.reshape(-1, 3) for d in half.ght_bspline])
+    np.testing.assert_allclose(P[:, :2], np.c_[-P0[:, 1], P0[:, 0]], atol=1e-9 * 200)
+
+
+def test_cadquery_loft_metadata_follows_in_place_moves():
+    import cadquery
+
+    from ght_cad.cad.cq_plugin import developable_loft_cq
+
+    a = cadquery.Edge.makeCircle(100, angle1=0, angle2=180)
+    b = cadquery.Edge.makeCircle(60, pnt=cadquery.Vector(0, 0, 150), angle1=0, angle2=180)
+    shell = developable_loft_cq(a, b)
+    dev = shell.ght_max_deviation
+    shell.move(cadquery.Location(cadquery.Vector(0, 0, 10)))        # in place: the attributes stay on it
+    assert shell.ght_max_deviation == dev
+    assert getattr(shell, "ght_loft", None) is None
+    z = np.vstack([d.poles.reshape(-1, 3) for d in shell.ght_bspline])[:, 2]
+    assert z.min() == pytest.approx(10.0, abs=1e-9) and z.max() == pytest.approx(160.0, abs=1e-6)

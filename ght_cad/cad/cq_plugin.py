@@ -173,10 +173,10 @@ def developable_loft_cq(rail_a: Any, rail_b: Any, **options: Any) -> Any:
 
     shape = developable_loft(rail_a, rail_b, mode=Mode.PRIVATE, **options)
     out = cq.Shell(shape.wrapped) if shape.wrapped.ShapeType().name == "TopAbs_SHELL" else cq.Face(shape.wrapped)
-    out.ght_loft = shape.ght_loft
-    out.ght_bspline = shape.ght_bspline
-    out.ght_max_deviation = shape.ght_max_deviation
-    return out
+    from .certified import certify
+
+    return certify(out, ght_loft=shape.ght_loft, ght_bspline=shape.ght_bspline,
+                   ght_max_deviation=shape.ght_max_deviation)
 
 
 def developableLoft(self: "cq.Workplane", rail_a: Any = None, rail_b: Any = None, **options: Any) -> "cq.Workplane":

@@ -5,7 +5,8 @@ Every shape holds a *certified* B-spline (:func:`ght_cad.bspline.curve_to_bsplin
 matched parameters below ``tol`` (default ``1e-7 ×`` bounding-box diagonal), parametrization kept
 (the edge's parameter is the curve's t ∈ [0, 1]) and end derivatives up to order
 ``min(3, degree-1)`` exact, so G2/G3 joints stay G2/G3 in the B-rep. The conversion record is
-attached as ``shape.ght_bspline``.
+attached as ``shape.ght_bspline``; it follows the shape when the shape is moved, rotated, mirrored
+or scaled, and is dropped when the shape's geometry changes otherwise (:mod:`ght_cad.cad.certified`).
 
 Algebra mode: :func:`ght_edge`, :func:`ght_wire`, :func:`ght_face` return plain build123d shapes.
 Builder mode: :class:`GHTBezierLine` (an Edge) and :class:`GHTCompositeLine` (a Wire) add
@@ -38,6 +39,7 @@ from ..bspline import BSplineCurveData, curve_to_bspline
 from ..curve import GHTCurve
 from ..errors import GHTError
 from ..patch import GHTSurface
+from .certified import certified, certify
 from .occ import geom_bspline_curve, make_face
 
 __all__ = [
@@ -160,9 +162,7 @@ def ght_edge(curve: GHTCurve, tol: float | None = None, degree: int = 5) -> Edge
         GHTError: not a 2-D/3-D GHTCurve, bad tol; ConversionError: unreachable tol.
     """
     data = curve_to_bspline(_as_curve(curve), tol, degree)
-    edge = Edge(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge())
-    edge.ght_bspline = data
-    return edge
+    return certify(Edge(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge()), ght_bspline=data)
 
 
 def _wire_edges(curves: Any, tol: float | None, degree: int, closed: bool | None) -> tuple[Any, list[BSplineCurveData]]:
@@ -230,9 +230,7 @@ def ght_wire(
         GHTError: gaps between segments, a requested closure that does not close, bad input.
     """
     w, datas = _wire_edges(curves, tol, degree, closed)
-    wire = Wire(w)
-    wire.ght_bspline = datas
-    return wire
+    return certify(Wire(w), ght_bspline=datas)
 
 
 def ght_face(patch: GHTSurface, tol: float | None = None, degree: int = 5) -> Face:
@@ -249,9 +247,7 @@ def ght_face(patch: GHTSurface, tol: float | None = None, degree: int = 5) -> Fa
     if patch.dim != 3:
         raise GHTError(f"a CAD face needs a 3-D patch; this patch has dim={patch.dim}")
     data = patch.to_bspline(tol, degree)
-    face = make_face(data)
-    face.ght_bspline = data
-    return face
+    return certify(make_face(data), ght_bspline=data)
 
 
 def ght_shape(obj: Any, tol: float | None = None, degree: int = 5) -> Any:
@@ -327,6 +323,7 @@ def _points(pts: Sequence[Any]) -> np.ndarray:
     return np.array([_point(p) for p in flat], dtype=float)
 
 
+@certified
 class GHTBezierLine(BaseEdgeObject):
     r"""Line object: a GHT-Bézier curve ``P(t) = Σ b_{i,m}(t; μ,ν,γ) P_i`` as one certified edge.
 
@@ -369,6 +366,7 @@ class GHTBezierLine(BaseEdgeObject):
         self.ght_bspline = edge.ght_bspline
 
 
+@certified
 class GHTCompositeLine(BaseLineObject):
     r"""Line object: a chain of GHT segments (CompositeCurve or list of GHTCurves) as one Wire.
 

@@ -283,10 +283,10 @@ def loft_shape(loft: Any, *, tol: float | None = None, degree: int = 5, sew_tol:
             shape = Face(TopoDS.Face_s(sewn))
         else:
             shape = sew_shell(faces, stol, len(faces) - 1 + (1 if closed else 0))
-    shape.ght_loft = loft
-    shape.ght_bspline = datas
-    shape.ght_max_deviation = max(float(d.max_deviation or 0.0) for d in datas)
-    return shape
+    from .certified import certify
+
+    return certify(shape, ght_loft=loft, ght_bspline=datas,
+                   ght_max_deviation=max(float(d.max_deviation or 0.0) for d in datas))
 
 
 def developable_loft(
