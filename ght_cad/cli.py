@@ -338,9 +338,18 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     design = load_design(args.design)
     out = args.out if args.out is not None else Path(args.design).with_suffix("").name + "-out"
-    report = run_design(design, out, progress=not args.no_progress, **_wait_args(args))
+    report = run_design(design, out, progress=not args.no_progress, chord_tol=_chord_tol(args), **_wait_args(args))
     _emit(args, {"command": "run", **report}, _report_text)
     return EXIT_OK
+
+
+def _chord_tol(args: argparse.Namespace) -> float | None:
+    """``--chord-tol`` (None: the pattern's default, 1e-3 mm in its unit); refused unless > 0."""
+    tol = getattr(args, "chord_tol", None)
+    if tol is not None and not (tol > 0 and math.isfinite(tol)):
+        raise UsageError(f"--chord-tol={tol!r} is not allowed; allowed: a positive length in the pattern's units "
+                         "(default 1e-3 mm)")
+    return tol
 
 
 def _wait_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -500,7 +509,9 @@ def _write_pattern(args: argparse.Namespace, pattern: Any, title: str) -> dict[s
     if args.forming_png and pattern.sheet is None:
         raise UsageError(f"--forming-png needs a sheet thickness (no thickness was given for {title}); "
                          "allowed: with --thickness, --k-factor on a plate solid, or a design's [sheet] table")
-    return _write_staged([("dxf", args.dxf, pattern.export_dxf), ("svg", args.svg, pattern.export_svg),
+    tol = _chord_tol(args)
+    return _write_staged([("dxf", args.dxf, lambda path: pattern.export_dxf(path, chord_tol=tol)),
+                          ("svg", args.svg, lambda path: pattern.export_svg(path, chord_tol=tol)),
                           ("png", args.png, lambda path: plot_pattern(pattern, path, title=title)),
                           ("forming_png", args.forming_png, lambda path: pattern.plot_roll_chart(path, title=title))])
 
@@ -630,7 +641,7 @@ def cmd_export(args: argparse.Namespace) -> int:
                 f"cannot export to {f!r}: unknown suffix {Path(f).suffix!r}; allowed: {', '.join(_EXPORT_SUFFIXES)}"
             )
     design = _load(args)
-    written = export_files(design, args.files)
+    written = export_files(design, args.files, chord_tol=_chord_tol(args))
     result = {"command": "export", "name": design.name, "outputs": written}
     _emit(args, result, lambda r: "\n".join(f"wrote {v}" for v in r["outputs"].values()))
     return EXIT_OK
@@ -659,6 +670,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     def common(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("--json", action="store_true", help="print the result as one JSON object on stdout")
+
+    def chord_tol_arg(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--chord-tol", type=float, metavar="TOL",
+                        help="DXF/SVG outlines: largest distance between a curved edge and the arcs written for "
+                             "it, in the pattern's units (default 1e-3 mm; straight and circular edges are exact)")
 
     def design_arg(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("design", metavar="DESIGN.toml", help="design file (schema: docs/design-files.md)")
@@ -694,6 +710,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="output folder (default: <DESIGN file name without .toml>-out in the current folder)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     add_wait_options(sp)
+    chord_tol_arg(sp)
     common(sp)
     sp.set_defaults(func=cmd_run)
 
@@ -788,6 +805,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="STEP only: unroll the faces in N local processes (default 1; panels identical to serial)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="STEP only: unroll the faces on a dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
+    chord_tol_arg(sp)
     common(sp)
     sp.set_defaults(func=cmd_unroll)
 
@@ -801,6 +819,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     design_arg(sp)
     sp.add_argument("files", nargs="+", metavar="FILE", help="output files (.step .stp .dxf .svg .json .png)")
+    chord_tol_arg(sp)
     common(sp)
     sp.set_defaults(func=cmd_export)
 

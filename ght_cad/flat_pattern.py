@@ -45,6 +45,8 @@ __all__ = [
     "shared_edge_pairs",
     "INSUNITS",
     "SVG_UNITS",
+    "CHORD_TOL_MM",
+    "default_chord_tol",
 ]
 
 #: DXF $INSUNITS codes
@@ -66,6 +68,15 @@ _MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
 
 #: SVG stroke width of every line at true scale, millimetres
 SVG_STROKE_MM = 0.25
+
+#: default chord tolerance of the DXF/SVG outlines, millimetres (converted to the pattern's unit)
+CHORD_TOL_MM = 1e-3
+
+
+def default_chord_tol(units: str) -> float:
+    """The default outline chord tolerance in ``units``: ``CHORD_TOL_MM / (mm per unit)`` (1 µm;
+    a unitless pattern: 1e-3)."""
+    return CHORD_TOL_MM / _MM_PER_UNIT.get(units, 1.0)
 
 _ROMBERG_N = 128
 #: relative |R2 - R| below which the outline samples' Romberg length is accepted (BoundaryEdge.measure)
@@ -400,6 +411,47 @@ class FlatPanel:
     forming_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     report: DistortionReport | None = None
     area_flat: float = float("nan")
+    _arcs: dict[float, list[tuple[np.ndarray, np.ndarray, list[str]]]] = field(
+        default_factory=dict, init=False, repr=False, compare=False)
+
+    def loop_arcs(self, chord_tol: float) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
+        """Closed loops as lines and circular arcs (:mod:`ght_cad.outline_arcs`), offset applied.
+
+        Every boundary edge becomes an :class:`~ght_cad.outline_arcs.ArcChain`: one exact line or
+        arc when its development is one (within ``1e-12`` of the panel's size), else arcs through
+        three points of the exact edge within ``chord_tol`` of it. Corners are the development's
+        edge end points.
+
+        Args:
+            chord_tol: largest distance between the exact flat edges and the written arcs (the
+                pattern's units).
+
+        Returns:
+            Per loop ``(points (n, 2), bulges (n,), kinds)``: segment ``i`` runs from
+            ``points[i]`` to ``points[i + 1 mod n]`` with DXF bulge ``bulges[i]`` (``tan(θ/4)``,
+            θ the signed sweep, 0 straight); ``kinds`` the edges' kinds ("line", "arc", "arcs",
+            "curve", "point").
+        """
+        from .outline_arcs import arc_chain
+
+        key = float(chord_tol)
+        if key not in self._arcs:
+            lo, hi = self.bbox()
+            size = float(np.max(hi - lo))
+            loops = []
+            for loop in self.loops:
+                pts, bul, kinds = [], [], []
+                for e in loop:
+                    grid = e.flat if e.flat.shape[0] == e.samples and not e.breaks else None
+                    ch = arc_chain(e.flat_fn, key, size, e.breaks, grid)
+                    kinds.append(ch.kind)
+                    if ch.bulges.size:  # a zero-length edge adds no segment
+                        pts.append(ch.points[:-1])
+                        bul.append(ch.bulges)
+                if bul:
+                    loops.append((np.concatenate(pts), np.concatenate(bul), kinds))
+            self._arcs[key] = loops
+        return [(p + self.offset, b, k) for p, b, k in self._arcs[key]]
 
     def loop_polylines(self) -> list[np.ndarray]:
         """Closed loops as (n, 2) arrays (last point not repeated), offset applied."""
@@ -806,6 +858,63 @@ def mark_shared_edges(panels: Sequence[FlatPanel], rel_tol: float = 1e-5) -> int
     return len(pairs)
 
 
+def arcs_to_rational_quadratic(points: np.ndarray, bulges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A closed chain of lines and arcs as one exact rational quadratic B-spline.
+
+    A segment ``p0 -> p1`` with bulge b (sweep ``θ = 4 atan b``, halved while ``|θ| > 90°``:
+    ``b -> b / (1 + sqrt(1 + b²))``) has the control points ``p0, C, p1`` with
+    ``C = m - ½ tan(θ/2) rot90(p1 - p0)`` (the end tangents' intersection, m the chord's middle,
+    ``tan(θ/2) = 2b / (1 - b²)``) and weights ``1, cos(θ/2) = (1 - b²)/(1 + b²), 1`` (a line: C = m,
+    weight 1). Segments join at double knots (C0: the corners stay corners).
+
+    Returns:
+        control points (2n + 1, 2) (the last = the first), weights (2n + 1,), knots (2n + 4,).
+    """
+    p = np.asarray(points, dtype=float)
+    q = np.concatenate([p[1:], p[:1]])
+    segs: list[tuple[np.ndarray, np.ndarray, float]] = []
+    for a, c, b in zip(p, q, np.asarray(bulges, dtype=float).tolist()):
+        todo = [(a, c, b)]
+        while todo:
+            a0, a1, bb = todo.pop()
+            if abs(bb) > math.tan(math.pi / 8) + 1e-15:  # |θ| > 90°: split at the arc's middle
+                d = a1 - a0
+                mid = 0.5 * (a0 + a1) - 0.5 * bb * np.array([-d[1], d[0]])
+                half = bb / (1.0 + math.sqrt(1.0 + bb * bb))
+                todo += [(mid, a1, half), (a0, mid, half)]
+            else:
+                segs.append((a0, a1, bb))
+    cp, w = [p[0]], [1.0]
+    for a0, a1, bb in segs:
+        d = a1 - a0
+        cp += [0.5 * (a0 + a1) - (bb / (1.0 - bb * bb)) * np.array([-d[1], d[0]]), a1]
+        w += [(1.0 - bb * bb) / (1.0 + bb * bb), 1.0]
+    n = len(segs)
+    knots = np.concatenate([[0.0, 0.0, 0.0], np.repeat(np.arange(1.0, n), 2), [float(n)] * 3])
+    return np.array(cp), np.array(w), knots
+
+
+def svg_arc_path(points: np.ndarray, bulges: np.ndarray, tr: Callable[[np.ndarray], tuple[float, float]]) -> str:
+    """SVG path data of a closed chain of lines and arcs: ``M`` the first point, then per segment
+    ``L x y`` (bulge 0) or ``A r r 0 large sweep x y`` with ``r = L / (2 |sin(θ/2)|)``,
+    ``large = |θ| > π`` and ``sweep = (b < 0)`` (``tr`` flips y: a counter-clockwise arc is drawn
+    with sweep flag 0), then ``Z``; coordinates through ``tr`` (model -> SVG user units)."""
+    p = np.asarray(points, dtype=float)
+    xy = [tr(v) for v in p]
+    d = [f"M{xy[0][0]:.12g},{xy[0][1]:.12g}"]
+    for i, b in enumerate(np.asarray(bulges, dtype=float).tolist()):
+        j = (i + 1) % len(xy)
+        x, y = xy[j]
+        if b == 0.0:
+            d.append(f"L{x:.12g},{y:.12g}")
+            continue
+        th = 4.0 * math.atan(b)
+        r = math.hypot(*(p[j] - p[i])) / (2.0 * abs(math.sin(0.5 * th)))
+        d.append(f"A{r:.15g},{r:.15g} 0 {int(abs(th) > math.pi)} {int(b < 0)} {x:.12g},{y:.12g}")
+    d.append("Z")
+    return " ".join(d)
+
+
 class FlatPattern:
     """A flat pattern: one or more panels in the plane, with report and exports.
 
@@ -819,6 +928,8 @@ class FlatPattern:
             raise GHTError(f"units={units!r} is not allowed; allowed units are {tuple(INSUNITS)}")
         self.panels = list(panels)
         self.units = units
+        #: default chord tolerance of the DXF/SVG outlines (pattern units): 1e-3 mm
+        self.chord_tol = default_chord_tol(units)
 
     # -- geometry ------------------------------------------------------------------------
     @property
@@ -830,6 +941,30 @@ class FlatPattern:
     def outline(self) -> np.ndarray:
         """Outer loop of the first panel, (n, 2) (last point not repeated)."""
         return self.panels[0].loop_polylines()[0]
+
+    def outline_arcs(self, chord_tol: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+        """All closed loops as lines and circular arcs (:meth:`FlatPanel.loop_arcs`): per loop
+        ``(points (n, 2), bulges (n,))``, segment i from ``points[i]`` to ``points[i + 1 mod n]``
+        with DXF bulge ``tan(θ/4)``.
+
+        Args:
+            chord_tol: largest distance between an exact flat edge and its arcs, pattern units
+                (None: :attr:`chord_tol`, 1e-3 mm by default). Straight and circular edges are
+                written exactly whatever the tolerance.
+        """
+        tol = self._chord_tol(chord_tol)
+        return [(p, b) for panel in self.panels for p, b, _ in panel.loop_arcs(tol)]
+
+    def _chord_tol(self, chord_tol: float | None) -> float:
+        tol = self.chord_tol if chord_tol is None else chord_tol
+        try:
+            ok = float(tol) > 0 and math.isfinite(float(tol))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise GHTError(f"chord_tol={tol!r} is not allowed; allowed: a positive length in the pattern's "
+                           f"units ({self.units})")
+        return float(tol)
 
     @property
     def outer_outlines(self) -> list[np.ndarray]:
@@ -923,22 +1058,32 @@ class FlatPattern:
         return f"FlatPattern(panels={len(self.panels)}, units={self.units!r}, max_error={self.errors['max']:.2e})"
 
     # -- exports -------------------------------------------------------------------------
-    def export_dxf(self, path: str | os.PathLike, *, spline: bool = False) -> Path:
+    def export_dxf(self, path: str | os.PathLike, *, spline: bool = False, chord_tol: float | None = None) -> Path:
         """Write a DXF (R2010) with layers OUTLINE, BEND, LABELS, MARKS (and FORMING for a sheet:
         bend radius and angle of every bend line, rotated along it); $INSUNITS from units.
 
-        OUTLINE: every loop as a closed LWPOLYLINE (``spline=True``: a closed fit-point SPLINE).
-        BEND: bend lines as LINEs with linetype DASHED. LABELS: TEXT. MARKS: edge-mark ticks.
-        Without ezdxf (FreeCAD's Python) a plain R12 file with the same layers is written
-        (:meth:`dxf_r12_text`).
+        OUTLINE: every loop as one closed LWPOLYLINE of lines and circular arcs (vertex bulges,
+        :meth:`outline_arcs`): a straight edge is one segment, a circular edge (a cone's rail) one
+        arc, other edges arcs within ``chord_tol`` of the exact development; corners are the
+        development's. ``spline=True``: every loop as one SPLINE carrying the same lines and arcs
+        exactly as control data (rational quadratic: control points, weights, knots; no fit
+        points). BEND: bend lines as LINEs with linetype DASHED. LABELS: TEXT. MARKS: edge-mark
+        ticks. Without ezdxf (FreeCAD's Python) a plain R12 file with the same layers and the same
+        outline arcs is written (:meth:`dxf_r12_text`).
+
+        Args:
+            path: the file to write (atomically).
+            spline: loops as SPLINE entities instead of LWPOLYLINEs.
+            chord_tol: outline chord tolerance in the pattern's units (None: :attr:`chord_tol`).
 
         Returns:
             The path written.
         """
+        tol = self._chord_tol(chord_tol)
         try:
             import ezdxf
         except ImportError:  # e.g. FreeCAD's own Python: plain R12 writer, same layers
-            return write_text_atomic(path, self.dxf_r12_text())
+            return write_text_atomic(path, self.dxf_r12_text(chord_tol=tol))
         doc = ezdxf.new("R2010", setup=True)
         doc.header["$INSUNITS"] = INSUNITS[self.units]
         doc.header["$MEASUREMENT"] = 0 if self.units in ("in", "ft") else 1
@@ -949,11 +1094,14 @@ class FlatPattern:
         if self.forming_labels:
             doc.layers.add("FORMING", color=6)
         msp = doc.modelspace()
-        for lp in self.outlines:
+        for pts, bulges in self.outline_arcs(tol):
             if spline:
-                msp.add_spline(np.vstack([lp, lp[:1]]).tolist(), dxfattribs={"layer": "OUTLINE"}).closed = True
+                cp, w, knots = arcs_to_rational_quadratic(pts, bulges)
+                msp.add_rational_spline(cp.tolist(), w.tolist(), degree=2, knots=knots.tolist(),
+                                        dxfattribs={"layer": "OUTLINE"})
             else:
-                msp.add_lwpolyline(lp.tolist(), close=True, dxfattribs={"layer": "OUTLINE"})
+                msp.add_lwpolyline(np.column_stack([pts, bulges]).tolist(), format="xyb", close=True,
+                                   dxfattribs={"layer": "OUTLINE"})
         bl = self.bend_lines
         size = max(float(np.max(hi - lo)) for lo, hi in (p.bbox() for p in self.panels))
         for p, q in bl:
@@ -970,9 +1118,15 @@ class FlatPattern:
             doc.saveas(tmp)
         return Path(path)
 
-    def dxf_r12_text(self) -> str:
+    def dxf_r12_text(self, chord_tol: float | None = None) -> str:
         """Minimal ASCII DXF R12 (no ezdxf needed): LTYPE DASHED, layers OUTLINE/BEND/LABELS/MARKS,
-        closed POLYLINEs, LINEs, TEXT; ``$INSUNITS`` in the header."""
+        every outline loop one closed POLYLINE of lines and arcs (VERTEX bulges, group 42; the
+        same geometry as :meth:`export_dxf`), LINEs, TEXT; ``$INSUNITS`` in the header.
+        Coordinates and bulges are written to 17 significant digits (they read back exactly).
+
+        Args:
+            chord_tol: outline chord tolerance in the pattern's units (None: :attr:`chord_tol`).
+        """
         out: list[str] = []
 
         def put(code: int, value: Any) -> None:
@@ -994,10 +1148,12 @@ class FlatPattern:
             put(0, "LAYER"), put(2, name), put(70, 0), put(62, color), put(6, lt)
         put(0, "ENDTAB"), put(0, "ENDSEC")
         put(0, "SECTION"), put(2, "ENTITIES")
-        for lp in self.outlines:
+        for pts, bulges in self.outline_arcs(chord_tol):
             put(0, "POLYLINE"), put(8, "OUTLINE"), put(66, 1), put(70, 1)
-            for x, y in lp:
-                put(0, "VERTEX"), put(8, "OUTLINE"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
+            for (x, y), b in zip(pts.tolist(), bulges.tolist()):
+                put(0, "VERTEX"), put(8, "OUTLINE"), put(10, repr(x)), put(20, repr(y)), put(30, 0.0)
+                if b:
+                    put(42, repr(b))
             put(0, "SEQEND"), put(8, "OUTLINE")
         for layer, segs in (("BEND", list(self.bend_lines)), ("MARKS", self.marks)):
             for p, q in segs:
@@ -1017,8 +1173,11 @@ class FlatPattern:
         put(0, "ENDSEC"), put(0, "EOF")
         return "\n".join(out) + "\n"
 
-    def svg_text(self, margin: float | None = None) -> str:
+    def svg_text(self, margin: float | None = None, chord_tol: float | None = None) -> str:
         """The SVG document as a string (see :meth:`export_svg`).
+
+        Every outline loop is one closed ``<path>`` of ``L`` (straight) and ``A`` (circular arc)
+        commands, the same lines and arcs as the DXF (:meth:`outline_arcs`).
 
         The viewBox is in model units; ``width``/``height`` are the same extent in an SVG length
         unit (:data:`SVG_UNITS`: ``width = (extent + 2 margin) × scale`` with m → mm × 1000,
@@ -1028,10 +1187,12 @@ class FlatPattern:
 
         Args:
             margin: blank border in model units (default 3 % of the larger extent).
+            chord_tol: outline chord tolerance in the pattern's units (None: :attr:`chord_tol`).
 
         Returns:
             The SVG text.
         """
+        arcs = self.outline_arcs(chord_tol)
         pts = np.concatenate(self.outlines, axis=0)
         lo, hi = points_bbox(pts)
         span = float(np.max(hi - lo))
@@ -1054,9 +1215,8 @@ class FlatPattern:
             f'version="1.1" width="{W * scale:.9g}{unit}" height="{H * scale:.9g}{unit}" viewBox="0 0 {W:.9g} {H:.9g}">',
             f'<g id="OUTLINE" inkscape:groupmode="layer" inkscape:label="OUTLINE" fill="none" stroke="black" stroke-width="{sw:.6g}">',
         ]
-        for lp in self.outlines:
-            d = " ".join(f"{x:.9g},{y:.9g}" for x, y in (tr(p) for p in lp))
-            out.append(f'<polygon points="{d}"/>')
+        for loop_pts, bulges in arcs:
+            out.append(f'<path d="{svg_arc_path(loop_pts, bulges, tr)}"/>')
         out.append("</g>")
         out.append(
             f'<g id="BEND" inkscape:groupmode="layer" inkscape:label="BEND" fill="none" stroke="red" '
@@ -1091,10 +1251,11 @@ class FlatPattern:
         out.append("</svg>")
         return "\n".join(out) + "\n"
 
-    def export_svg(self, path: str | os.PathLike) -> Path:
-        """Write an SVG: groups (Inkscape layers) OUTLINE, BEND (dashed), MARKS, LABELS; true-scale
-        size in mm, cm or in (m and ft converted, see :meth:`svg_text`)."""
-        return write_text_atomic(path, self.svg_text())
+    def export_svg(self, path: str | os.PathLike, *, chord_tol: float | None = None) -> Path:
+        """Write an SVG: groups (Inkscape layers) OUTLINE (one path of lines and arcs per loop),
+        BEND (dashed), MARKS, LABELS; true-scale size in mm, cm or in (m and ft converted, see
+        :meth:`svg_text`)."""
+        return write_text_atomic(path, self.svg_text(chord_tol=chord_tol))
 
     def plot_png(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
         """PNG preview (matplotlib Agg): outline, dashed bend lines, marks, labels (and a sheet's

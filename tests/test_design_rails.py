@@ -18,6 +18,8 @@ pytest.importorskip("build123d")
 from ght_cad.cli import main
 from ght_cad.design import DesignError, build_curves, load_design, optimize_design, parse_design_text
 
+from dxf_read import dxf_outline_areas
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 DORY = EXAMPLES / "design_dory_multichine.toml"
 HOPPER = EXAMPLES / "design_hopper_transition.toml"
@@ -130,21 +132,6 @@ def distance_to_edges(points: np.ndarray, edges: list) -> float:
         d = BRepExtrema_DistShapeShape(v, comp)
         worst = max(worst, float(d.Value()))
     return worst
-
-
-def dxf_outline_areas(path: Path) -> list[float]:
-    """Shoelace areas of the closed OUTLINE polylines of a DXF (ezdxf, independent of the writer)."""
-    import ezdxf
-
-    msp = ezdxf.readfile(path).modelspace()
-    out = []
-    for e in msp:
-        if e.dxftype() == "LWPOLYLINE" and e.dxf.layer == "OUTLINE":
-            assert e.closed
-            xy = np.array([(p[0], p[1]) for p in e.get_points("xy")])
-            x, y = xy[:, 0], xy[:, 1]
-            out.append(abs(0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))))
-    return out
 
 
 def run(design: Path | str, tmp_path: Path, name: str = "out", capsys=None) -> tuple[int, Path]:

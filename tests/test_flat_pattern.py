@@ -15,6 +15,8 @@ from ght_cad.flat_pattern import DistortionReport, FlatPattern, clip_segments, r
 from ght_cad.ruled import CurvePairRuledSurface
 from ght_cad.unroll import unroll, unroll_composite
 
+from dxf_read import dxf_outline_areas, outline_bulges, outline_vertices, svg_outline_areas
+
 
 def quarter(r: float, z: float, start: float = 0.0) -> GHTCurve:
     c, s = math.cos(start), math.sin(start)
@@ -52,8 +54,13 @@ def test_dxf_reread(pattern: FlatPattern, tmp_path) -> None:
     msp = doc.modelspace()
     outlines = msp.query('LWPOLYLINE[layer=="OUTLINE"]')
     assert len(outlines) == 1 and outlines[0].closed
-    pts = np.array([p[:2] for p in outlines[0].get_points()])
-    np.testing.assert_allclose(pts, pattern.outlines[0], atol=1e-12)
+    # a cone frustum: arc a, straight ruling, arc b, straight ruling; vertices = the corners
+    pts = outline_vertices(outlines[0])
+    np.testing.assert_allclose(pts, pattern.outlines[0][::256], atol=1e-12)
+    bulges = outline_bulges(outlines[0])
+    assert bulges[1] == bulges[3] == 0.0 and bulges[0] * bulges[2] < 0  # the arcs turn opposite ways
+    (area,) = dxf_outline_areas(path)
+    assert area == pytest.approx(pattern.area, rel=1e-12)
     bends = msp.query('LINE[layer=="BEND"]')
     assert len(bends) == 7
     assert all(b.dxf.linetype == "DASHED" for b in bends)
@@ -64,11 +71,29 @@ def test_dxf_reread(pattern: FlatPattern, tmp_path) -> None:
 
 
 def test_dxf_units_and_spline(tmp_path) -> None:
-    pat = unroll(CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 2.0)), units="in", rulings=2)
+    pat = unroll(CurvePairRuledSurface(quarter(1.0, 0.0), quarter(2.0, 1.5)), units="in", rulings=2)  # a cone
     doc = ezdxf.readfile(pat.export_dxf(tmp_path / "s.dxf", spline=True))
     assert doc.header["$INSUNITS"] == 1
     sp = doc.modelspace().query('SPLINE[layer=="OUTLINE"]')
-    assert len(sp) == 1 and sp[0].closed
+    assert len(sp) == 1 and sp[0].dxf.degree == 2 and not sp[0].fit_points
+    # control data of the exact arcs and lines (no fit points): on the knot span of edge a, the
+    # spline (ezdxf's rational evaluation) lies on the circle through three exact points of the
+    # developed edge a to 1e-12 of the size; on the span of a straight ruling, on its chord
+    bs = sp[0].construction_tool()
+    a, ruling = pat.panels[0].loops[0][:2]
+    p0, pm, p1 = a.flat_fn(np.array([0.0, 0.5, 1.0]))
+    A = 2 * np.array([pm - p0, p1 - p0])
+    centre = np.linalg.solve(A, [pm @ pm - p0 @ p0, p1 @ p1 - p0 @ p0])
+    radius = np.linalg.norm(p0 - centre)
+    size = float(np.max(np.ptp(pat.outlines[0], axis=0)))
+    on_a = np.array(list(bs.points(np.linspace(0.0, 1.0, 201))))[:, :2]
+    assert np.max(np.abs(np.linalg.norm(on_a - centre, axis=1) - radius)) <= 1e-12 * size
+    q0, q1 = ruling.flat_fn(np.array([0.0, 1.0]))
+    on_r = np.array(list(bs.points(np.linspace(1.0, 2.0, 51))))[:, :2]
+    n = np.array([-(q1 - q0)[1], (q1 - q0)[0]]) / np.linalg.norm(q1 - q0)
+    assert np.max(np.abs((on_r - q0) @ n)) <= 1e-12 * size
+    corners = np.array([tuple(bs.point(float(k)))[:2] for k in range(4)])
+    np.testing.assert_allclose(corners, pat.outlines[0][::256], atol=1e-12)
 
 
 def test_svg_is_valid_xml_with_layers(pattern: FlatPattern, tmp_path) -> None:
@@ -79,13 +104,15 @@ def test_svg_is_valid_xml_with_layers(pattern: FlatPattern, tmp_path) -> None:
     assert root.get("width").endswith("mm")
     groups = {g.get("id"): g for g in root.findall("s:g", ns)}
     assert {"OUTLINE", "BEND", "LABELS"} <= set(groups)
-    assert len(groups["OUTLINE"].findall("s:polygon", ns)) == 1
+    assert len(groups["OUTLINE"].findall("s:path", ns)) == 1
     assert len(groups["BEND"].findall("s:line", ns)) == 7
     assert groups["BEND"].get("stroke-dasharray")
-    # polygon reproduces the outline up to the y flip and translation
-    poly = np.array([[float(c) for c in p.split(",")] for p in groups["OUTLINE"][0].get("points").split()])
-    out = pattern.outlines[0]
-    np.testing.assert_allclose(np.ptp(poly, axis=0), np.ptp(out, axis=0), rtol=1e-8)
+    # the path: two lines, two arcs, closed; its area (svgelements' reading of the A commands)
+    # is the pattern's
+    d = groups["OUTLINE"][0].get("d")
+    assert d.count("A") == 2 and d.count("L") == 2 and d.endswith("Z")
+    (area,) = svg_outline_areas(path)
+    assert area == pytest.approx(pattern.area, rel=1e-9)
 
 
 def test_png_preview(pattern: FlatPattern, tmp_path) -> None:
@@ -178,8 +205,11 @@ def test_dxf_r12_fallback_without_ezdxf(pattern: FlatPattern, tmp_path, monkeypa
     msp = doc.modelspace()
     polys = msp.query('POLYLINE[layer=="OUTLINE"]')
     assert len(polys) == 1 and polys[0].is_closed
-    pts = np.array([(v.dxf.location.x, v.dxf.location.y) for v in polys[0].vertices])
-    np.testing.assert_allclose(pts, pattern.outlines[0], atol=1e-9)
+    # the same corners (17 digits: exact) and bulges as the R2010 file, the same area
+    np.testing.assert_array_equal(outline_vertices(polys[0]), pattern.outlines[0][::256])
+    lw = ezdxf.readfile(pattern.export_dxf(tmp_path / "r2010.dxf")).modelspace().query("LWPOLYLINE")[0]
+    np.testing.assert_array_equal(outline_bulges(polys[0]), outline_bulges(lw))
+    assert dxf_outline_areas(path)[0] == pytest.approx(pattern.area, rel=1e-12)
     bends = msp.query('LINE[layer=="BEND"]')
     assert len(bends) == 7 and all(b.dxf.linetype == "DASHED" for b in bends)
     assert [t.dxf.text for t in msp.query("TEXT")] == ["P1"]

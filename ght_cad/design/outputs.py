@@ -309,7 +309,7 @@ def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None
                              labels=list(pattern.labels), marks=list(pattern.marks))
 
 
-def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str, str]:
+def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: float | None = None) -> dict[str, str]:
     """Build the design with its given shape parameters and write each file by its suffix.
 
     ``.step``/``.stp``: face + curves; ``.dxf``/``.svg``: flat pattern; ``.json``: name, units,
@@ -325,6 +325,8 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
     Args:
         design: a validated design (:func:`load_design`).
         files: output paths; the suffix selects the content.
+        chord_tol: DXF/SVG outline chord tolerance in the design's units (None: 1e-3 mm,
+            :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
 
     Raises:
         DesignError: a suffix that is not allowed, a surface output without [surface].
@@ -352,7 +354,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
         out: dict[str, str] = {}
         pattern = None
         for f in files:
-            pattern = _export_one(design, curves, builts, f, stage.path(f), pattern)
+            pattern = _export_one(design, curves, builts, f, stage.path(f), pattern, chord_tol)
             suf = f.suffix.lower().lstrip(".")
             out[suf + (f"_{len(out)}" if suf in out else "")] = str(f)
         stage.commit()
@@ -360,7 +362,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike]) -> dict[str
 
 
 def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurface], target: Path,
-                tmp: Path, pattern: Any) -> Any:
+                tmp: Path, pattern: Any, chord_tol: float | None = None) -> Any:
     """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
     import json
 
@@ -376,7 +378,7 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
             write_step(curve_edges(curves), tmp, units=design.units)
     elif suf in (".dxf", ".svg"):
         pattern = pattern or unroll_surfaces(builts)
-        (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp)
+        (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp, chord_tol=chord_tol)
     elif suf == ".json":
         summ = {"name": design.name, "units": design.units}
         summ.update(surfaces_summary(builts) if builts else {})

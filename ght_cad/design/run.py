@@ -83,7 +83,7 @@ def _shell_plate_report(design: Design, builts: list[Any], plates: list[Any], sh
 
 
 def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True, wait: bool = False,
-               timeout: float | None = None) -> dict[str, Any]:
+               timeout: float | None = None, chord_tol: float | None = None) -> dict[str, Any]:
     """Run the whole pipeline of a design and write its outputs into ``out_dir``.
 
     Steps: GHT curves (+ joins, measured) → surface (developable from control planes, or a ruled
@@ -107,6 +107,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         progress: progress bar on stderr when it is a terminal (and a line when it has to wait).
         wait: wait while another process writes ``out_dir`` instead of refusing.
         timeout: with ``wait``, give up after this many seconds (None: no limit).
+        chord_tol: DXF/SVG outline chord tolerance in the design's units (None: 1e-3 mm,
+            :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
 
     Returns:
         The report dictionary (the content of ``report.json``).
@@ -247,9 +249,9 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             pattern = unroll_surfaces(builts)
             report["flat_pattern"] = pattern_report(pattern)
             if "dxf" in want_files:
-                pattern.export_dxf(stage.path(FILE_NAMES["dxf"]))
+                pattern.export_dxf(stage.path(FILE_NAMES["dxf"]), chord_tol=chord_tol)
             if "svg" in want_files:
-                pattern.export_svg(stage.path(FILE_NAMES["svg"]))
+                pattern.export_svg(stage.path(FILE_NAMES["svg"]), chord_tol=chord_tol)
         else:
             pattern = None
             if "step" in want_files and curves:
