@@ -315,3 +315,114 @@ def test_dxf_r12_labels_keep_non_ascii_text(tmp_path) -> None:
     path.write_text(text, encoding="ascii")
     doc = ezdxf.readfile(path)
     assert "Düse ø20" in [ezdxf.decode_dxf_unicode(t.dxf.text) for t in doc.modelspace().query("TEXT")]
+
+
+# ---------------------------------------------------------------------------------------------
+# DXF/SVG for CAM (issue 25): lines and arcs exact, other curves within the chord tolerance
+# ---------------------------------------------------------------------------------------------
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parent.parent / "examples"
+
+
+@pytest.fixture(scope="module")
+def readme_cone() -> FlatPattern:
+    """The README Quickstart's exact quarter cone frustum from control planes, unrolled."""
+    from ght_cad import developable_from_planes
+
+    cone = developable_from_planes([(-400, 1, 0, 0.5), (-400, 1, 1, 0.5), (-400, 0, 1, 0.5)],
+                                   [(0, 0, 0, 1), (-400, 0, 0, 1)], gamma=-1)
+    return unroll(cone)
+
+
+def _write(pat: FlatPattern, version: str, path, **kw):
+    if version == "R12":
+        path.write_text(pat.dxf_r12_text(**kw))
+        return path
+    return pat.export_dxf(path, **kw)
+
+
+@pytest.mark.parametrize("version", ["R2010", "R12"])
+def test_readme_cone_dxf_corners_arcs_and_area_exact(readme_cone: FlatPattern, version: str, tmp_path) -> None:
+    """The README cone's DXF (R2010 through ezdxf, R12 by the own writer): one closed outline of 4
+    vertices = the development's corners map(u, v), (u, v) in {0, 1}², to 1e-9; its two rails are
+    arcs (bulges) whose radii are the slant radii ρ2 = √(400² + 800²), ρ1 = ρ2/2 to 1e-12 and the
+    two rulings straight; the area measured on ezdxf's path is the annular sector's
+    ½ φ (ρ2² - ρ1²), φ = (π/2) 400/ρ2, to 1e-9 (measured 1.9e-14)."""
+    from dxf_read import entity_area, outline_entities
+
+    (ent,) = outline_entities(_write(readme_cone, version, tmp_path / "cone.dxf"))
+    assert ent.dxftype() == ("POLYLINE" if version == "R12" else "LWPOLYLINE") and ent.is_closed
+    pts, bulges = outline_vertices(ent), outline_bulges(ent)
+    corners = readme_cone.map(np.array([0.0, 1.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0, 1.0]))
+    assert np.max(np.abs(pts - corners)) <= 1e-9
+    rho2 = math.hypot(400.0, 800.0)
+    rho1, phi = rho2 / 2, (math.pi / 2) * 400.0 / rho2
+    assert bulges[1] == bulges[3] == 0.0
+    for k, rho in ((0, rho2), (2, rho1)):  # edge a (z = 0, the larger circle), edge b reversed
+        L = float(np.linalg.norm(pts[(k + 1) % 4] - pts[k]))
+        theta = 4 * math.atan(bulges[k])
+        assert abs(theta) == pytest.approx(phi, rel=1e-12)
+        assert L / (2 * math.sin(abs(theta) / 2)) == pytest.approx(rho, rel=1e-12)
+    exact = 0.5 * phi * (rho2**2 - rho1**2)
+    assert entity_area(ent) == pytest.approx(exact, rel=1e-9)
+    assert svg_outline_areas(readme_cone.svg_text())[0] == pytest.approx(exact, rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def hopper_pattern() -> FlatPattern:
+    from ght_cad.design import build_surfaces, load_design, unroll_surfaces
+
+    return unroll_surfaces(build_surfaces(load_design(EXAMPLES / "design_hopper_transition.toml")))
+
+
+@pytest.mark.parametrize("chord_tol", [1e-3, 0.1])
+def test_hopper_outline_within_chord_tolerance(hopper_pattern: FlatPattern, chord_tol: float, tmp_path) -> None:
+    """The hopper (rails loft: its rails develop to curves that are neither lines nor arcs): every
+    point of every exact flat edge (4,001 per edge) lies within chord_tol of the written arcs;
+    the rulings are single lines; R2010, R12 and SVG files give the exact flat area to 1e-7 at
+    the default 1e-3 mm (measured 7.6e-9 with 81 segments; the former 4,096-point polyline was
+    2.4e-7 short) and within chord_tol × perimeter at 0.1 mm, with fewer arcs at 0.1 than at 1e-3."""
+    from dxf_read import dxf_outline_areas
+    from test_outline_arcs import chain_distance
+
+    panel = hopper_pattern.panels[0]
+    (pts, bulges, kinds), = panel.loop_arcs(chord_tol)
+    assert kinds == ["curve", "line", "curve", "line"]
+    closed = np.concatenate([pts, pts[:1]])
+    t = np.linspace(0.0, 1.0, 4001)
+    for e in panel.loops[0]:
+        q = e.flat_fn(t) + panel.offset
+        assert chain_distance(q, closed, bulges).max() <= chord_tol, e.name
+    perimeter = sum(e.length_flat for e in panel.loops[0])
+    exact = hopper_pattern.area
+    areas = [dxf_outline_areas(_write(hopper_pattern, v, tmp_path / f"{v}.dxf", chord_tol=chord_tol))[0]
+             for v in ("R2010", "R12")]
+    areas.append(svg_outline_areas(hopper_pattern.svg_text(chord_tol=chord_tol))[0])
+    for a in areas:
+        assert abs(a - exact) <= (1e-7 * exact if chord_tol == 1e-3 else chord_tol * perimeter)
+    if chord_tol == 0.1:
+        assert bulges.size < len(panel.loop_arcs(1e-3)[0][1])
+
+
+def test_cli_chord_tol(hopper_pattern: FlatPattern, tmp_path, capsys) -> None:
+    """``ght-cad unroll DESIGN --dxf --svg --chord-tol 0.1`` writes the outline of that tolerance
+    (the vertices of :meth:`FlatPattern.outline_arcs`); ``--chord-tol 0`` is refused (exit 2, one
+    line naming the option)."""
+    from ght_cad.cli import main
+
+    from dxf_read import outline_entities
+
+    design = str(EXAMPLES / "design_hopper_transition.toml")
+    assert main(["unroll", design, "--dxf", str(tmp_path / "h.dxf"), "--svg", str(tmp_path / "h.svg"),
+                 "--chord-tol", "0.1"]) == 0
+    (ent,) = outline_entities(tmp_path / "h.dxf")
+    (pts, bulges), = hopper_pattern.outline_arcs(0.1)
+    np.testing.assert_allclose(outline_bulges(ent), bulges, rtol=1e-12, atol=1e-15)
+    assert svg_outline_areas(tmp_path / "h.svg")[0] == pytest.approx(
+        dxf_outline_areas(tmp_path / "h.dxf")[0], rel=1e-9)
+    capsys.readouterr()
+    assert main(["unroll", design, "--dxf", str(tmp_path / "z.dxf"), "--chord-tol", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--chord-tol" in err[0]
+    assert not (tmp_path / "z.dxf").exists()
+    with pytest.raises(GHTError, match="chord_tol"):
+        hopper_pattern.svg_text(chord_tol=-1.0)

@@ -402,14 +402,16 @@ class FlatPatternTest(unittest.TestCase):
         self.assertEqual(pairs[-1][1].strip(), "EOF")
         # every outline vertex of the DXF lies on the feature's flat face boundary (same coordinates)
         i0 = next(i for i in range(len(pairs) - 1) if pairs[i] == ("0", "POLYLINE"))
-        verts = []
+        verts, bulges = [], 0
         for i in range(i0, len(pairs) - 4):
             if pairs[i] == ("0", "SEQEND"):
                 break
             if pairs[i] == ("0", "VERTEX"):
                 j = next(k for k in range(i, i + 6) if pairs[k][0] == "10")
                 verts.append(App.Vector(float(pairs[j][1]), float(pairs[j + 1][1]), 0.0))
-        self.assertGreater(len(verts), 20)
+            bulges += pairs[i][0] == "42"
+        # the cylinder's rectangle: its 4 corners joined by straight segments (no bulge)
+        self.assertEqual((len(verts), bulges), (4, 0))
         # up to a translation (the DXF keeps the core pattern's own frame)
         bb = fp.Shape.Faces[0].BoundBox
         shift = App.Vector(bb.XMin - min(v.x for v in verts), bb.YMin - min(v.y for v in verts), 0.0)
