@@ -265,14 +265,23 @@ def test_cadquery_plugin_and_shared_wrapped_objects(tmp_path):
 
 
 def test_exact_edges_restores_build123d_behaviour():
+    """build123d's clean and SkipClean are never replaced; only the upgrader its modules construct
+    is rebound for the block (and restored, also on error, also when nested)."""
+    from build123d.topology import shape_core
     from build123d.topology.shape_core import Shape, SkipClean
+    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 
     before = Shape.clean
     with pytest.raises(RuntimeError):
         with exact_edges():
-            assert Shape.clean is not before and SkipClean.clean is False
+            assert Shape.clean is before and SkipClean.clean is True
+            assert shape_core.ShapeUpgrade_UnifySameDomain is not ShapeUpgrade_UnifySameDomain
+            with exact_edges():
+                pass
+            assert shape_core.ShapeUpgrade_UnifySameDomain is not ShapeUpgrade_UnifySameDomain
             raise RuntimeError("boom")
     assert Shape.clean is before and SkipClean.clean is True
+    assert shape_core.ShapeUpgrade_UnifySameDomain is ShapeUpgrade_UnifySameDomain
 
 
 def test_step_export_is_quiet_and_atomic(tmp_path, capfd):

@@ -160,3 +160,73 @@ def test_cadquery_loft_metadata_follows_in_place_moves():
     assert getattr(shell, "ght_loft", None) is None
     z = np.vstack([d.poles.reshape(-1, 3) for d in shell.ght_bspline])[:, 2]
     assert z.min() == pytest.approx(10.0, abs=1e-9) and z.max() == pytest.approx(160.0, abs=1e-6)
+
+
+# -- exact_edges keeps build123d's clean: history, warnings, nested SkipClean ----------------
+def test_exact_edges_keeps_history_and_warnings():
+    """Inside the block build123d's own clean runs: the shape history of a join is merged
+    (Select.NEW: 0 vertices, as outside; the replaced clean gave 2) and a failing clean warns."""
+    import warnings
+    from unittest.mock import patch
+
+    from build123d import Line, Select, Solid
+
+    from ght_cad.cad.curves import exact_edges
+
+    def counts():
+        bent = Line((0, 0), (1, 0)) + Line((1, 0), (1, 1))
+        return len(bent.edges(Select.NEW)), len(bent.vertices(Select.NEW)), len(bent.vertices(Select.LAST))
+
+    outside = counts()
+    with exact_edges():
+        assert counts() == outside == (0, 0, 2)
+        box = Solid.make_box(1, 1, 1)
+        with patch("build123d.topology.shape_core.ShapeUpgrade_UnifySameDomain") as upgrader:
+            upgrader.return_value.Build.side_effect = RuntimeError("mocked failure")
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                box.clean()
+        assert any("Unable to clean" in str(w.message) for w in caught)
+
+
+def _bspline_edges(shape) -> int:
+    from build123d import GeomType
+
+    return sum(1 for e in shape.edges() if e.geom_type == GeomType.BSPLINE)
+
+
+def test_exact_edges_survives_a_nested_skipclean():
+    """A ``with SkipClean():`` inside the block used to turn cleaning (with B-spline
+    concatenation) back on for the rest of it: the G2 chain's two edges became one."""
+    from build123d import Box, BuildLine, BuildPart, BuildSketch, Line, Mode, SkipClean, extrude, make_face
+
+    from ght_cad.cad.curves import GHTCompositeLine, exact_edges
+    from ght_cad.composite import CompositeCurve
+    from ght_cad.continuity import join
+
+    a = GHTCurve([(0, 0), (10, 12), (20, 12), (30, 0)], mu=0.3)
+    b = join(a, "G2", [(30, 0), (40, -10), (50, -6), (60, 0)])
+    chain = CompositeCurve([a, b])
+    end = b.evaluate(1.0)
+
+    def part():
+        with BuildPart() as p:
+            with BuildSketch():
+                with BuildLine():
+                    GHTCompositeLine(chain)
+                    Line(tuple(end), (60, -30))
+                    Line((60, -30), (0, -30))
+                    Line((0, -30), (0, 0))
+                make_face()
+            extrude(amount=5)
+            Box(4, 4, 4, mode=Mode.SUBTRACT)        # a boolean: cleaned
+        return p.part
+
+    with exact_edges():
+        kept = _bspline_edges(part())
+        with SkipClean():
+            pass
+        after_skipclean = _bspline_edges(part())
+    # two GHT edges on each cap, plus the curves where the box's faces cut the first one's surface
+    assert kept == after_skipclean == 6
+    assert _bspline_edges(part()) < kept            # outside the block build123d merges them

@@ -19,7 +19,8 @@ results with ``ShapeUpgrade_UnifySameDomain(shape, True, True, True)``, whose la
 (ConcatBSplines) merges tangent-continuous B-spline edges into one *re-approximated* edge: a
 smooth GHT chain then loses its certified deviation (we measured 1.5e-4 on a chain of radius 3).
 Run builder code inside :func:`exact_edges` (``with exact_edges(): with BuildPart(): ...``),
-which keeps the clean-up but without B-spline concatenation. Algebra-mode ``extrude``/``revolve``
+which keeps build123d's clean-up (history, warnings, ``SkipClean``) but without B-spline
+concatenation. Algebra-mode ``extrude``/``revolve``
 on :func:`ght_wire` faces do not concatenate. In cadquery pass ``clean=False`` to
 ``extrude``/``revolve``/booleans for the same reason.
 """
@@ -55,26 +56,38 @@ __all__ = [
 ]
 
 
-def _unify_without_concat(shape: Any) -> Any:
-    from build123d.topology.shape_core import downcast
+def _unify_keeping_bsplines(shape: Any, unify_edges: bool = True, unify_faces: bool = True,
+                            concat_bsplines: bool = True) -> Any:
+    """``ShapeUpgrade_UnifySameDomain`` as build123d constructs it, with ``ConcatBSplines`` off."""
     from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 
-    upgrader = ShapeUpgrade_UnifySameDomain(shape, True, True, False)
-    upgrader.AllowInternalEdges(False)
-    upgrader.Build()
-    return downcast(upgrader.Shape())
+    return ShapeUpgrade_UnifySameDomain(shape, unify_edges, unify_faces, False)
+
+
+def _unify_bindings() -> list[Any]:
+    """The loaded build123d modules whose global ``ShapeUpgrade_UnifySameDomain`` is OCCT's (or
+    already ours, in a nested block): ``Shape.clean`` and the boolean operations construct it."""
+    import sys
+
+    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
+
+    return [m for name, m in list(sys.modules.items())
+            if m is not None and (name == "build123d" or name.startswith("build123d."))
+            and getattr(m, "ShapeUpgrade_UnifySameDomain", None) in (ShapeUpgrade_UnifySameDomain, _unify_keeping_bsplines)]
 
 
 @contextlib.contextmanager
 def exact_edges() -> Iterator[None]:
     """Inside the block, build123d's clean-ups keep tangent B-spline edges as they are.
 
-    build123d cleans builder results and boolean results with
-    ``ShapeUpgrade_UnifySameDomain(..., ConcatBSplines=True)``, which merges G1-connected B-spline
-    edges by approximation. In the block, ``Shape.clean`` runs the same clean-up with
-    ``ConcatBSplines=False`` and boolean operations skip it (build123d's own ``SkipClean``).
-    The previous behaviour is restored on exit (also on error). Not thread-safe (it patches
-    build123d's ``Shape.clean`` for the duration).
+    build123d cleans builder results (``Shape.clean``) and boolean results (``Shape._bool_op``)
+    with ``ShapeUpgrade_UnifySameDomain(shape, True, True, True)``, whose last flag (ConcatBSplines)
+    merges G1-connected B-spline edges into one re-approximated edge (1.5e-4 off a GHT chain of
+    radius 3). In the block build123d's own ``clean`` and booleans run unchanged -- shape history
+    merged, "Unable to clean" warnings, ``SkipClean`` (also nested in the block) -- except that the
+    ``ShapeUpgrade_UnifySameDomain`` they construct is built with ``ConcatBSplines=False``
+    (:func:`_unify_keeping_bsplines`, bound as the modules' global name for the block). The
+    previous bindings are restored on exit (also on error); blocks nest. Not thread-safe.
 
     Example:
         >>> with exact_edges():                        # doctest: +SKIP
@@ -85,27 +98,19 @@ def exact_edges() -> Iterator[None]:
         ...             make_face()
         ...         extrude(amount=2)
     """
-    from build123d.topology.shape_core import Shape, SkipClean
+    import build123d  # noqa: F401  (all of build123d's modules bound before they are rebound)
 
-    original = Shape.clean
-    previous = SkipClean.clean
-
-    def clean(self: Any) -> Any:
-        if self._wrapped is None:
-            return self
-        try:
-            self.wrapped = _unify_without_concat(self.wrapped)
-        except Exception:  # pragma: no cover - best effort, as in build123d
-            pass
-        return self
-
-    Shape.clean = clean  # type: ignore[method-assign]
-    SkipClean.clean = False
+    saved = [(m, m.ShapeUpgrade_UnifySameDomain) for m in _unify_bindings()]
+    if not saved:  # pragma: no cover - a build123d that no longer constructs it by that name
+        raise GHTError("exact_edges: no build123d module constructs ShapeUpgrade_UnifySameDomain by name; "
+                       "this build123d version is not supported by exact_edges")
+    for m, _ in saved:
+        m.ShapeUpgrade_UnifySameDomain = _unify_keeping_bsplines
     try:
         yield
     finally:
-        Shape.clean = original  # type: ignore[method-assign]
-        SkipClean.clean = previous
+        for m, previous in saved:
+            m.ShapeUpgrade_UnifySameDomain = previous
 
 
 def _as_curve(curve: Any) -> GHTCurve:
