@@ -702,6 +702,7 @@ def make_flat_pattern(
     if src.isValid() and flat.isValid():
         gap = 0.2 * max(src.DiagonalLength, flat.DiagonalLength)
         obj.Placement = App.Placement(App.Vector(src.XMax + gap - flat.XMin, src.YMin - flat.YMin, 0), App.Rotation())
+        obj.Document.recompute()  # the Placement touched it: returned up to date, as every make_*
     return obj
 
 
