@@ -404,7 +404,7 @@ def test_hopper_outline_within_chord_tolerance(hopper_pattern: FlatPattern, chor
 
 
 def test_cli_chord_tol(hopper_pattern: FlatPattern, tmp_path, capsys) -> None:
-    """``ght-cad unroll DESIGN --dxf --svg --chord-tol 0.1`` writes the outline of that tolerance
+    """``ght-cad unroll DESIGN --dxf --svg --chord-tol 0.1`` (and ``export``) writes the outline of that tolerance
     (the vertices of :meth:`FlatPattern.outline_arcs`); ``--chord-tol 0`` is refused (exit 2, one
     line naming the option)."""
     from ght_cad.cli import main
@@ -419,6 +419,9 @@ def test_cli_chord_tol(hopper_pattern: FlatPattern, tmp_path, capsys) -> None:
     np.testing.assert_allclose(outline_bulges(ent), bulges, rtol=1e-12, atol=1e-15)
     assert svg_outline_areas(tmp_path / "h.svg")[0] == pytest.approx(
         dxf_outline_areas(tmp_path / "h.dxf")[0], rel=1e-9)
+    assert main(["export", design, str(tmp_path / "e.dxf"), "--chord-tol", "0.1"]) == 0
+    (ent,) = outline_entities(tmp_path / "e.dxf")
+    np.testing.assert_allclose(outline_bulges(ent), bulges, rtol=1e-12, atol=1e-15)
     capsys.readouterr()
     assert main(["unroll", design, "--dxf", str(tmp_path / "z.dxf"), "--chord-tol", "0"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

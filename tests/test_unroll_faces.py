@@ -183,6 +183,39 @@ def test_project_developable_face_matches_ruled_unroll() -> None:
     assert pf.area == pytest.approx(ps.area, rel=1e-6)
 
 
+def test_dxf_of_faces_with_holes_lines_and_arcs(tmp_path) -> None:
+    """DXF for CAM of STEP-like faces with holes (issue 25): a plate 40 × 30 drilled with r = 5
+    writes its outline as 4 exact lines and the hole as exact arcs of radius 5 (area on ezdxf's
+    path 1200 - 25π to 1e-12); the half cylinder R = 20 pierced by r = 5 writes its rectangle as 4
+    lines (the circles develop to lines) and the hole (not a circle in the flat) as arcs within
+    the 1e-3 mm chord tolerance, R2010 and R12 giving the exact flat area within chord_tol × the
+    hole's length and 1e-7 (measured 8.6e-9)."""
+    from dxf_read import dxf_outline_areas, outline_bulges, outline_entities
+
+    plate = bd.Box(40.0, 30.0, 5.0) - bd.Cylinder(5.0, 10.0)
+    top = max(plate.faces().filter_by(bd.GeomType.PLANE), key=lambda f: f.center().Z)
+    pat = unroll(top)
+    kinds = [k for _, _, k in pat.panels[0].loop_arcs(pat.chord_tol)]
+    assert kinds[0] == ["line"] * 4 and set(kinds[1]) <= {"arc", "arcs"}, kinds
+    ents = outline_entities(pat.export_dxf(tmp_path / "plate.dxf"))
+    outer, hole = sorted(ents, key=lambda e: -len(e))
+    assert not np.any(outline_bulges(outer))
+    b = outline_bulges(hole)
+    assert np.all(b != 0) and 4 * np.sum(np.abs(np.arctan(b))) == pytest.approx(2 * math.pi, rel=1e-12)
+    a_out, a_hole = sorted(dxf_outline_areas(tmp_path / "plate.dxf"), reverse=True)
+    assert a_out - a_hole == pytest.approx(1200.0 - 25.0 * math.pi, rel=1e-12)
+
+    part = bd.Cylinder(20.0, 50.0, arc_size=180) - bd.Cylinder(5.0, 100.0, rotation=(90, 0, 0))
+    pat = unroll(_face(part, bd.GeomType.CYLINDER), rulings=4)
+    kinds = [k for _, _, k in pat.panels[0].loop_arcs(pat.chord_tol)]
+    assert all(k == "line" for k in kinds[0]) and "curve" in kinds[1], kinds
+    (tmp_path / "r12.dxf").write_text(pat.dxf_r12_text())
+    for path in (pat.export_dxf(tmp_path / "cyl.dxf"), tmp_path / "r12.dxf"):
+        a_out, a_hole = sorted(dxf_outline_areas(path), reverse=True)
+        hole_length = sum(e.length_flat for e in pat.panels[0].loops[1])
+        assert abs(a_out - a_hole - pat.area) <= min(pat.chord_tol * hole_length, 1e-7 * pat.area)
+
+
 def test_holes_and_planar_face_output() -> None:
     """Half cylinder (R=20) pierced by a cylinder (r=5): the hole is kept; areas match the exact
     integral; the planar build123d face has the hole as inner wire."""
