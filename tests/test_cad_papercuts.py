@@ -230,3 +230,28 @@ def test_exact_edges_survives_a_nested_skipclean():
     # two GHT edges on each cap, plus the curves where the box's faces cut the first one's surface
     assert kept == after_skipclean == 6
     assert _bspline_edges(part()) < kept            # outside the block build123d merges them
+
+
+def test_ght_shapes_still_pickle_with_their_metadata():
+    import pickle
+
+    from build123d import Location
+
+    from ght_cad.cad.curves import ght_edge, ght_face, ght_wire
+    from ght_cad.patch import GHTSurface
+
+    c1 = GHTCurve([(0, 0), (1, 1), (2, 0)], mu=0.2)
+    c2 = GHTCurve([(2, 0), (3, -1), (4, 0)])
+    patch = GHTSurface([[(0, 0, 0), (1, 0, 1), (2, 0, 0)], [(0, 1, 0), (1, 1, 1), (2, 1, 0)], [(0, 2, 0), (1, 2, 1), (2, 2, 0)]])
+    for shape in (ght_edge(c1), ght_wire([c1, c2]), ght_face(patch), GHTBezierLine(c1)):
+        back = pickle.loads(pickle.dumps(shape))
+        assert type(back).__name__ == type(shape).__name__
+        a, b = shape.ght_bspline, back.ght_bspline
+        for x, y in zip(a if isinstance(a, list) else [a], b if isinstance(b, list) else [b]):
+            np.testing.assert_array_equal(x.poles, y.poles)
+        # the copy's metadata still follows its shape: moved up by 3, 2-D data lifted to z = 3
+        moved = back.moved(Location((0, 0, 3)))
+        m = moved.ght_bspline[0] if isinstance(moved.ght_bspline, list) else moved.ght_bspline
+        o = a[0] if isinstance(a, list) else a
+        lifted = np.concatenate([o.poles, np.zeros(o.poles.shape[:-1] + (3 - o.poles.shape[-1],))], axis=-1)
+        np.testing.assert_allclose(m.poles, lifted + [0.0, 0.0, 3.0], rtol=0, atol=1e-12)

@@ -209,9 +209,28 @@ def certified_class(cls: type) -> type:
     sub = _CLASSES.get(cls)
     if sub is None:
         # a plain one-base subclass (a mixin base would make __class__ assignment refuse the layout)
-        sub = certified(type(cls.__name__, (cls,), {"__module__": cls.__module__, "__qualname__": cls.__qualname__}))
+        sub = certified(type(cls.__name__, (cls,), {"__module__": cls.__module__, "__qualname__": cls.__qualname__,
+                                                     "__reduce_ex__": _reduce_ex}))
         _CLASSES[cls] = sub
     return sub
+
+
+def _reduce_ex(self: Any, protocol: int) -> Any:
+    """Pickle as the plain base class (the same-named subclass cannot be found by name) and make
+    the copy certified again on load; the record travels in the instance state."""
+    cls = type(self)
+    base = cls.__mro__[1]
+    rv = super(cls, self).__reduce_ex__(protocol)
+    func, args = rv[0], tuple(rv[1])
+    if args and args[0] is cls:
+        args = (base,) + args[1:]
+    return (_recertify, (func, args)) + tuple(rv[2:])
+
+
+def _recertify(func: Any, args: tuple) -> Any:
+    obj = func(*args)
+    obj.__class__ = certified_class(type(obj))
+    return obj
 
 
 def certify(shape: Any, **values: Any) -> Any:
