@@ -50,8 +50,7 @@ def _occt_fit(curve: GHTCurve, n: int, tol3d: float, matched: bool, deg_max: int
     from OCP.GeomAbs import GeomAbs_C2
     from OCP.GeomAPI import GeomAPI_PointsToBSpline
     from OCP.gp import gp_Pnt
-    from OCP.TColgp import TColgp_Array1OfPnt
-    from OCP.TColStd import TColStd_Array1OfReal
+    from ght_cad.cad._ocp import TColgp_Array1OfPnt, TColStd_Array1OfReal
 
     t = np.linspace(0.0, 1.0, n)
     pts = curve.evaluate(t)

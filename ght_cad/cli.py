@@ -17,7 +17,8 @@ Exit codes (stable, scripts may rely on them):
     0  success
     1  internal failure (a bug or a failing CAD kernel); the message says what failed
     2  bad input or usage: unknown option, unreadable or invalid design file, a value out of
-       range (one line on stderr naming the file, the key and the allowed values)
+       range (one line on stderr naming the file, the key and the allowed values), or a command
+       that needs a CAD kernel where none is installed (the line names the extra to install)
     130 interrupted (Ctrl-C)
 
 With ``--json`` the result (or ``{"ok": false, "error": ..., "exit_code": ...}``, also for usage
@@ -1001,6 +1002,10 @@ def _dispatch(args: argparse.Namespace) -> int:
     except Exception as exc:  # noqa: BLE001 - exit code 1 for every internal failure
         if _SIGINT_SEEN[0]:  # e.g. an ImportError of a module Ctrl-C cut off half-way
             return _fail(args, EXIT_INTERRUPTED, "interrupted")
+        from .cad import KERNEL_HINT, is_missing_kernel
+
+        if is_missing_kernel(exc):  # a core-only environment (e.g. FreeCAD's Python): not a bug
+            return _fail(args, EXIT_USAGE, f"ght-cad {args.command}: this command {KERNEL_HINT} (No module named {exc.name!r})")
         if os.environ.get("GHT_CAD_DEBUG"):
             traceback.print_exc()
         return _fail(args, EXIT_FAILURE, f"internal failure: {type(exc).__name__}: {exc} (set GHT_CAD_DEBUG=1 for a traceback)")

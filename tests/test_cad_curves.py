@@ -8,7 +8,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("build123d")
-cq = pytest.importorskip("cadquery")
 
 from build123d import Axis, BuildLine, BuildPart, BuildSketch, Line, Plane, extrude, make_face, revolve  # noqa: E402
 from OCP.BRepAdaptor import BRepAdaptor_Curve  # noqa: E402
@@ -18,13 +17,14 @@ from OCP.GCPnts import GCPnts_AbscissaPoint  # noqa: E402
 from OCP.GProp import GProp_GProps  # noqa: E402
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_SOLID  # noqa: E402
 from OCP.TopExp import TopExp, TopExp_Explorer  # noqa: E402
-from OCP.TopTools import TopTools_IndexedMapOfShape  # noqa: E402
-from OCP.TopoDS import TopoDS  # noqa: E402
+from ght_cad.cad._ocp import TopTools_IndexedMapOfShape  # noqa: E402
+from ght_cad.cad._ocp import TopoDS  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.curves import GHTBezierLine, GHTCompositeLine, exact_edges, export_step, ght_edge, ght_face, ght_shape, ght_wire  # noqa: E402
 from ght_cad.cad.occ import read_step, volume, write_step  # noqa: E402
 from ght_cad.composite import CompositeCurve  # noqa: E402
+from cad_checks import green_area as _green_area  # noqa: E402
 from ght_cad.curve import gauss_legendre  # noqa: E402
 from ght_cad.errors import GHTError  # noqa: E402
 from ght_cad.patch import GHTSurface  # noqa: E402
@@ -52,16 +52,6 @@ def _edges(shape) -> list:
 
 def _valid(shape) -> bool:
     return bool(BRepCheck_Analyzer(getattr(shape, "wrapped", shape)).IsValid())
-
-
-def _green_area(segments) -> float:
-    """Exact enclosed area ½∮(x y' - y x') dt of a closed chain of planar GHT curves (Gauss 64)."""
-    t, w = gauss_legendre(64)
-    total = 0.0
-    for s in segments:
-        p, d = s.evaluate(t), s.derivative(t, 1)
-        total += 0.5 * float(np.sum(w * (p[:, 0] * d[:, 1] - p[:, 1] * d[:, 0])))
-    return abs(total)
 
 
 @settings(max_examples=10)
@@ -241,6 +231,7 @@ def test_face_from_patch_area_and_step(tmp_path):
 
 
 def test_cadquery_plugin_and_shared_wrapped_objects(tmp_path):
+    cq = pytest.importorskip("cadquery")  # the [cadquery] world (OCP 7.9); build123d-only worlds skip
     import ght_cad.cad.cq_plugin  # noqa: F401  (registers Workplane.ghtBezier / ghtCurve)
 
     pts = [(1, 1.5), (2.5, 1.0), (3, 0)]
@@ -345,7 +336,7 @@ def test_adapter_errors():
 def test_cadquery_plugin_refuses_curves_of_more_than_three_dimensions():
     # a 4-D curve (e.g. a dual curve of planes) handed to Workplane.ghtCurve raised numpy's
     # "could not broadcast input array from shape (4,) into shape (3,)" (a bare ValueError)
-    import cadquery as cq
+    cq = pytest.importorskip("cadquery")
 
     import ght_cad.cad.cq_plugin  # noqa: F401
 

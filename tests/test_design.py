@@ -495,7 +495,7 @@ def test_optimized_curve_strip_exports_the_optimized_curves(tmp_path: Path) -> N
     from OCP.BRepAdaptor import BRepAdaptor_Curve
     from OCP.TopAbs import TopAbs_EDGE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ght_cad.cad._ocp import TopoDS
 
     from ght_cad.cad.occ import unwrap
 

@@ -32,7 +32,7 @@ HULL = EXAMPLES / "design_hull_plate.toml"
 def step_faces(path: Path) -> list:
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ght_cad.cad._ocp import TopoDS
 
     from ght_cad.cad.occ import read_step, unwrap
 
@@ -101,7 +101,7 @@ def edge_points(edge, n: int = 401) -> np.ndarray:
 def face_edges(faces: list) -> list:
     from OCP.TopAbs import TopAbs_EDGE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ght_cad.cad._ocp import TopoDS
 
     out = []
     for f in faces:
@@ -235,8 +235,8 @@ def test_dory_one_shell_the_chine_really_shared(dory) -> None:
     points lie on shared edges within 1e-6 of the size), while keel and sheer are free edges."""
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL
     from OCP.TopExp import TopExp, TopExp_Explorer
-    from OCP.TopoDS import TopoDS
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+    from ght_cad.cad._ocp import TopoDS
+    from ght_cad.cad._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
     from ght_cad.cad.occ import is_valid, read_step, unwrap
 

@@ -167,6 +167,7 @@ def _max_curvature_jump(shell) -> float:
         for f in (fa, fb):
             u, v = GeomAPI_ProjectPointOnSurf(p, BRep_Tool.Surface_s(f)).LowerDistanceParameters()
             props = BRepLProp_SLProps(BRepAdaptor_Surface(f), u, v, 2, 1e-12)
+            assert props.IsCurvatureDefined()  # computes the curvatures: OCCT 8 returns 0 before it
             k = max(abs(props.MaxCurvature()), abs(props.MinCurvature()))
             vals.append(k)
         ks.append(abs(vals[0] - vals[1]) / max(vals))

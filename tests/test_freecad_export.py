@@ -26,7 +26,9 @@ def _xcaf_tree(path: Path) -> tuple[list[str], list[str]]:
     from OCP.STEPCAFControl import STEPCAFControl_Reader
     from OCP.TCollection import TCollection_ExtendedString
     from OCP.TDataStd import TDataStd_Name
-    from OCP.TDF import TDF_Label, TDF_LabelSequence
+    from OCP.TDF import TDF_Label
+
+    from ght_cad.cad._ocp import TDF_LabelSequence
     from OCP.TDocStd import TDocStd_Document
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 

@@ -38,7 +38,7 @@ def test_joined_developable_inside_freecadcmd(tmp_path: Path) -> None:
     # the STEP file FreeCAD wrote is a valid two-face shell for OCP 7.9 too
     from ght_cad.cad.occ import is_valid, read_step
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-    from OCP.TopTools import TopTools_IndexedMapOfShape
+    from ght_cad.cad._ocp import TopTools_IndexedMapOfShape
     from OCP.TopExp import TopExp
 
     shape = read_step(tmp_path / "joined.step")

@@ -150,7 +150,7 @@ def test_plate_of_a_pointed_loft(both: bool, T: float, side: str) -> None:
     # the inside face ends in a degenerate (point) edge at each pointed end
     from OCP.TopAbs import TopAbs_EDGE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ght_cad.cad._ocp import TopoDS
 
     ex, deg = TopExp_Explorer(out["plate"].inside, TopAbs_EDGE), 0
     while ex.More():

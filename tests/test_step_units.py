@@ -19,8 +19,8 @@ from ght_cad.errors import GHTError  # noqa: E402
 def _extent(shape) -> tuple[float, ...]:
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box)
-    x0, y0, z0, x1, y1, z1 = box.Get()
-    return (x1 - x0, y1 - y0, z1 - z0)
+    lo, hi = box.CornerMin(), box.CornerMax()  # (OCP 8's Bnd_Box.Get returns a struct pybind11 cannot convert)
+    return (hi.X() - lo.X(), hi.Y() - lo.Y(), hi.Z() - lo.Z())
 
 
 @pytest.mark.parametrize(

@@ -308,8 +308,8 @@ def test_radially_drilled_cylinder_over_a_parameter_box(R: float, ratio: float, 
 @pytest.mark.parametrize("which", ["plane", "cylinder"])
 def test_unbounded_face_is_refused(which: str) -> None:
     """Faces of whole OCCT surfaces (BRepBuilderAPI_MakeFace(gp_Pln()), an infinite cylinder):
-    bounds ±2e100 (before: ZeroDivisionError for the plane, 'wire 2 (a hole) lies outside the
-    outer wire' for the cylinder)."""
+    bounds ±2e100 (OCCT 8: ±1e100 for the cylinder; before: ZeroDivisionError for the plane, 'wire 2
+    (a hole) lies outside the outer wire' for the cylinder)."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
     from OCP.gp import gp_Ax3, gp_Cylinder, gp_Pln
 
@@ -317,7 +317,7 @@ def test_unbounded_face_is_refused(which: str) -> None:
 
     geom = gp_Pln() if which == "plane" else gp_Cylinder(gp_Ax3(), 5.0)
     face = bd.Face(BRepBuilderAPI_MakeFace(geom).Face())
-    with pytest.raises(DegenerateGeometryError, match=r"unbounded or empty: parameter bounds .*2e\+100.*allowed: a face trimmed"):
+    with pytest.raises(DegenerateGeometryError, match=r"unbounded or empty: parameter bounds .*[12]e\+100.*allowed: a face trimmed"):
         unroll(face)
 
 
@@ -388,7 +388,7 @@ def test_bezier_and_rational_bezier_faces() -> None:
 
 
 def test_cadquery_face() -> None:
-    import cadquery as cq
+    cq = pytest.importorskip("cadquery")
 
     face = next(f for f in cq.Workplane().cylinder(5.0, 2.0).val().Faces() if f.geomType() == "CYLINDER")
     pat = unroll(face)

@@ -63,7 +63,7 @@ def shape_samples(shape: Any) -> np.ndarray:
     from OCP.BRepTools import BRepTools
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ._ocp import TopoDS
 
     w = getattr(shape, "wrapped", shape)
     pts: list[tuple[float, float, float]] = []

@@ -23,7 +23,8 @@ coordinates point by point, which is exact because a GHT-Bézier curve is affine
              .ghtBezier([(1, 1), (2, 1), (3, 0)], mu=0.3, includeCurrent=True)
              .close().extrude(1))
 
-The edges wrap the very OCP objects that build123d uses: ``cq.Edge(b3d_edge.wrapped)``.
+The edges wrap the very OCP objects that build123d uses: ``cq.Edge(b3d_edge.wrapped)``. The plugin
+never imports build123d (the ``[cadquery]`` extra installs cadquery alone).
 """
 
 from __future__ import annotations
@@ -33,9 +34,11 @@ from typing import Any, Iterable
 import cadquery as cq
 import numpy as np
 
+from ..bspline import curve_to_bspline
 from ..curve import GHTCurve
 from ..errors import GHTError
-from .curves import ght_edge, segments_of
+from ._chain import segments_of
+from .occ import make_edge
 
 __all__ = ["ghtBezier", "ghtCurve", "developableLoft", "developable_loft_cq", "register"]
 
@@ -64,6 +67,11 @@ def _local_points(wp: "cq.Workplane", control_points: Iterable[Any], include_cur
         cur = wp._findFromPoint(True)  # local coordinates of the current point
         arr = np.vstack([[cur.x, cur.y, cur.z], arr])
     return arr
+
+
+def _edge(curve: GHTCurve, tol: float | None, degree: int) -> "cq.Edge":
+    """``cq.Edge`` on the certified B-spline of a 3-D GHT curve (:func:`ght_cad.bspline.curve_to_bspline`)."""
+    return cq.Edge(make_edge(curve_to_bspline(curve, tol, degree)).wrapped)
 
 
 def _add_edges(wp: "cq.Workplane", edges: list, forConstruction: bool, makeWire: bool) -> "cq.Workplane":
@@ -111,7 +119,7 @@ def ghtBezier(
     """
     local = _local_points(self, control_points, includeCurrent)
     curve = GHTCurve(_to_world(self, local), mu, nu, gamma)
-    edge = cq.Edge(ght_edge(curve, tol, degree).wrapped)
+    edge = _edge(curve, tol, degree)
     return _add_edges(self, [edge], forConstruction, makeWire)
 
 
@@ -145,7 +153,7 @@ def ghtCurve(
     edges = []
     for seg in segs:
         world = seg.with_control_points(_to_world(self, seg.control_points))
-        edges.append(cq.Edge(ght_edge(world, tol, degree).wrapped))
+        edges.append(_edge(world, tol, degree))
     return _add_edges(self, edges, forConstruction, makeWire)
 
 
@@ -167,11 +175,9 @@ def developable_loft_cq(rail_a: Any, rail_b: Any, **options: Any) -> Any:
     Raises:
         NotDevelopableError: no developable joins the rails; GHTError: bad rails or options.
     """
-    from build123d import Mode
+    from .loft import loft_between
 
-    from .loft import developable_loft
-
-    shape = developable_loft(rail_a, rail_b, mode=Mode.PRIVATE, **options)
+    shape = loft_between(rail_a, rail_b, **options)
     out = cq.Shell(shape.wrapped) if shape.wrapped.ShapeType().name == "TopAbs_SHELL" else cq.Face(shape.wrapped)
     from .certified import certify
 

@@ -40,6 +40,7 @@ from ..bspline import BSplineCurveData, curve_to_bspline
 from ..curve import GHTCurve
 from ..errors import GHTError
 from ..patch import GHTSurface
+from ._chain import _as_curve, segments_of
 from .certified import certified, certify
 from .occ import geom_bspline_curve, make_face
 
@@ -111,36 +112,6 @@ def exact_edges() -> Iterator[None]:
     finally:
         for m, previous in saved:
             m.ShapeUpgrade_UnifySameDomain = previous
-
-
-def _as_curve(curve: Any) -> GHTCurve:
-    if isinstance(curve, GHTCurve):
-        if curve.dim not in (2, 3):
-            raise GHTError(f"a CAD edge needs a 2-D or 3-D curve; this curve has dim={curve.dim}")
-        return curve
-    raise GHTError(f"expected a GHTCurve, got {type(curve).__name__}")
-
-
-def segments_of(curves: Any) -> tuple[list[GHTCurve], bool | None]:
-    """``(segments, closed)`` of a CompositeCurve (``.segments``, ``.closed``), a GHTCurve or a list.
-
-    ``closed`` is the composite's own flag, or ``None`` when not known (then decided by geometry).
-    """
-    if isinstance(curves, GHTCurve):
-        return [curves], None
-    segs = getattr(curves, "segments", None)
-    closed = getattr(curves, "closed", None)
-    if segs is None:
-        segs = curves
-    try:
-        segs = list(segs)
-    except TypeError:
-        raise GHTError(
-            f"expected a GHTCurve, a CompositeCurve or a sequence of GHTCurves; got {type(curves).__name__}"
-        ) from None
-    if not segs:
-        raise GHTError("no segments: a wire needs at least one GHT curve")
-    return [_as_curve(s) for s in segs], (None if closed is None else bool(closed))
 
 
 def _xyz(p: np.ndarray) -> np.ndarray:

@@ -29,14 +29,14 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL
 from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from ._ocp import TopoDS
+from ._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..bspline import BSplineSurfaceData
 from ..developable import _size, developable_bspline
 from ..errors import ConversionError, GHTError
 from ..ruled import RuledSurface
-from .occ import is_valid, make_face, unwrap
+from .occ import is_valid, make_face, shape_class, unwrap
 
 __all__ = [
     "planes_from_build123d",
@@ -131,13 +131,13 @@ def composite_shell(composite: Any, *, tol: float | None = None, degree: int = 5
 
 
 def sew_shell(faces: list, sew_tol: float, shared_edges: int) -> Any:
-    """A build123d ``Shell`` of ``faces`` sewn with ``BRepBuilderAPI_Sewing(sew_tol)``.
+    """A ``Shell`` (build123d's, else cadquery's) of ``faces`` sewn with ``BRepBuilderAPI_Sewing(sew_tol)``.
 
     Raises:
         ConversionError: sewing gave no or several shells, a number of shared edges other than
             ``shared_edges`` (the joint rulings), or a shell that fails ``BRepCheck_Analyzer``.
     """
-    from build123d import Shell
+    Shell = shape_class("Shell")
 
     sewing = BRepBuilderAPI_Sewing(float(sew_tol))
     for f in faces:

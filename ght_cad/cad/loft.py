@@ -37,13 +37,14 @@ from OCP.BRepAdaptor import BRepAdaptor_CompCurve, BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
+from OCP.TopoDS import TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
+from ._ocp import TopoDS
 
 from .._validate import as_parameter_array
 from ..curve import GHTCurve
 from ..errors import ConversionError, GHTError
 from .developable_faces import sew_shell
-from .occ import is_valid, make_face, unwrap
+from .occ import is_valid, make_face, shape_class, unwrap
 
 __all__ = ["OCPCurveRail", "rail_of", "developable_loft", "loft_shape", "LOFT_OPTIONS"]
 
@@ -256,8 +257,6 @@ def loft_shape(loft: Any, *, tol: float | None = None, degree: int = 5, sew_tol:
         ConversionError: a face or the sewn shell fails ``BRepCheck_Analyzer``, or sewing did not
             give one shell with the expected shared rulings.
     """
-    from build123d import Face
-
     datas = loft.bspline_data(tol=tol, degree=degree)
     faces = [make_face(d) for d in datas]
     for i, (f, sg) in enumerate(zip(faces, loft.segments)):
@@ -280,7 +279,7 @@ def loft_shape(loft: Any, *, tol: float | None = None, degree: int = 5, sew_tol:
             sewn = sewing.SewedShape()
             if sewn.ShapeType().name != "TopAbs_FACE" or not is_valid(sewn):
                 raise ConversionError("sewing the closed one-segment loft did not give one valid face with a seam")
-            shape = Face(TopoDS.Face_s(sewn))
+            shape = shape_class("Face")(TopoDS.Face_s(sewn))
         else:
             shape = sew_shell(faces, stol, len(faces) - 1 + (1 if closed else 0))
     from .certified import certify
@@ -326,11 +325,6 @@ def developable_loft(
     from build123d import BuildPart, Mode
     from build123d.build_common import Builder
 
-    from ..loft import developable_loft as core_loft
-
-    unknown = sorted(set(options) - set(LOFT_OPTIONS))
-    if unknown:
-        raise GHTError(f"unknown loft option(s) {unknown}; allowed: tol, degree, sew_tol, mode, {', '.join(LOFT_OPTIONS)}")
     mode = Mode.ADD if mode is None else mode
     context = Builder._get_context("developable_loft")
     if context is not None and mode != Mode.PRIVATE and not isinstance(context, BuildPart):
@@ -338,8 +332,24 @@ def developable_loft(
             f"developable_loft inside {type(context).__name__}: a loft is a 3-D surface; use it in BuildPart "
             "(its faces join the pending faces) or outside any builder"
         )
-    loft = core_loft(rail_of(edge_a, "rail_a"), rail_of(edge_b, "rail_b"), **options)
-    shape = loft_shape(loft, tol=tol, degree=degree, sew_tol=sew_tol)
+    shape = loft_between(edge_a, edge_b, tol=tol, degree=degree, sew_tol=sew_tol, **options)
     if context is not None and mode != Mode.PRIVATE:
         context._add_to_context(*shape.faces(), mode=mode)
     return shape
+
+
+def loft_between(edge_a: Any, edge_b: Any, *, tol: float | None = None, degree: int = 5,
+                 sew_tol: float | None = None, **options: Any) -> Any:
+    """:func:`developable_loft` outside any builder, without importing build123d's builders (the
+    cadquery plugin's path): the rails read by :func:`rail_of`, the core loft, :func:`loft_shape`.
+
+    Raises:
+        GHTError: an unknown option (and everything :func:`developable_loft` raises).
+    """
+    from ..loft import developable_loft as core_loft
+
+    unknown = sorted(set(options) - set(LOFT_OPTIONS))
+    if unknown:
+        raise GHTError(f"unknown loft option(s) {unknown}; allowed: tol, degree, sew_tol, mode, {', '.join(LOFT_OPTIONS)}")
+    loft = core_loft(rail_of(edge_a, "rail_a"), rail_of(edge_b, "rail_b"), **options)
+    return loft_shape(loft, tol=tol, degree=degree, sew_tol=sew_tol)

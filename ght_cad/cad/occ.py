@@ -18,24 +18,27 @@ from OCP.gp import gp_Pnt
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
-from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array2OfPnt
-from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
 
 from ..bspline import BSplineCurveData, BSplineSurfaceData
 from ..errors import GHTError
 from ..io import atomic_path
+from ._ocp import TColgp_Array1OfPnt, TColgp_Array2OfPnt, TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 __all__ = [
     "geom_bspline_curve",
     "geom_bspline_surface",
     "make_edge",
     "make_face",
+    "shape_class",
     "is_valid",
     "volume",
     "has_c0_faces",
     "write_step",
     "read_step",
+    "read_step_products",
+    "step_writer",
+    "name_products",
     "unwrap",
     "quiet_occt",
 ]
@@ -115,21 +118,31 @@ def geom_bspline_surface(data: BSplineSurfaceData) -> Geom_BSplineSurface:
     )
 
 
-def make_edge(data: BSplineCurveData) -> Any:
-    """A build123d ``Edge`` holding the exact B-spline of ``data``."""
-    from build123d import Edge
+def shape_class(kind: str) -> Any:
+    """build123d's shape class ``kind`` (``"Edge"``, ``"Face"``, ``"Shell"``, ...), or cadquery's
+    where build123d is not installed (the ``[cadquery]`` extra); both wrap the OCP shape as
+    ``.wrapped``. Raises ``ModuleNotFoundError`` (of build123d) when neither is installed."""
+    try:
+        import build123d as lib
+    except ModuleNotFoundError as exc:
+        try:
+            import cadquery as lib
+        except ModuleNotFoundError:
+            raise exc from None
+    return getattr(lib, kind)
 
-    return Edge(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge())
+
+def make_edge(data: BSplineCurveData) -> Any:
+    """An ``Edge`` (build123d's, else cadquery's: :func:`shape_class`) holding the exact B-spline of ``data``."""
+    return shape_class("Edge")(BRepBuilderAPI_MakeEdge(geom_bspline_curve(data)).Edge())
 
 
 def make_face(data: BSplineSurfaceData, tolerance: float = 1e-7) -> Any:
-    """A build123d ``Face`` on the B-spline surface of ``data`` (natural bounds)."""
-    from build123d import Face
-
+    """A ``Face`` (build123d's, else cadquery's) on the B-spline surface of ``data`` (natural bounds)."""
     builder = BRepBuilderAPI_MakeFace(geom_bspline_surface(data), float(tolerance))
     if not builder.IsDone():
         raise GHTError("OCCT could not build a face on the B-spline surface")
-    return Face(builder.Face())
+    return shape_class("Face")(builder.Face())
 
 
 def volume(shape: Any, *, eps: float | None = None) -> float:
@@ -186,7 +199,7 @@ def has_c0_faces(shape: Any) -> bool:
     from OCP.GeomAbs import GeomAbs_C0
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ._ocp import TopoDS
 
     exp = TopExp_Explorer(unwrap(shape), TopAbs_FACE)
     while exp.More():
@@ -212,7 +225,71 @@ STEP_UNITS: dict[str, tuple[str, float]] = {
 }
 
 
-def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, units: str = "mm") -> str:
+def _stem(path: str | os.PathLike) -> str:
+    return os.path.splitext(os.path.basename(os.fspath(path)))[0]
+
+
+@contextlib.contextmanager
+def step_writer(units: str) -> Iterator[STEPControl_Writer]:
+    """A ``STEPControl_Writer`` whose file declares ``units``.
+
+    The unit goes through the ``write.step.unit`` static (set for the block, restored on exit), the coordinates stay as they are (``SetLocalLengthUnit`` = mm per unit); OCCT
+    messages are silenced inside the block. Call :func:`name_products` after ``Transfer``.
+
+    Raises:
+        GHTError: an unknown unit.
+    """
+    from OCP.Interface import Interface_Static
+
+    if units not in STEP_UNITS:
+        raise GHTError(f"units={units!r} is not a STEP length unit; allowed: {', '.join(STEP_UNITS)}")
+    step_unit, mm_per_unit = STEP_UNITS[units]
+    with quiet_occt():
+        STEPControl_Writer()  # registers the STEP statics before they are set
+        previous = Interface_Static.CVal_s("write.step.unit")
+        Interface_Static.SetCVal_s("write.step.unit", step_unit)
+        try:
+            writer = STEPControl_Writer()
+            writer.Model().SetLocalLengthUnit(mm_per_unit)  # the coordinates are in `units`
+            yield writer
+        finally:
+            Interface_Static.SetCVal_s("write.step.unit", previous)
+
+
+def name_products(writer: STEPControl_Writer, name: str) -> int:
+    """Give every ``PRODUCT`` entity of the writer's model (after ``Transfer``) the id and name
+    ``name`` (OCCT calls it "Open CASCADE STEP translator <version> <n>"); returns how many were
+    named. Read back by :func:`read_step_products`."""
+    from OCP.StepBasic import StepBasic_Product
+    from OCP.TCollection import TCollection_HAsciiString
+
+    model = writer.Model()
+    name = str(name)
+    n = 0
+    for i in range(1, model.NbEntities() + 1):
+        ent = model.Value(i)
+        if isinstance(ent, StepBasic_Product):
+            ent.SetId(TCollection_HAsciiString(name))
+            ent.SetName(TCollection_HAsciiString(name))
+            n += 1
+    return n
+
+
+def read_step_products(path: str | os.PathLike) -> list[str]:
+    """The names of the ``PRODUCT`` entities of a STEP file, in file order."""
+    from OCP.StepBasic import StepBasic_Product
+
+    with quiet_occt():
+        reader = STEPControl_Reader()
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise GHTError(f"could not read STEP file {path}")
+        model = reader.StepModel()
+        return [model.Value(i).Name().ToCString() for i in range(1, model.NbEntities() + 1)
+                if isinstance(model.Value(i), StepBasic_Product)]
+
+
+def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, units: str = "mm",
+               product: str | None = None) -> str:
     """Write one shape or several (as a compound) to a STEP file, atomically.
 
     Args:
@@ -221,6 +298,8 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
         check: refuse shapes that ``BRepCheck_Analyzer`` finds invalid.
         units: the length unit the shape coordinates are in; the file declares it and keeps the
             coordinates as they are (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``).
+        product: the name of the STEP product (what CAD programs show as the part's name);
+            default the file name without its suffix.
 
     Raises:
         GHTError: something that is not a shape, a null shape, an invalid shape (when ``check``),
@@ -228,7 +307,6 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
     """
     if units not in STEP_UNITS:
         raise GHTError(f"units={units!r} is not a STEP length unit; allowed: {', '.join(STEP_UNITS)}")
-    step_unit, mm_per_unit = STEP_UNITS[units]
     items = list(shapes) if isinstance(shapes, (list, tuple)) else [shapes]
     if not items:
         raise GHTError("nothing to export: the list of shapes is empty")
@@ -254,18 +332,9 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
         for s in raw:
             bb.Add(comp, s)
         shape = comp
-    from OCP.Interface import Interface_Static
-
-    with quiet_occt():
-        STEPControl_Writer()  # registers the STEP statics before they are set
-        previous = Interface_Static.CVal_s("write.step.unit")
-        Interface_Static.SetCVal_s("write.step.unit", step_unit)
-        try:
-            writer = STEPControl_Writer()
-            writer.Model().SetLocalLengthUnit(mm_per_unit)  # the coordinates are in `units`
-            writer.Transfer(shape, STEPControl_AsIs)
-        finally:
-            Interface_Static.SetCVal_s("write.step.unit", previous)
+    with step_writer(units) as writer:
+        writer.Transfer(shape, STEPControl_AsIs)
+        name_products(writer, product if product is not None else _stem(path))
         with atomic_path(path) as tmp:
             if writer.Write(str(tmp)) != IFSelect_RetDone:
                 raise GHTError(f"OCCT failed to write STEP file {path}")

@@ -54,7 +54,8 @@ from OCP.GProp import GProp_GProps
 from OCP.BRep import BRep_Tool
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+from ._ocp import TopoDS
 
 from ..errors import GHTError
 from ..ruled import RuledSurface
@@ -335,7 +336,7 @@ def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
 
 
 def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLike, *, units: str = "mm",
-                     extra: list[Any] | None = None) -> str:
+                     extra: list[Any] | None = None, product: str | None = None) -> str:
     """Write plate solid(s) to STEP with named faces, atomically.
 
     The solids go through ``STEPControl_Writer``; each face's ``ADVANCED_FACE`` entity (found by
@@ -348,20 +349,20 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
         path: target file.
         units: length unit of the coordinates (mm, cm, m, in, ft).
         extra: more shapes written with the plates (e.g. the design's curve edges).
+        product: the STEP product's name (default the file name without its suffix).
 
     Raises:
         GHTError: an invalid solid, an unknown unit or a failed write (the target is untouched).
     """
     from OCP.BRep import BRep_Builder
     from OCP.IFSelect import IFSelect_RetDone
-    from OCP.Interface import Interface_Static
     from OCP.STEPConstruct import STEPConstruct
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs
     from OCP.TCollection import TCollection_HAsciiString
     from OCP.TopoDS import TopoDS_Compound
 
     from ..io import atomic_path
-    from .occ import STEP_UNITS
+    from .occ import STEP_UNITS, _stem, name_products, step_writer
 
     plates = plate if isinstance(plate, list) else [plate]
     if units not in STEP_UNITS:
@@ -380,31 +381,23 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
             bb.Add(shape, p.solid)
         for x in more:
             bb.Add(shape, x)
-    step_unit, mm_per_unit = STEP_UNITS[units]
-    with quiet_occt():
-        STEPControl_Writer()  # registers the statics
-        previous = Interface_Static.CVal_s("write.step.unit")
-        Interface_Static.SetCVal_s("write.step.unit", step_unit)
-        try:
-            writer = STEPControl_Writer()
-            writer.Model().SetLocalLengthUnit(mm_per_unit)
-            writer.Transfer(shape, STEPControl_AsIs)
-            finder = writer.WS().TransferWriter().FinderProcess()
-            for p in plates:
-                if p.name:  # the solid's MANIFOLD_SOLID_BREP carries the plate's name
-                    item = STEPConstruct.FindEntity_s(finder, p.solid)
-                    if item is not None and hasattr(item, "SetName"):
-                        item.SetName(TCollection_HAsciiString(p.name))
-                for name, f in p.named_faces():
-                    item = STEPConstruct.FindEntity_s(finder, f)
-                    if item is None:
-                        raise GHTError(f"the STEP entity of face {name!r} was not found; not exported to {path}")
-                    item.SetName(TCollection_HAsciiString(name))
-            with atomic_path(path) as tmp:
-                if writer.Write(str(tmp)) != IFSelect_RetDone:
-                    raise GHTError(f"OCCT failed to write STEP file {path}")
-        finally:
-            Interface_Static.SetCVal_s("write.step.unit", previous)
+    with step_writer(units) as writer:
+        writer.Transfer(shape, STEPControl_AsIs)
+        name_products(writer, product if product is not None else _stem(path))
+        finder = writer.WS().TransferWriter().FinderProcess()
+        for p in plates:
+            if p.name:  # the solid's MANIFOLD_SOLID_BREP carries the plate's name
+                item = STEPConstruct.FindEntity_s(finder, p.solid)
+                if item is not None and hasattr(item, "SetName"):
+                    item.SetName(TCollection_HAsciiString(p.name))
+            for name, f in p.named_faces():
+                item = STEPConstruct.FindEntity_s(finder, f)
+                if item is None:
+                    raise GHTError(f"the STEP entity of face {name!r} was not found; not exported to {path}")
+                item.SetName(TCollection_HAsciiString(name))
+        with atomic_path(path) as tmp:
+            if writer.Write(str(tmp)) != IFSelect_RetDone:
+                raise GHTError(f"OCCT failed to write STEP file {path}")
     return str(path)
 
 

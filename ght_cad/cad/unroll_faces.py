@@ -49,10 +49,11 @@ from OCP.GeomAbs import (
     GeomAbs_SurfaceOfExtrusion,
 )
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec, gp_Vec2d
-from OCP.TColStd import TColStd_Array1OfReal
+from ._ocp import TColStd_Array1OfReal
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+from ._ocp import TopoDS
 
 from .. import face_unroll as _core
 from ..errors import GHTError

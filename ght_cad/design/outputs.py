@@ -79,7 +79,7 @@ def sew_shell(shapes: Sequence[Any], sew_tol: float | None = None) -> Any:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
     from OCP.TopAbs import TopAbs_SHELL
     from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from ..cad._ocp import TopoDS
 
     from ..cad.developable_faces import shell_faces
     from ..cad.occ import is_valid, unwrap
@@ -111,7 +111,7 @@ def shared_edge_count(shape: Any) -> int:
     """Number of edges of a B-rep shared by two or more of its faces (``TopExp`` edge→face map)."""
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+    from ..cad._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
     from ..cad.occ import unwrap
 
@@ -141,9 +141,9 @@ def export_step(built: BuiltSurface | Sequence[BuiltSurface], path: str | os.Pat
     if plates:
         from ..cad.sheet_solid import write_plate_step
 
-        write_plate_step(plates, path, units=builts[0].design.units, extra=edges)
+        write_plate_step(plates, path, units=builts[0].design.units, extra=edges, product=builts[0].design.name)
         return Path(path)
-    write_step([brep_shapes(builts)] + edges, path, units=builts[0].design.units)
+    write_step([brep_shapes(builts)] + edges, path, units=builts[0].design.units, product=builts[0].design.name)
     return Path(path)
 
 
@@ -375,7 +375,7 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
         else:
             from ..cad.occ import write_step
 
-            write_step(curve_edges(curves), tmp, units=design.units)
+            write_step(curve_edges(curves), tmp, units=design.units, product=design.name)
     elif suf in (".dxf", ".svg"):
         pattern = pattern or unroll_surfaces(builts)
         (pattern.export_dxf if suf == ".dxf" else pattern.export_svg)(tmp, chord_tol=chord_tol)

@@ -63,7 +63,9 @@ def report_markdown(r: dict[str, Any]) -> str:
                 L.append(f"| {j['first']} → {j['second']} | {j['requested']} | G{j['achieved_G']} | "
                          f"{'yes' if j['satisfied'] else 'NO'} |")
             L.append("")
-    if r.get("brep"):
+    if (r.get("brep") or {}).get("skipped"):
+        L += ["## B-rep", "", f"Not built: {r['brep']['skipped']}.", ""]
+    elif r.get("brep"):
         b = r["brep"]
         L += ["## B-rep", "", f"{b['faces']} face(s){' in one shell' if b.get('shape') == 'shell' else ''} "
               f"(valid: {b['valid']}), area {b['area']:.9g} {r['units']}², "

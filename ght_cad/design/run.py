@@ -127,6 +127,13 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         raise GHTError(f"output folder path {os.fspath(out_dir)!r} is empty; allowed: a folder path")
     out = Path(out_dir)
     want_files = set(design.outputs.files)
+    from ..cad import KERNEL_HINT, kernel_available
+
+    # without a kernel (core-only: FreeCAD's Python) everything but the B-rep and STEP is computed
+    use_kernel = kernel_available()
+    if "step" in want_files and not use_kernel:
+        raise GHTError(f"{design.source}: outputs.files asks for 'step', which {KERNEL_HINT}; "
+                       "or leave 'step' out of outputs.files")
     want_figs = set(design.outputs.figures)
     steps = ["curves", "surface", "optimize", "measure", "B-rep + STEP", "flat pattern", "figures", "report"]
     show = bool(progress) and progress_enabled()
@@ -207,43 +214,47 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         if builts:
             # 5. B-rep
             step("B-rep + STEP")
-            face = brep_shapes(builts)
-            from ..cad.occ import is_valid
+            if not use_kernel:
+                report["brep"] = {"skipped": f"the B-rep {KERNEL_HINT}"}
+            else:
+                face = brep_shapes(builts)
+                from ..cad.occ import is_valid
 
-            valid = is_valid(face)
-            nfaces = len(face.faces()) if hasattr(face, "faces") else 1
-            report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": nfaces}
-            if len(builts) > 1 or _is_composite(built.surface) or nfaces > 1:
-                report["brep"]["shape"] = "shell"
-                report["brep"]["shared_edges"] = shared_edge_count(face)
-            if built is not None and _is_composite(built.surface):
-                from ..cad.developable_faces import joint_normal_deviation
+                valid = is_valid(face)
+                nfaces = len(face.faces()) if hasattr(face, "faces") else 1
+                report["brep"] = {"valid": bool(valid), "area": float(face.area), "faces": nfaces}
+                if len(builts) > 1 or _is_composite(built.surface) or nfaces > 1:
+                    report["brep"]["shape"] = "shell"
+                    report["brep"]["shared_edges"] = shared_edge_count(face)
+                if built is not None and _is_composite(built.surface):
+                    from ..cad.developable_faces import joint_normal_deviation
 
-                report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
-            if not valid:
-                raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
-            edges = curve_edges(curves)
-            report["brep"]["curve_edges"] = len(edges)
-            plates = plate_solids(built) if built is not None else []  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
-            if built is None and design.sheet is not None:
-                # [[surfaces]] with [sheet]: one named plate per surface (per strip), faces <name>.inside, ...
-                plates = design_plates(builts)[0]
-                report["plate"] = _shell_plate_report(design, builts, plates, *shell)
-            elif plates:
-                closed = [p.closed_form_volume for p in plates]
-                report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
-                                   # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)
-                                   "volume_closed_form": None if None in closed else float(sum(closed)),
-                                   **design.sheet.to_sheet().as_dict()}
-            if "step" in want_files:
-                if plates:
-                    from ..cad.sheet_solid import write_plate_step
+                    report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
+                if not valid:
+                    raise GHTError(f"{design.source}: the B-rep of the surface is not valid (BRepCheck)")
+                edges = curve_edges(curves)
+                report["brep"]["curve_edges"] = len(edges)
+                plates = plate_solids(built) if built is not None else []  # [sheet]: the plate as solid(s), faces inside/outside/edgeN
+                if built is None and design.sheet is not None:
+                    # [[surfaces]] with [sheet]: one named plate per surface (per strip), faces <name>.inside, ...
+                    plates = design_plates(builts)[0]
+                    report["plate"] = _shell_plate_report(design, builts, plates, *shell)
+                elif plates:
+                    closed = [p.closed_form_volume for p in plates]
+                    report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
+                                       # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)
+                                       "volume_closed_form": None if None in closed else float(sum(closed)),
+                                       **design.sheet.to_sheet().as_dict()}
+                if "step" in want_files:
+                    if plates:
+                        from ..cad.sheet_solid import write_plate_step
 
-                    write_plate_step(plates, stage.path(FILE_NAMES["step"]), units=design.units, extra=edges)
-                else:
-                    from ..cad.occ import write_step
+                        write_plate_step(plates, stage.path(FILE_NAMES["step"]), units=design.units, extra=edges,
+                                         product=design.name)
+                    else:
+                        from ..cad.occ import write_step
 
-                    write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units)
+                        write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units, product=design.name)
             # 6. flat pattern
             step("flat pattern")
             pattern = unroll_surfaces(builts)
@@ -257,7 +268,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if "step" in want_files and curves:
                 from ..cad.occ import write_step
 
-                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]), units=design.units)
+                write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]), units=design.units, product=design.name)
 
         # 7. figures
         step("figures")

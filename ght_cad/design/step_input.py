@@ -75,7 +75,7 @@ def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
     """
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_Reader
-    from OCP.TColStd import TColStd_SequenceOfAsciiString
+    from ..cad._ocp import TColStd_SequenceOfAsciiString
 
     from ..cad.occ import quiet_occt
 
