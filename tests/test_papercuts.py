@@ -138,3 +138,22 @@ def test_minimize_takes_scalar_objectives_and_scipy_bounds():
         minimize(scalar, [(0.0, 1.0), (2.0, 3.0)])
     # one reading valid: taken
     assert minimize(lambda x: float(np.sum(x**2)), [(0.5, 1.0), (0.5, 1.0)], seed=0).fun == pytest.approx(0.5, abs=1e-9)
+
+
+def test_shipped_plane_designs_state_normalize_explicitly():
+    """The default changed (true -> false): every shipped design built from control planes writes
+    its choice, so its output is what it was (default design and composite examples: as before)."""
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    files = sorted((root / "examples").glob("*.toml")) + [root / "ght_cad" / "data" / "default_design.toml"]
+    seen = 0
+    for f in files:
+        data = tomllib.loads(f.read_text())
+        for surf in [data.get("surface", {})] + list(data.get("surfaces", [])):
+            if surf and surf.get("type", "planes") in ("planes", "composite") and ("planes" in surf or "segments" in surf):
+                assert "normalize" in surf, f"{f.name}: a planes/composite surface without an explicit normalize"
+                seen += 1
+    assert seen >= 4
+    assert tomllib.loads(files[-1].read_text())["surface"]["normalize"] is True
