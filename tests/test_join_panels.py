@@ -158,3 +158,80 @@ def test_rigid_motion_onto_maps_the_chord() -> None:
         np.testing.assert_allclose(M @ q0 + t, p0, atol=1e-14)
         np.testing.assert_allclose(M @ q1 + t, p0 + d, atol=1e-14)
         assert math.isclose(np.linalg.det(M), det, rel_tol=1e-14) and np.allclose(M.T @ M, np.eye(2), atol=1e-15)
+
+
+_WALL = """
+name = "cylinder-wall"
+units = "mm"
+
+[[curves]]
+name = "foot"
+control_points = [[0, 0, 0], [100, 60, 0], [200, -20, 0], [300, 40, 0]]
+
+[[curves]]
+name = "seam"
+control_points = [[0, 0, 30], [100, 60, 70], [200, -20, 10], [300, 40, 45]]
+
+[[curves]]
+name = "top"
+control_points = [[0, 0, 120], [100, 60, 120], [200, -20, 120], [300, 40, 120]]
+
+[[surfaces]]
+name = "lower"
+type = "rails"
+curve_a = "foot"
+curve_b = "seam"
+
+[[surfaces]]
+name = "upper"
+type = "rails"
+curve_a = "seam"
+curve_b = "top"
+
+[unroll]
+rulings = 6
+"""
+
+
+@pytest.mark.parametrize("sheet", ["", "\n[sheet]\nthickness = 2.0\nk_factor = 0.4\n"])
+def test_design_surfaces_meeting_g1_along_a_rail_are_one_blank(sheet: str) -> None:
+    """Two `rails` lofts over one planar profile (every rail has the same x, y control points: one
+    general cylinder) share the wavy seam rail and meet G1 there: one blank `lower+upper`, the
+    rectangle (profile length) x 120 (with a sheet: the neutral profile, whose length equals the
+    profile's here because the profile's end tangents are parallel), area = sum of the per-surface
+    panels to 1e-12; `per-surface` keeps two panels marked E1."""
+    from ght_cad.design import build_surfaces, parse_design_text, unroll_surfaces
+
+    d = parse_design_text(_WALL + sheet, "wall.toml")
+    pat = unroll_surfaces(build_surfaces(d))
+    apart = unroll_surfaces(build_surfaces(parse_design_text(_WALL.replace("rulings = 6", 'rulings = 6\npanels = "per-surface"')
+                                                             + sheet, "wall.toml")))
+    assert [p.label for p in apart.panels] == ["lower", "upper"] and [t[2] for t in apart.labels].count("E1") == 2
+    (pn,) = pat.panels
+    assert pn.label == "lower+upper" and pat.errors["max"] < 1e-12
+    assert math.isclose(pn.area_flat, sum(p.area_flat for p in apart.panels), rel_tol=1e-12)
+    foot = next(e for e in pn.loops[0] if e.name == "lower:a")
+    _rectangle_checks(pn, foot.length_flat, 120.0)
+    (j,) = pn.info["joints"]
+    assert j["kind"] == "mark" and j["tangency_deg"] < 1e-6
+    assert ("sheet" in pn.info) == bool(sheet)
+
+
+def test_plated_composite_design_is_one_neutral_blank() -> None:
+    """The two duct strips with a [sheet]: one blank of the neutral strips (they share the neutral
+    joint ruling), area = the per-strip neutral panels' sum to 1e-12, one sheet entry with both
+    strips' edges and bend lines numbered on."""
+    from pathlib import Path
+
+    from ght_cad.design import build_surface, parse_design_text, unroll_surface
+
+    text = (Path(__file__).resolve().parents[1] / "examples" / "design_duct_two_strips.toml").read_text()
+    text += "\n[sheet]\nthickness = 0.01\nk_factor = 0.4\n"
+    (pn,) = unroll_surface(build_surface(parse_design_text(text, "p.toml"))).panels
+    apart = unroll_surface(build_surface(parse_design_text(text.replace("[unroll]\n", '[unroll]\npanels = "per-surface"\n'), "p.toml")))
+    assert len(apart.panels) == 2
+    assert math.isclose(pn.area_flat, sum(p.area_flat for p in apart.panels), rel_tol=1e-12)
+    sh = pn.info["sheet"]
+    assert sh["thickness"] == 0.01 and len(sh["edges"]) == 8
+    lines = [r["line"] for r in sh["forming"] if r["line"]]
+    assert lines == list(range(1, len(lines) + 1)) and len(lines) == sum(len(p.info["sheet"]["forming"]) for p in apart.panels)
