@@ -204,3 +204,29 @@ def test_cadquery_extra_works_on_ocp_7_9_without_build123d() -> None:
     assert "build123d" not in there and "cadquery-ocp-novtk" not in there, there
     tail = _pytest_in(python, CADQUERY_TESTS)
     assert " passed" in tail and "test_cq_plugin" not in "".join(l for l in tail.splitlines() if l.startswith("SKIPPED"))
+
+
+@pytest.mark.freecad
+def test_core_and_run_in_debian_freecad_python(tmp_path: Path) -> None:
+    """FreeCAD's Python for real (Debian 12: /usr/bin/python3 with python3-numpy 1.24, scipy 1.10,
+    matplotlib 3.6, no ezdxf, no OCP): ``ght-cad run`` writes DXF/SVG/JSON; a STEP output exits 2."""
+    py = "/usr/bin/python3"
+    probe = subprocess.run([py, "-s", "-c", "import numpy, scipy, matplotlib; print(numpy.__version__)"],
+                           capture_output=True, text=True) if os.path.exists(py) else None
+    if probe is None or probe.returncode != 0:
+        pytest.skip("no Debian python3 with numpy/scipy/matplotlib (apt-get install freecad-python3)")
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONHOME")}
+    env["PYTHONPATH"] = str(ROOT)
+    design = tmp_path / "cone.toml"
+    design.write_text(CONE.format(files='"dxf", "svg", "json"'))
+    res = subprocess.run([py, "-s", "-m", "ght_cad.cli", "run", str(design), "--out", str(tmp_path / "out"), "--no-progress"],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-2000:]
+    for name in ("flat_pattern.dxf", "flat_pattern.svg", "report.json"):
+        assert (tmp_path / "out" / name).stat().st_size > 0, name
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert "skipped" in report["brep"] and report["flat_pattern"]["area"] > 0
+    design.write_text(CONE.format(files='"step", "dxf"'))
+    res = subprocess.run([py, "-s", "-m", "ght_cad.cli", "run", str(design), "--out", str(tmp_path / "out2")],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 2 and "pip install 'ght_cad[build123d]'" in res.stderr, res.stderr
