@@ -61,6 +61,7 @@ __all__ = [
     "fit_function",
     "GHTSurface",
     "developable_loft",
+    "unfold",
 ]
 
 # Names provided by modules that import scipy or are heavier: loaded on first use so that
@@ -75,6 +76,7 @@ _LAZY: dict[str, str] = {
     "fit_function": "ght_cad.bspline",
     "GHTSurface": "ght_cad.patch",
     "developable_loft": "ght_cad.loft",
+    "unfold": "ght_cad.cad.unfold_solid",
 }
 
 

@@ -467,12 +467,15 @@ def cmd_unroll(args: argparse.Namespace) -> int:
     _check_suffix("--svg", args.svg, (".svg",))
     _check_suffix("--png", args.png, _PNG)
     _check_suffix("--forming-png", args.forming_png, _PNG)
+    _check_suffix("--plate-step", args.plate_step, (".step", ".stp"))
     if Path(args.design).suffix.lower() in (".step", ".stp"):
         return _unroll_step(args)
     for opt, val in (("--face", args.face), ("--best-effort", args.best_effort or None), ("--units", args.units),
                      ("--tol-deg", args.tol_deg), ("--rulings", args.rulings), ("--thickness", args.thickness),
                      ("--k-factor", args.k_factor), ("--din-k-factor", args.din_k_factor), ("--side", args.side),
-                     ("--jobs", args.jobs), ("--scheduler", args.scheduler)):
+                     ("--jobs", args.jobs), ("--scheduler", args.scheduler), ("--k-factor-table", args.k_factor_table),
+                     ("--base-face", args.base_face), ("--bend-lines", args.bend_lines),
+                     ("--allow-split", args.allow_split or None), ("--plate-step", args.plate_step)):
         if val is not None:
             raise UsageError(f"{opt} applies to STEP input only ({args.design} is a design file: give the sheet "
                              "in its [sheet] table); allowed for design files: --dxf, --svg, --png, --forming-png, --json")
@@ -542,9 +545,25 @@ def _sheet_text(r: dict[str, Any], pattern: Any) -> str:
 
 def _unroll_step(args: argparse.Namespace) -> int:
     """``ght-cad unroll FILE.step``: one panel per (selected) face; refuses non-developable faces."""
+    tol = 0.01 if args.tol_deg is None else args.tol_deg
+    blank_opts = [o for o, v in (("--k-factor-table", args.k_factor_table), ("--base-face", args.base_face),
+                                 ("--bend-lines", args.bend_lines), ("--allow-split", args.allow_split or None),
+                                 ("--plate-step", args.plate_step)) if v is not None]
+    if not args.face and not args.best_effort and args.jobs is None and not args.scheduler:
+        from .unfold_step import unfold_step
+
+        blanks = unfold_step(args.design, units=args.units, thickness=args.thickness, k_factor=args.k_factor,
+                             din_k_factor=args.din_k_factor, k_factor_table=args.k_factor_table,
+                             base_face=args.base_face, bend_lines=args.bend_lines or "tangent",
+                             allow_split=args.allow_split, tol_deg=tol,
+                             rulings=args.rulings if args.rulings is not None else 8, force=bool(blank_opts))
+        if blanks is not None:
+            return _emit_blanks(args, blanks)
+    elif blank_opts:
+        raise UsageError(f"{', '.join(blank_opts)} apply to sheet solids (one blank per solid), not with --face, "
+                         "--best-effort, --jobs or --scheduler")
     from .design import unroll_step
 
-    tol = 0.01 if args.tol_deg is None else args.tol_deg
     if args.jobs is not None and args.scheduler:
         raise UsageError("--jobs and --scheduler exclude each other: --jobs runs local processes, "
                          "--scheduler a Dask cluster's workers")
@@ -593,6 +612,51 @@ def _unroll_step(args: argparse.Namespace) -> int:
                          f"F{pl['outside_face']}, thickness {pl['thickness']:.9g}, side {pl['side']} (found by {pl['found_by']})")
         out = _outputs_text(r)
         return "\n".join(lines) + _sheet_text(r, pattern) + ("\n" + out if out else "")
+
+    _emit(args, result, text)
+    return EXIT_OK
+
+
+def _emit_blanks(args: argparse.Namespace, res: Any) -> int:
+    """Report and files of ``ght-cad unroll`` on sheet solids (:func:`ght_cad.unfold_step.unfold_step`)."""
+    if args.side is not None:
+        raise UsageError("--side does not apply to a sheet solid (its material side is the solid's own)")
+    unf = res.unfolded
+    pattern = unf.pattern
+    name = Path(args.design).name
+    result: dict[str, Any] = {"command": "unroll", "name": name, "source": str(args.design), "units": res.units,
+                              "file_units": res.file_units, "face_count": res.face_count,
+                              "panels": len(pattern.panels), "area": float(pattern.area),
+                              "errors": _errors_dict(pattern), **{k: v for k, v in unf.as_dict().items() if k == "blanks"},
+                              "outputs": {}}
+    if args.forming_png:
+        raise UsageError("--forming-png charts a single plate's roll bending; a sheet solid's blank has a bend table "
+                         "instead (in the report)")
+
+    def png(path: Path) -> None:
+        from .design import plot_pattern
+
+        plot_pattern(pattern, path, title=name)
+
+    def plate(path: Path) -> None:
+        from .cad.occ import write_step
+        from .cad.unfold_solid import blank_plates
+
+        write_step(blank_plates(unf), path, units=res.units)
+
+    result["outputs"] = _write_staged([("dxf", args.dxf, pattern.export_dxf), ("svg", args.svg, pattern.export_svg),
+                                       ("png", args.png, png), ("plate_step", args.plate_step, plate)])
+
+    def text(r: dict[str, Any]) -> str:
+        lines = [f"{r['name']}: {len(r['blanks'])} blank(s) in {r['panels']} panel(s) from {r['face_count']} face(s), "
+                 f"units {r['units']}, flat area {r['area']:.9g}"]
+        for b in r["blanks"]:
+            lines.append(f"  {b['name']}: thickness {b['thickness']:.9g}, base face F{b['base_face']}, skin faces "
+                         f"{' '.join(f'F{n}' for n in b['faces'])}, area {b['area']:.9g}"
+                         + (f", cut edges {' '.join(b['cut_edges'])}" if b["cut_edges"] else ""))
+        lines.append(unf.bend_table())
+        out = _outputs_text(r)
+        return "\n".join(lines) + ("\n" + out if out else "")
 
     _emit(args, result, text)
     return EXIT_OK
@@ -773,7 +837,9 @@ def build_parser() -> argparse.ArgumentParser:
         "relative length and area errors of the pattern. FILE is a design file (.toml) or a STEP "
         "file (.step/.stp, detected by suffix) made by any CAD tool: every developable face "
         "(cylinder, cone, plane, extrusion, ruled B-spline) becomes one labelled panel F<n> "
-        "(n = face number), with matching edge marks on edges shared by two faces. A face that is "
+        "(n = face number), with matching edge marks on edges shared by two faces; a sheet solid (bent "
+        "part) gives ONE blank: its skin unfolded across the bends at the neutral radius R + K T, with bend "
+        "lines and a bend table (--face or --best-effort unroll single faces instead). A face that is "
         "not developable within --tol-deg is refused (exit 2, naming the face and its theta_max "
         "and DD) unless --best-effort is given.",
         epilog=_EPILOG,
@@ -802,6 +868,17 @@ def build_parser() -> argparse.ArgumentParser:
                     help="STEP only: material along the face normal (normal, default) or against it (reverse)")
     sp.add_argument("--forming-png", metavar="FILE",
                     help="roll-bending chart of a sheet pattern (neutral radius along the plate)")
+    sp.add_argument("--k-factor-table", metavar="ansi|din|FILE",
+                    help="STEP sheet solids: K per bend by R/T from a table (ansi, din or a file of 'R/T K' lines)")
+    sp.add_argument("--base-face", type=int, metavar="N",
+                    help="STEP sheet solids: the face (1-based, file order) that keeps its place in the blank "
+                         "(default: the largest planar face)")
+    sp.add_argument("--bend-lines", choices=("tangent", "centre"),
+                    help="STEP sheet solids: draw both tangent lines of every bend (default) or its centre line")
+    sp.add_argument("--allow-split", action="store_true",
+                    help="STEP sheet solids: keep pieces that would overlap in the flat apart as separate panels")
+    sp.add_argument("--plate-step", metavar="FILE",
+                    help="STEP sheet solids: write every blank as a flat plate (outline extruded by T) for CAM")
     sp.add_argument("--jobs", type=int, metavar="N",
                     help="STEP only: unroll the faces in N local processes (default 1; panels identical to serial)")
     sp.add_argument("--scheduler", metavar="ADDRESS",

@@ -583,9 +583,12 @@ def unroll_face(
     )
 
 
-def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, float]) -> FaceData:
+def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, float],
+              edge_name: Callable[[Any], str] | None = None) -> FaceData:
     """The face as :class:`ght_cad.face_unroll.FaceData`: every wire (outer first) traversed by
-    ``BRepTools_WireExplorer``, each edge's pcurve, 3-D curve and length (:func:`_edge_samples`)."""
+    ``BRepTools_WireExplorer``, each edge's pcurve, 3-D curve and length (:func:`_edge_samples`);
+    edges named ``edge<k>`` in wire order, or ``edge_name(edge)`` (e.g. the solid's edge key,
+    the same in both faces sharing an edge)."""
     wires = []
     for w in _wires(f):
         loop = []
@@ -594,7 +597,8 @@ def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, 
         while exp.More():
             e = exp.Current()
             uvf, xyzf, L3, duvf = _edge_samples(e, f, e.Orientation() == TopAbs_REVERSED)
-            loop.append(EdgeData(uv=uvf, duv=duvf, xyz=xyzf, length_3d=L3, breaks=duvf.breaks, name=f"edge{k}"))
+            loop.append(EdgeData(uv=uvf, duv=duvf, xyz=xyzf, length_3d=L3, breaks=duvf.breaks,
+                                 name=f"edge{k}" if edge_name is None else edge_name(e)))
             k += 1
             exp.Next()
         if loop:

@@ -1,0 +1,110 @@
+"""Bent sheet parts built in build123d for the blank tests and bench/bench_blank.py, with their
+closed-form neutral blanks.
+
+A profile is a path in the xy plane: flat lengths ``flats[i]`` joined by circular bends
+``(angle, inside_radius, turn)`` (turn +1 left / -1 right); the material lies to the right of the
+path, so a left turn has the path on its inside (radius R, other side R + T) and a right turn on
+its outside (R + T, other side R). The profile face is extruded by ``width`` along z.
+Closed-form blank length: ``Σ flats + Σ (R + K T) A``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Profile:
+    flats: list[float]
+    bends: list[tuple[float, float, int]]  # (angle rad, inside radius, turn ±1)
+    thickness: float
+    width: float
+
+    def blank_length(self, k: float) -> float:
+        return sum(self.flats) + sum((r + k * self.thickness) * a for a, r, _ in self.bends)
+
+    def blank_area(self, k: float) -> float:
+        return self.blank_length(k) * self.width
+
+
+def _paths(p: Profile) -> tuple[list, list]:
+    """Both sides of the profile as lists of pieces ('line', p0, p1) / ('arc', p0, pm, p1)."""
+    T = p.thickness
+    pos = np.zeros(2)
+    d = np.array([1.0, 0.0])
+    left, right = [], []  # left = the path itself, right = offset by T to the right
+
+    def rperp(v: np.ndarray) -> np.ndarray:
+        return np.array([v[1], -v[0]])
+
+    for i, L in enumerate(p.flats):
+        q = pos + L * d
+        left.append(("line", pos.copy(), q.copy()))
+        right.append(("line", pos + T * rperp(d), q + T * rperp(d)))
+        pos = q
+        if i < len(p.bends):
+            a, R, turn = p.bends[i]
+            r_path = R if turn > 0 else R + T
+            n_left = -rperp(d)  # unit normal to the left
+            c = pos + turn * r_path * n_left
+            def rot(v: np.ndarray, ang: float) -> np.ndarray:
+                cs, sn = math.cos(ang), math.sin(ang)
+                return np.array([cs * v[0] - sn * v[1], sn * v[0] + cs * v[1]])
+            ang = turn * a
+            for side, rr in ((left, r_path), (right, r_path + (T if turn > 0 else -T))):
+                v0 = (pos - c) / r_path * rr
+                side.append(("arc", c + v0, c + rot(v0, 0.5 * ang), c + rot(v0, ang)))
+            pos = c + rot(pos - c, ang)
+            d = rot(d, ang)
+    return left, right
+
+
+def profile_solid(p: Profile, holes: list[tuple[float, float, float]] = ()):
+    """The extruded sheet solid (build123d Solid); ``holes``: (x, y, radius) of round holes
+    through a flange parallel to the xz plane... given as (flat index, position along, diameter)."""
+    import build123d as bd
+
+    left, right = _paths(p)
+
+    def edge(piece, reverse=False):
+        pts = [bd.Vector(float(x), float(y), 0.0) for x, y in piece[1:]]
+        if reverse:
+            pts = pts[::-1]
+        if piece[0] == "line":
+            return bd.Edge.make_line(pts[0], pts[1])
+        return bd.Edge.make_three_point_arc(*pts)
+
+    edges = [edge(pc) for pc in left]
+    edges.append(bd.Edge.make_line(bd.Vector(*left[-1][-1], 0), bd.Vector(*right[-1][-1], 0)))
+    edges += [edge(pc, True) for pc in reversed(right)]
+    edges.append(bd.Edge.make_line(bd.Vector(*right[0][1], 0), bd.Vector(*left[0][1], 0)))
+    face = bd.Face(bd.Wire(edges))
+    solid = bd.Solid.extrude(face, bd.Vector(0, 0, p.width))
+    for fi, along, dia in holes:
+        piece = left[2 * fi]
+        a, b = piece[1], piece[2]
+        d = (b - a) / np.linalg.norm(b - a)
+        c = a + along * d
+        nrm = np.array([d[1], -d[0]])  # to the right: through the material
+        cyl = bd.Solid.make_cylinder(dia / 2, 10 * p.thickness,
+                                     bd.Plane(origin=(float(c[0] - 5 * p.thickness * nrm[0]), float(c[1] - 5 * p.thickness * nrm[1]),
+                                                      p.width / 2), z_dir=(float(nrm[0]), float(nrm[1]), 0.0)))
+        solid = solid - cyl
+    return solid
+
+
+def bracket() -> Profile:
+    """The issue's L-bracket: T 2, inside R 3, flanges 40 and 25, width 50."""
+    return Profile([40.0, 25.0], [(math.pi / 2, 3.0, 1)], 2.0, 50.0)
+
+
+def z_profile() -> Profile:
+    return Profile([30.0, 20.0, 30.0], [(math.pi / 2, 2.0, 1), (math.pi / 2, 2.0, -1)], 1.5, 40.0)
+
+
+def u_channel() -> Profile:
+    """U-channel with two radii (3 and 5); a 10 mm hole in its base (flat 1)."""
+    return Profile([25.0, 60.0, 25.0], [(math.pi / 2, 3.0, 1), (math.pi / 2, 5.0, 1)], 2.0, 45.0)
