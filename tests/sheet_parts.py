@@ -108,3 +108,64 @@ def z_profile() -> Profile:
 def u_channel() -> Profile:
     """U-channel with two radii (3 and 5); a 10 mm hole in its base (flat 1)."""
     return Profile([25.0, 60.0, 25.0], [(math.pi / 2, 3.0, 1), (math.pi / 2, 5.0, 1)], 2.0, 45.0)
+
+
+def tray(A: float = 100.0, B: float = 80.0, T: float = 2.0, R: float = 3.0, F: float = 20.0, g: float = 4.0):
+    """A tray: base A x B (thickness T), four flanges of flat height F bent up 90 deg at inside radius R,
+    each side's bend and flange ``g`` shorter at both ends (corner reliefs). Returns the solid and
+    ``area(K)``, the closed-form neutral blank ``A B + 2 (A + B - 4 g) ((R + K T) π/2 + F)``."""
+    import build123d as bd
+
+    def side(length: float) -> list:
+        c = (0.0, T + R)
+
+        def pt(r: float, a: float):
+            return bd.Vector(c[0] + r * math.cos(a), 0, c[1] + r * math.sin(a))
+
+        e = [bd.Edge.make_three_point_arc(pt(R, -math.pi / 2), pt(R, -math.pi / 4), pt(R, 0)),
+             bd.Edge.make_line(pt(R, 0), pt(R + T, 0)),
+             bd.Edge.make_three_point_arc(pt(R + T, 0), pt(R + T, -math.pi / 4), pt(R + T, -math.pi / 2)),
+             bd.Edge.make_line(pt(R + T, -math.pi / 2), pt(R, -math.pi / 2))]
+        bend = bd.Solid.extrude(bd.Face(bd.Wire(e)), bd.Vector(0, length, 0))
+        return [bend, bd.Solid.make_box(T, length, F).translate((R, 0, T + R))]
+
+    parts = [bd.Solid.make_box(A, B, T)]
+    parts += [s.translate((A, g, 0)) for s in side(B - 2 * g)]
+    parts += [s.mirror(bd.Plane.YZ).translate((0, g, 0)) for s in side(B - 2 * g)]
+    parts += [s.rotate(bd.Axis.Z, 90).translate((A - g, B, 0)) for s in side(A - 2 * g)]
+    parts += [s.rotate(bd.Axis.Z, 90).mirror(bd.Plane.XZ).translate((A - g, 0, 0)) for s in side(A - 2 * g)]
+    solid = parts[0]
+    for p in parts[1:]:
+        solid = solid + p
+
+    def area(k: float) -> float:
+        return A * B + 2 * (A + B - 4 * g) * ((R + k * T) * math.pi / 2 + F)
+
+    return solid, area
+
+
+def freeform_bend(sign: int, T: float = 2.0, W: float = 40.0):
+    """Straight (30) - cubic Bézier (turning 90 deg) - straight (25) profile extruded by W and
+    thickened by T (``BRepOffsetAPI_MakeThickSolid.MakeThickSolidBySimple``: the other skin is the
+    exact offset surface); ``sign`` -1 puts the material on the convex side (the profile is the
+    inside skin), +1 on the concave side (the profile is the outside skin). Returns the solid and
+    ``area(K) = (L_inside + K T π/2) W`` with ``L_inside = L`` or ``L - T π/2``."""
+    import build123d as bd
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeThickSolid
+
+    from ght_cad.cad.curves import exact_edges
+
+    with exact_edges():
+        l1 = bd.Edge.make_line((0, 0, 0), (30, 0, 0))
+        sp = bd.Edge.make_bezier((30, 0, 0), (40, 0, 0), (50, 10, 0), (50, 20, 0))
+        l2 = bd.Edge.make_line((50, 20, 0), (50, 45, 0))
+        shell = bd.Shell([bd.Face.extrude(e, bd.Vector(0, 0, W)) for e in (l1, sp, l2)])
+    mk = BRepOffsetAPI_MakeThickSolid()
+    mk.MakeThickSolidBySimple(shell.wrapped, sign * T)
+    mk.Build()
+    L = 55.0 + sp.length - (T * math.pi / 2 if sign > 0 else 0.0)
+
+    def area(k: float) -> float:
+        return (L + k * T * math.pi / 2) * W
+
+    return bd.Solid(mk.Shape()), area

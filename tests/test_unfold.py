@@ -174,3 +174,30 @@ def test_blank_options_need_a_sheet_solid(tmp_path: Path, capsys) -> None:
     assert rc == EXIT_USAGE and "F99" in res["error"]
     rc, res = _run(["unroll", str(step), "--face", "1"], capsys)  # a face selection: per-face unroll as before
     assert rc == EXIT_OK and res["panels"] == 1 and abs(res["area"] - 2000.0) < 1e-9
+
+
+def test_tray_four_flanges_corner_reliefs() -> None:
+    from sheet_parts import tray
+
+    solid, area = tray()
+    res = ght_cad.unfold(solid, k_factor=K)
+    assert len(res.pattern.panels) == 1 and not res.blanks[0].cut_edges
+    assert abs(res.pattern.area / area(K) - 1) < 1e-6
+    ba = (3.0 + K * 2.0) * math.pi / 2
+    rows = res.blanks[0].bends
+    assert len(rows) == 4 and all(r["direction"] == "up" for r in rows)
+    assert all(abs(r["bend_lines_distance"] / ba - 1) < 1e-9 for r in rows)
+
+
+@pytest.mark.parametrize("sign", [-1, 1])
+def test_freeform_bend_either_side(sign: int) -> None:
+    """A spline bend (extrusion face and its exact offset): inside length + K T × turn angle."""
+    from sheet_parts import freeform_bend
+
+    solid, area = freeform_bend(sign)
+    res = ght_cad.unfold(solid, k_factor=K)
+    assert len(res.pattern.panels) == 1
+    assert abs(res.pattern.area / area(K) - 1) < 1e-6, (res.pattern.area, area(K))
+    row = res.blanks[0].bends[0]
+    assert abs(row["angle_deg"] - 90.0) < 1e-6 and row["kind"] not in ("cylinder", "cone")
+    assert res.pattern.panels[0].bend_lines.shape[0] > 2  # tangent lines + rulings

@@ -133,6 +133,10 @@ def sheet_skins(shape: Any, *, base_face: int | None = None, name: str = "") -> 
 
 
 def _solid_skin(solid: Any, sname: str, fmap: Any, number_of: dict[int, int], base_face: int | None) -> SheetSkin:
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid, props)
+    if props.Mass() < 0:  # an inside-out solid (e.g. thickened against its faces' normals): face normals inward
+        solid = solid.Reversed()
     faces, exp = [], TopExp_Explorer(solid, TopAbs_FACE)
     seen = set()
     while exp.More():
