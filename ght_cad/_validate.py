@@ -72,6 +72,12 @@ def check_degree(degree: Any, minimum: int = 2) -> int:
     return degree
 
 
+#: largest coordinate magnitude of control points: products of up to six coordinates (areas, the
+#: determinants of the developability measures, squared lengths of derivatives of high degree) stay
+#: far from float overflow (1.8e308); 1e300 gave an infinite arc length with numpy warnings
+MAX_COORDINATE = 1e50
+
+
 def check_finite_array(name: str, arr: np.ndarray) -> np.ndarray:
     """Raise if ``arr`` holds NaN or inf, naming the first offending index."""
     bad = ~np.isfinite(arr)
@@ -80,6 +86,17 @@ def check_finite_array(name: str, arr: np.ndarray) -> np.ndarray:
         raise GHTError(
             f"{name} contains a non-finite value {float(arr[idx])!r} at index {idx}; all values must be finite"
         )
+    return arr
+
+
+def check_coordinate_range(name: str, arr: np.ndarray, limit: float = MAX_COORDINATE) -> np.ndarray:
+    """Raise if an entry of the (finite) ``arr`` exceeds ``limit`` in magnitude (derivatives,
+    lengths and areas computed from it would overflow), naming the first offending index."""
+    big = np.abs(arr) > limit
+    if big.any():
+        idx = tuple(int(i) for i in np.argwhere(big)[0])
+        raise GHTError(f"{name} has the value {float(arr[idx]):g} at index {idx}, beyond ±{limit:g}; allowed: "
+                       f"coordinates within ±{limit:g} (lengths and areas of larger ones overflow)")
     return arr
 
 
@@ -114,6 +131,7 @@ def check_points(
     if dims is not None and arr.shape[1] not in dims:
         raise GHTError(f"{name} has dimension {arr.shape[1]}; allowed dimensions are {dims}")
     check_finite_array(name, arr)
+    check_coordinate_range(name, arr)
     return arr
 
 

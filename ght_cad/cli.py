@@ -238,12 +238,14 @@ def cmd_curve(args: argparse.Namespace) -> int:
     _check_suffix("--step", args.step, _STEP)
     _check_suffix("--plot", args.plot, _PNG)
     _check_suffix("--curvature-plot", args.curvature_plot, _PNG)
+    from .curve import curvature_from_derivatives
+
     curve = GHTCurve(_parse_points(args.points), args.mu, args.nu, args.gamma)
     t = np.linspace(0.0, 1.0, 513)
     pts = curve.control_points
     point = float(np.max(np.ptp(pts, axis=0))) <= 1e-12 * float(np.max(np.abs(pts)))  # all points coincide
     with np.errstate(all="ignore"):
-        kappa = np.asarray(curve.curvature(t), dtype=float)
+        kappa = curvature_from_derivatives(curve.derivative(t, 1), curve.derivative(t, 2))  # NaN where P' = 0
     finite = np.zeros(0) if point else kappa[np.isfinite(kappa)]
     result: dict[str, Any] = {
         "command": "curve",

@@ -260,12 +260,13 @@ def join_targets(
     if not cont.geometric:
         return d
     out = [d[0]]
-    if r >= 1:
-        out.append(k * d[1])
-    if r >= 2:
-        out.append(k * k * d[2] + beta2 * d[1])
-    if r >= 3:
-        out.append(k**3 * d[3] + 3.0 * k * beta2 * d[2] + beta3 * d[1])
+    with np.errstate(over="ignore", invalid="ignore"):  # huge k: inf targets, refused by join()
+        if r >= 1:
+            out.append(k * d[1])
+        if r >= 2:
+            out.append(k * k * d[2] + beta2 * d[1])
+        if r >= 3:
+            out.append(k * k * k * d[3] + 3.0 * k * beta2 * d[2] + beta3 * d[1])
     return out
 
 
@@ -361,7 +362,16 @@ def join(
                 f"R_{r}: change B's degree or shape parameters"
             )
         known = row[:r] @ pts[:r]
-        pts[r] = (targets[r] - known) / c
+        with np.errstate(over="ignore", invalid="ignore"):
+            pts[r] = (targets[r] - known) / c
+    from ._validate import MAX_COORDINATE
+
+    if not np.all(np.abs(pts) <= MAX_COORDINATE):  # NaN/inf included
+        raise SingularJoinError(
+            f"cannot impose {cont.value} with k={k:g}, beta2={beta2:g}, beta3={beta3:g}: segment B's solved "
+            f"control points R_1..R_{r_max} reach {float(np.nanmax(np.abs(pts))):g} (beyond ±{MAX_COORDINATE:g}); "
+            "allowed: G parameters of moderate size (k near the ratio of the two segments' end speeds)"
+        )
     return GHTCurve(pts, seed=b.seed)
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from ._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
 from .basis import MAX_DIRECT_DEGREE, _check_order, bernstein, bernstein_log, seed_basis
-from .errors import GHTError
+from .errors import DegenerateGeometryError, GHTError
 from .seeds import Seed, make_seed
 
 __all__ = ["GHTCurve", "gauss_legendre", "integrate"]
@@ -271,8 +271,21 @@ class GHTCurve:
         Gram determinant ``sqrt(|P'|²|P''|² - (P'·P'')²)``, whose cancellation leaves about
         ``sqrt(1e-16)`` = 1e-8 of ``|P''|/|P'|²`` on a straight line, this is at round-off level
         (``~1e-16 |P''|/|P'|²``): a straight line's curvature is 0 up to 1e-16.
+
+        Raises:
+            DegenerateGeometryError: ``P'(t) = 0`` at a requested ``t`` (coincident control points
+                at that end, or all of them: the curvature is undefined there, never NaN).
         """
-        return curvature_from_derivatives(self.derivative(t, 1), self.derivative(t, 2))
+        with np.errstate(all="ignore"):
+            kappa = curvature_from_derivatives(self.derivative(t, 1), self.derivative(t, 2))
+        bad = ~np.isfinite(np.atleast_1d(kappa))
+        if bad.any():
+            tt = np.atleast_1d(np.asarray(t, dtype=float))
+            at = float(tt[int(np.argmax(bad))]) if tt.size == bad.size else float(tt.ravel()[0])
+            raise DegenerateGeometryError(
+                f"the curvature is undefined at t={at:.6g}: the tangent P'(t) vanishes there (coincident control "
+                "points); allowed: parameters where P'(t) != 0")
+        return kappa
 
     def signed_curvature(self, t: Any) -> np.ndarray:
         """Signed curvature ``(x'y'' - y'x'') / |P'|^3`` of a planar (2-D) curve."""

@@ -564,7 +564,12 @@ def _boundary_roots(pair: _Pair, samples: int) -> list[tuple[float, float]]:
             if vals[i] == 0.0 and i > 0:
                 r = x[i]
             elif vals[i] * vals[i + 1] < 0:
-                r = brentq(fun, x[i], x[i + 1], xtol=1e-16, rtol=4 * _EPS, maxiter=200)
+                fa, fb = fun(x[i]), fun(x[i + 1])
+                if fa * fb < 0:
+                    r = brentq(fun, x[i], x[i + 1], xtol=1e-16, rtol=4 * _EPS, maxiter=200)
+                else:  # the sampled sign change is rounding at an end (e.g. a rail to a straight rail:
+                    # the scale-free f and the corner-integrated F differ there): the root is that end
+                    r = x[i] if abs(fa) <= abs(fb) else x[i + 1]
             else:
                 continue
             if r <= MIN_FAN:

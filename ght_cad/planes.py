@@ -167,6 +167,16 @@ def check_control_planes(planes: Any, name: str = "planes", *, tol: float = PARA
                 f"are {kind} (sine of the angle between their normals = {s:.3g} <= {tol:g}); "
                 "neighbouring control planes must intersect in a line"
             )
+    # a pencil: every control plane through one line (rank 2 of the 4-vectors); every U(t) and U'(t)
+    # then contain that line, so every ruling is that one line and the surface has no width
+    unit = arr / np.linalg.norm(arr, axis=1, keepdims=True)
+    sv = np.linalg.svd(unit, compute_uv=False)
+    if sv[2] <= tol * sv[0]:
+        raise DegenerateGeometryError(
+            f"the control planes ({name}) all pass through one line (a pencil of planes: singular values of the "
+            f"normalized 4-vectors {sv[0]:.3g}, {sv[1]:.3g}, {sv[2]:.3g}); every ruling would be that line; "
+            "control planes must not all share a line"
+        )
     return arr
 
 

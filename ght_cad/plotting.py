@@ -251,6 +251,8 @@ def plot_curvature(curve: Any, path: str | os.PathLike, samples: int = 400) -> P
     Returns:
         The written path.
     """
+    from .curve import curvature_from_derivatives
+
     curves = _as_curves(curve)
     t = np.linspace(0.0, 1.0, int(samples))
     fig = _figure("curvature")
@@ -259,7 +261,7 @@ def plot_curvature(curve: Any, path: str | os.PathLike, samples: int = 400) -> P
     ax2 = None
     for k, c in enumerate(curves):
         with np.errstate(all="ignore"):
-            kappa = np.asarray(c.curvature(t), dtype=float)
+            kappa = curvature_from_derivatives(c.derivative(t, 1), c.derivative(t, 2))  # NaN where P' = 0
         if np.isfinite(kappa).any():  # all NaN: the control points coincide (a point)
             kmax = max(kmax, float(np.nanmax(kappa)))
         ax.plot(t + k, kappa, lw=1.8, color="C0", label="curvature κ" if k == 0 else None)

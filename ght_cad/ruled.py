@@ -24,7 +24,7 @@ from ._vec import cross as _cross
 from ._vec import dot as _dot
 from ._vec import norm as _norm
 from .curve import GHTCurve, gauss_legendre
-from .errors import GHTError
+from .errors import DegenerateGeometryError, GHTError
 
 __all__ = [
     "Developability",
@@ -291,7 +291,12 @@ class RuledSurface(ABC):
         th, dot = _theta(a1, b1, g)
         _, theta_rms, dd, R = _integrals(th[:n], dot[:n], w)
         fin = np.isfinite(th)
-        theta_max = float(np.fmax.reduce(th)) if fin.any() else math.nan  # undefined normals (NaN) skipped
+        if not fin.any():  # no ruling with a defined normal: nothing to measure (and no NaN to report)
+            L = np.linalg.norm(g, axis=1)
+            why = ("every sampled ruling has zero length (a zero-width surface)" if not (L > 0).any() else
+                   "the surface normal is undefined at every sampled ruling (a' parallel to the ruling)")
+            raise DegenerateGeometryError(f"developability is undefined: {why}; allowed: a surface of positive width")
+        theta_max = float(np.fmax.reduce(th))  # undefined normals (NaN) skipped
         # the residual where the normals are defined (at a zero-length ruling it is noise / noise)
         res_all = np.abs(_residual(a1, g, g1))
         res = float(res_all[fin].max()) if fin.any() else float(res_all.max())
@@ -315,6 +320,11 @@ class CurvePairRuledSurface(RuledSurface):
                 raise GHTError(f"{name} must be a GHTCurve, got {type(c).__name__}")
             if c.dim != 3:
                 raise GHTError(f"{name} has dimension {c.dim}; a ruled surface needs 3-D curves")
+        if (curve_a.shape_parameters == curve_b.shape_parameters and curve_a.seed.name == curve_b.seed.name
+                and np.array_equal(curve_a.control_points, curve_b.control_points)):
+            raise DegenerateGeometryError(
+                "curve_a and curve_b are the same curve (equal control points and shape parameters): every ruling "
+                "has zero length, the surface has zero width; allowed: two different curves")
         self.curve_a = curve_a
         self.curve_b = curve_b
 

@@ -255,3 +255,173 @@ def test_msvcrt_branch_locks(tiny: Path, tmp_path: Path, capsys, monkeypatch) ->
     with od.TargetLock(tmp_path / "x"):
         with pytest.raises(od.FolderBusy):
             od.TargetLock(tmp_path / "x").acquire()
+
+
+# ---------------------------------------------------------------------------------------------
+# hostile STEP files
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def cylinder_step(tmp_path_factory: pytest.TempPathFactory) -> bytes:
+    """The bytes of a valid STEP file: a 120-degree cylinder face (R 30, H 50)."""
+    bd = pytest.importorskip("build123d")
+    from ght_cad.cad.occ import write_step
+
+    solid = bd.Solid.make_cylinder(30.0, 50.0, angle=120.0)
+    face = next(f for f in solid.faces() if f.geom_type == bd.GeomType.CYLINDER)
+    p = tmp_path_factory.mktemp("step") / "cyl.step"
+    write_step(face, p)
+    return p.read_bytes()
+
+
+def _points_scaled(text: str, fn) -> str:
+    import re
+
+    def sub(m: "re.Match[str]") -> str:
+        return m.group(1) + ",".join(fn(float(x)) for x in m.group(2).split(",")) + ")"
+
+    return re.sub(r"(CARTESIAN_POINT\('[^']*',\()([^)]*)\)", sub, text)
+
+
+def test_step_with_an_overflowing_coordinate_exits_2_in_seconds(cylinder_step: bytes, tmp_path: Path, capsys) -> None:
+    """``1.E400`` in a CARTESIAN_POINT: OCCT's TransferRoots never finished (> 150 s); now refused by the
+    text scan before OCCT sees the file: exit 2, one line naming the file and the entity, < 30 s."""
+    import re
+    import time
+
+    p = tmp_path / "e400.step"
+    p.write_text(re.sub(r"(CARTESIAN_POINT\('[^']*',\()[^,]+", r"\g<1>1.E400", cylinder_step.decode(), count=1))
+    t0 = time.perf_counter()
+    rc, _, err = _run(["unroll", str(p)], capsys)
+    assert time.perf_counter() - t0 < 30.0
+    assert rc == EXIT_USAGE and str(p) in err and "CARTESIAN_POINT" in err and "1.E400" in err, err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_step_scaled_by_1e290_exits_2_without_warnings(cylinder_step: bytes, tmp_path: Path, capsys) -> None:
+    """Every coordinate x 1e290: was NaN developability with two numpy overflow warnings."""
+    import warnings
+
+    p = tmp_path / "x1e290.step"
+    p.write_text(_points_scaled(cylinder_step.decode(), lambda x: f"{x * 1e290:.17E}"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rc, _, err = _run(["unroll", str(p)], capsys)
+    assert rc == EXIT_USAGE and "beyond" in err and "Warning" not in err, err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_step_scan_keeps_legal_numbers(cylinder_step: bytes, tmp_path: Path, capsys) -> None:
+    """The valid file, its coordinates x 1e9 (within 1e12) and a name holding 'E99' still unroll."""
+    p = tmp_path / "big.step"
+    p.write_text(_points_scaled(cylinder_step.decode(), lambda x: f"{x * 1e9:.17E}").replace("''", "'PIPE12E99'", 1))
+    rc, _, err = _run(["unroll", str(p)], capsys)
+    assert rc == EXIT_OK, err
+
+
+def test_step_scan_names_the_entity() -> None:
+    from ght_cad.errors import GHTError
+    from ght_cad.step_guard import check_step_numbers
+
+    for text, token in [(b"#7=CARTESIAN_POINT('',(3E+291,0.,0.));", "#7 CARTESIAN_POINT"),
+                        (b"#1=A(1.);\n#8=B_SPLINE_CURVE_WITH_KNOTS('',(-1.E+20));", "#8 B_SPLINE_CURVE_WITH_KNOTS"),
+                        (b"#2=P((0.,12345678901234.5));", "#2 P")]:
+        with pytest.raises(GHTError, match=token):
+            check_step_numbers("f.step", text)
+    for ok in (b"#1=P((1.5E+05,1.E-400,123456789012.));", b"#1=X('a1E99',(1.,2.));", b"#3=P((1.E12,-1.E+012));"):
+        check_step_numbers("f.step", ok)
+
+
+def test_a_directory_named_like_a_step_file(tmp_path: Path, capsys) -> None:
+    (tmp_path / "x.step").mkdir()
+    rc, _, err = _run(["unroll", str(tmp_path / "x.step")], capsys)
+    assert rc == EXIT_USAGE and "is a directory" in err and "no such" not in err, err
+
+
+# ---------------------------------------------------------------------------------------------
+# degenerate geometry: refused at construction, never NaN
+# ---------------------------------------------------------------------------------------------
+def test_pencil_of_control_planes_is_degenerate() -> None:
+    """Three planes through the z axis: every ruling would be that axis (was accepted, DD NaN)."""
+    import numpy as np
+
+    from ght_cad import developable_from_planes
+    from ght_cad.errors import DegenerateGeometryError
+
+    planes = [[0.0, np.sin(a), -np.cos(a), 0.0] for a in (0.1, 0.7, 1.3)]
+    with pytest.raises(DegenerateGeometryError, match="pencil"):
+        developable_from_planes(planes, [[0, 0, 0, 1], [-1, 0, 0, 1]])
+    from ght_cad.planes import check_control_planes
+
+    moved = [list(p) for p in planes]
+    moved[1][3] = 0.5  # the middle plane tilted out of the pencil: accepted by the pencil test
+    check_control_planes(moved)
+
+
+def test_curvature_where_the_tangent_vanishes_raises() -> None:
+    import numpy as np
+
+    from ght_cad import GHTCurve
+    from ght_cad.errors import DegenerateGeometryError
+
+    c = GHTCurve([[0, 0], [0, 0], [1, 1]])
+    with pytest.raises(DegenerateGeometryError, match=r"t=0\b"):
+        c.curvature([0.0, 0.5])
+    assert np.isfinite(c.curvature([0.25, 0.5, 1.0])).all()
+    with pytest.raises(DegenerateGeometryError):
+        GHTCurve([[1, 1], [1, 1], [1, 1]]).curvature(0.5)
+
+
+def test_control_points_near_1e300_are_refused_without_warnings() -> None:
+    import warnings
+
+    from ght_cad import GHTCurve
+    from ght_cad.errors import GHTError
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(GHTError, match=r"beyond ±1e\+50"):
+            GHTCurve([[0, 0], [1e300, 1], [2e300, 0]])
+
+
+def test_zero_width_ruled_surface_is_degenerate_not_nan() -> None:
+    from ght_cad import GHTCurve, unroll
+    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
+
+    c = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 1]])
+    with pytest.raises(DegenerateGeometryError, match="same curve"):
+        CurvePairRuledSurface(c, c)
+    s = FunctionRuledSurface(lambda u, d: c.derivative(u, d), lambda u, d: c.derivative(u, d))
+    for call in (s.developability, lambda: unroll(s)):
+        with pytest.raises(DegenerateGeometryError, match="zero width|zero-width"):
+            call()
+
+
+def test_join_with_huge_k_is_refused_naming_k() -> None:
+    import warnings
+
+    from ght_cad import GHTCurve
+    from ght_cad.continuity import join
+    from ght_cad.errors import SingularJoinError
+
+    a = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for cont in ("G1", "G3"):
+            with pytest.raises(SingularJoinError, match=r"k=1e\+300"):
+                join(a, cont, [[2, 0, 0], [3, -1, 0], [4, 0, 0], [5, 1, 0]], k=1e300)
+
+
+@pytest.mark.parametrize("body, key", [
+    ("[[curves]]\nname='a'\ncontrol_points=[[0,0,0],[1e13,1,0],[2,0,0]]\n", "curves[0].control_points[1][0]"),
+    ("[[curves]]\nname='a'\ncontrol_points=[" + ",".join(f"[{i},0,0]" for i in range(1001)) + "]\n",
+     "curves[0].control_points"),
+    ("[[curves]]\nname='a'\ncontrol_points=[[0,0,0],[1,1,0],[2,0,1]]\n[[curves]]\nname='b'\n"
+     "control_points=[[0,0,5],[1,1,5],[2,0,6]]\n[surface]\ntype='curves'\ncurve_a='a'\ncurve_b='b'\n"
+     "[unroll]\nsamples=20001\nrulings=1000\n", "unroll.samples"),
+])
+def test_design_limits_refused_before_allocating(body: str, key: str, tmp_path: Path, capsys) -> None:
+    p = tmp_path / "d.toml"
+    p.write_text(body)
+    rc, _, err = _run(["run", str(p), "--out", str(tmp_path / "out"), "--no-progress"], capsys)
+    assert rc == EXIT_USAGE and f"key '{key}'" in err and str(p) in err, err

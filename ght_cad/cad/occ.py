@@ -342,7 +342,11 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
 
 
 def read_step(path: str | os.PathLike) -> TopoDS_Shape:
-    """Read a STEP file into one OCP shape."""
+    """Read a STEP file into one OCP shape (after :func:`ght_cad.step_guard.check_step_numbers`:
+    a real beyond ±1e12 or not finite is refused with a GHTError before OCCT sees it)."""
+    from ..step_guard import check_step_numbers
+
+    check_step_numbers(path)
     with quiet_occt():
         reader = STEPControl_Reader()
         if reader.ReadFile(str(path)) != IFSelect_RetDone:

@@ -6,8 +6,9 @@ from __future__ import annotations
 from typing import Any
 
 
-def _f(x: Any, fmt: str = ".6g") -> str:
-    return "n/a" if x is None else format(x, fmt)
+def _f(x: Any, fmt: str = ".6g", none: str = "n/a") -> str:
+    """``x`` formatted, ``none`` for a value the report leaves out (``null`` in report.json)."""
+    return none if x is None else format(x, fmt)
 
 
 def report_markdown(r: dict[str, Any]) -> str:
@@ -84,7 +85,8 @@ def report_markdown(r: dict[str, Any]) -> str:
                   f"side {sh['side']}", "", "| edge | inside | neutral (cut) | outside |", "|---|---|---|---|"]
             L += [f"| {e['edge']} | {e['inside']:.9g} | {e['neutral']:.9g} | {e['outside']:.9g} |" for e in sh["edges"]]
             L += ["", "| bend | u | R at a | R at b | angle (deg) | at |", "|---|---|---|---|---|---|"]
-            L += [f"| {'all' if f['line'] == 0 else f['line']} | {f['u']:.6f} | {f['radius_a']:.9g} | {f['radius_b']:.9g} | "
+            L += [f"| {'all' if f['line'] == 0 else f['line']} | {f['u']:.6f} | {_f(f['radius_a'], '.9g', '∞ (straight)')} | "
+                  f"{_f(f['radius_b'], '.9g', '∞ (straight)')} | "
                   f"{f['angle_deg']:.6f} | {f['position']:.6g} |" for f in sh["forming"]]
             L.append("")
     if (r.get("plate") or {}).get("surfaces"):
@@ -129,7 +131,8 @@ def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: 
     L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
     for label, d in (("initial", initial), ("final", final)):
         if d:
-            L.append(f"| {label} | {d['theta_max']:.3e} | {d['theta_rms']:.3e} | {d['dd']:.12f} | {d['R']:.3e} |")
+            L.append(f"| {label} | {_f(d['theta_max'], '.3e')} | {_f(d['theta_rms'], '.3e')} | {_f(d['dd'], '.12f')} | "
+                     f"{_f(d['R'], '.3e')} |")
     L.append("")
     lf = s.get("loft")
     if lf:

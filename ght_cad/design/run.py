@@ -9,10 +9,11 @@ folders a later run can tell from a live one's, the manifest of one design per f
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -42,6 +43,16 @@ def _versions() -> dict[str, str]:
     return out
 
 
+def _curve_max_curvature(c: Any) -> float | None:
+    """Largest curvature over 513 parameters where it is defined (``P' != 0``); None for a point."""
+    from ..curve import curvature_from_derivatives
+
+    t = np.linspace(0, 1, 513)
+    kappa = curvature_from_derivatives(c.derivative(t, 1), c.derivative(t, 2))
+    fin = kappa[np.isfinite(kappa)]
+    return float(fin.max()) if fin.size else None
+
+
 def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
     """Per curve: degree, dimension, shape parameters, control points, arc length, max curvature."""
     return [
@@ -54,7 +65,7 @@ def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
             "gamma": c.gamma,
             "control_points": c.control_points.tolist(),
             "arc_length": c.arc_length(),
-            "curvature_max": float(np.nanmax(c.curvature(np.linspace(0, 1, 513)))),
+            "curvature_max": _curve_max_curvature(c),
         }
         for k, c in curves.items()
     ]
@@ -80,6 +91,25 @@ def _shell_plate_report(design: Design, builts: list[Any], plates: list[Any], sh
             "volume_closed_form": None if None in closed_all else float(sum(closed_all)),
             **design.sheet.to_sheet().as_dict(), "side_reference": design.sheet.side_reference,
             "surfaces": rows, "joints": rail_joints(builts, sheets, rails)}
+
+
+@contextlib.contextmanager
+def _naming(design: Design) -> Iterator[None]:
+    """A refusal from a later stage (unrolling, the B-rep, ...) that names neither the design file
+    nor a key gets both: the file and the key of the surface(s) (one line for the command line)."""
+    try:
+        yield
+    except GHTError as exc:
+        msg = " ".join(str(exc).split())
+        if msg.startswith(f"{design.source}:"):
+            raise
+        key = design.surface.key if design.surface is not None else "surfaces" if design.surfaces else "curves"
+        text = f"{design.source}: key '{key}': {msg}"
+        try:
+            named = type(exc)(text)
+        except TypeError:  # a subclass with another constructor
+            named = GHTError(text)
+        raise named from None
 
 
 def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = True, wait: bool = False,
@@ -156,7 +186,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         sys.stderr.write(f"ght-cad: waiting for {who}, which writes {busy.path}\n")
         sys.stderr.flush()
 
-    with OutputFolder(out, wait=wait, timeout=timeout, on_wait=waiting) as stage:
+    with OutputFolder(out, wait=wait, timeout=timeout, on_wait=waiting) as stage, _naming(design):
         # 1. curves
         step("curves")
         curves, joins = build_curves(design)

@@ -73,6 +73,16 @@ FILE_NAMES = {
 FIGURE_NAMES = {k: f"{k}.png" for k in FIGURE_OUTPUTS}
 
 
+#: largest coordinate (or plane coefficient) a design file may give, in its unit (as for STEP input)
+MAX_DESIGN_COORDINATE = 1e12
+#: most control points (planes) of one curve (surface) in a design file: degree 999 (an unused
+#: curve of 100,000 points allocated 1.7 GiB, one of 2,000,000 ran past 120 s)
+MAX_ROWS = 1000
+#: largest ``unroll.samples * (unroll.rulings + 1)``: the flat pattern's grid (20001 x 1001 inside the
+#: single ranges allocated 8.9 GiB; the defaults are 257 x 17)
+MAX_UNROLL_GRID = 1_000_000
+
+
 class DesignError(GHTError):
     """An invalid design file: one line naming the file, the key and the allowed values."""
 
@@ -363,6 +373,8 @@ class _Checker:
             raise self.fail(full, f"expected {what}, got {_tname(v)} {_short(v)}")
         if len(v) < min_rows or (max_rows is not None and len(v) > max_rows):
             raise self.fail(full, f"has {len(v)} rows; allowed: {what}")
+        if len(v) > MAX_ROWS:  # checked before anything is allocated for them
+            raise self.fail(full, f"has {len(v)} rows; allowed: at most {MAX_ROWS} (degree {MAX_ROWS - 1})")
         n = len(v[0])
         out = []
         for i, row in enumerate(v):
@@ -374,6 +386,9 @@ class _Checker:
                     raise self.fail(f"{full}[{i}][{j}]", f"expected a number, got {_tname(x)} {_short(x)}")
                 if not math.isfinite(float(x)):
                     raise self.fail(f"{full}[{i}][{j}]", f"{x} is not finite; allowed: a finite number")
+                if abs(float(x)) > MAX_DESIGN_COORDINATE:
+                    raise self.fail(f"{full}[{i}][{j}]", f"{float(x):g} is beyond ±{MAX_DESIGN_COORDINATE:g}; "
+                                    f"allowed: a number within ±{MAX_DESIGN_COORDINATE:g} (of the design's unit)")
                 vals.append(float(x))
             out.append(vals)
         return out
@@ -532,6 +547,10 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
                             ck.number(ut, "tol_deg", "unroll", 0.01, lo=0.0, hi=90.0, lo_open=True),
                             ck.integer(ut, "samples", "unroll", 257, lo=9, hi=20001),
                             ck.string(ut, "panels", "unroll", "joined", choices=PANELS_CHOICES))
+        if unroll.samples * (unroll.rulings + 1) > MAX_UNROLL_GRID:
+            raise ck.fail("unroll.samples", f"{unroll.samples} samples with unroll.rulings = {unroll.rulings} make a grid "
+                          f"of {unroll.samples * (unroll.rulings + 1):,} points; allowed: samples * (rulings + 1) "
+                          f"<= {MAX_UNROLL_GRID:,}")
 
     # sheet (spec 6.1)
     sheet = None

@@ -67,12 +67,104 @@ def _step_unit(name: str | None) -> str | None:
     return _STEP_UNIT_NAMES.get(name.strip().lower())
 
 
+#: seconds OCCT's STEP reader may take in its worker process (``GHT_CAD_STEP_TIMEOUT`` overrides)
+STEP_READ_TIMEOUT_S = 300.0
+
+
 def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
     """Read a STEP file with lengths in ``units`` (default: the file's own length unit, else mm).
 
     OCCT converts STEP lengths to its system length unit (``SetSystemLengthUnit``, in mm), so
     asking for ``MM_PER_UNIT[u]`` gives the coordinates in unit ``u``.
+
+    Guards (issue 26): the file's text is scanned first (:func:`ght_cad.step_guard.check_step_numbers`:
+    a real beyond ±1e12 or not finite -- OCCT hung on ``1.E400`` -- is refused before OCCT sees it);
+    then, where ``os.fork`` exists, OCCT reads the file in a forked worker process that hands the
+    shape back as a BRep file: a reader that crashes (mutated files made OCCT segfault) or runs
+    past ``STEP_READ_TIMEOUT_S`` (killed) gives a :class:`DesignError` naming the file instead of
+    taking the process down or hanging it. ``GHT_CAD_STEP_INPROCESS=1`` reads in this process.
+
+    Raises:
+        DesignError: unreadable, hostile or crashing file; a reader past the time limit.
     """
+    from ..step_guard import check_step_numbers
+
+    try:
+        check_step_numbers(path)  # absurd or overflowing reals: refused before OCCT sees them (it hung)
+    except OSError as exc:
+        raise DesignError(f"{path}: cannot read the STEP file ({exc.strerror or exc})") from None
+    except GHTError as exc:
+        raise DesignError(str(exc)) from None
+    if not hasattr(os, "fork") or os.environ.get("GHT_CAD_STEP_INPROCESS"):
+        return _transfer_step(path, units)
+    return _transfer_step_in_worker(path, units)
+
+
+def _transfer_step_in_worker(path: Path, units: str | None) -> tuple[Any, str, str | None]:
+    """:func:`_transfer_step` in a forked child with a wall-clock limit; the shape comes back as BRep."""
+    import json
+    import shutil
+    import signal
+    import tempfile
+    import time
+
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepTools import BRepTools
+    from OCP.TopoDS import TopoDS_Shape
+
+    limit = float(os.environ.get("GHT_CAD_STEP_TIMEOUT", STEP_READ_TIMEOUT_S))
+    tmp = Path(tempfile.mkdtemp(prefix="ght-cad-step."))
+    brep, meta = tmp / "shape.brep", tmp / "meta.json"
+    try:
+        pid = os.fork()
+        if pid == 0:  # the worker: never returns, never runs the parent's exit handlers
+            code = 3
+            try:
+                null = os.open(os.devnull, os.O_WRONLY)  # the kernel's own parser messages, a crash report
+                os.dup2(null, 1)
+                os.dup2(null, 2)
+                try:
+                    shape, unit, file_unit = _transfer_step(path, units)
+                    BRepTools.Write_s(shape, str(brep))
+                    meta.write_text(json.dumps({"unit": unit, "file_unit": file_unit}))
+                    code = 0
+                except DesignError as exc:
+                    meta.write_text(json.dumps({"error": str(exc)}))
+                    code = 2
+            finally:
+                os._exit(code)
+        deadline = time.monotonic() + limit
+        while True:
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                break
+            if time.monotonic() > deadline:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                raise DesignError(f"{path}: OCCT's STEP reader did not finish within {limit:g} s (stopped); allowed: "
+                                  "a valid STEP file (GHT_CAD_STEP_TIMEOUT sets the limit in seconds)")
+            time.sleep(0.005)
+        if os.WIFSIGNALED(status):
+            sig = os.WTERMSIG(status)
+            name = signal.Signals(sig).name if sig in signal.Signals._value2member_map_ else str(sig)
+            raise DesignError(f"{path}: OCCT's STEP reader crashed on this file ({name}); allowed: a valid STEP file")
+        code = os.WEXITSTATUS(status)
+        info = json.loads(meta.read_text()) if meta.is_file() else {}
+        if code == 2 and "error" in info:
+            raise DesignError(info["error"])
+        if code != 0 or "unit" not in info:
+            raise DesignError(f"{path}: OCCT's STEP reader failed on this file (worker exit {code}); "
+                              "allowed: a valid STEP file")
+        shape = TopoDS_Shape()
+        if not BRepTools.Read_s(shape, str(brep), BRep_Builder()):  # pragma: no cover - our own file
+            raise DesignError(f"{path}: the shape read from the STEP file could not be handed over")
+        return shape, info["unit"], info["file_unit"]
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _transfer_step(path: Path, units: str | None) -> tuple[Any, str, str | None]:
+    """OCCT's STEP reader and transfer in this process (see :func:`_read_step_in`)."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_Reader
     from ..cad._ocp import TColStd_SequenceOfAsciiString
@@ -160,6 +252,8 @@ def unroll_step(
     p = Path(path)
     if p.suffix.lower() not in STEP_SUFFIXES:
         raise DesignError(f"{p}: unknown suffix {p.suffix!r}; allowed STEP suffixes: {', '.join(STEP_SUFFIXES)}")
+    if p.is_dir():
+        raise DesignError(f"{p}: is a directory, not a STEP file; allowed: a .step/.stp file")
     if not p.is_file():
         raise DesignError(f"{p}: no such STEP file")
     if units is not None and units not in MM_PER_UNIT:
