@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
 import os
 import re
 import shutil
@@ -243,6 +244,13 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     pl = steps["GHT_Plate"]["value"]
     assert pl["valid"] and not pl["failed"] and pl["shape_type"] == "Solid" and pl["faces"] == 6, pl
     assert abs(pl["volume_error"]) < 1e-8 and abs(pl["volume"] / pl["closed_form"] - 1) < 1e-8, pl
+    # issue 23: the whole Part bracket selected: one face, the closed-form neutral blank
+    # W (40 + 25 + (3 + 0.42 * 2) pi/2) to 1e-6, one bend in the BendTable property, Report view clean
+    ws = steps["GHT_FlatPattern whole solid"]
+    assert ws["value"]["whole_solid"] and ws["value"]["valid"] and not ws["value"]["failed"], ws
+    assert ws["value"]["faces"] == 1 and len(ws["value"]["bend_table"]) == 2, ws
+    assert abs(ws["value"]["area"] / (50 * (65 + 3.84 * math.pi / 2)) - 1) < 1e-6, ws
+    assert not ws["tracebacks"] and not _report_lines(ws), ws
     r = steps["reopen"]["value"]
     assert r["objects"] == 10 and not r["bad"] and r["icons"] and r["panel_open"], r
     opt = steps["GHT_RunOptimization"]["value"]

@@ -399,11 +399,12 @@ class _Edge:
             return float(self.edge.Length)
 
 
-def face_data(face: "Part.Face", fast: bool = True) -> FaceData:
+def face_data(face: "Part.Face", fast: bool = True, edge_name: Callable[[Any], str] | None = None) -> FaceData:
     """A FreeCAD face as :class:`ght_cad.face_unroll.FaceData` (the adapter of this workbench).
 
     Wires: ``face.OuterWire`` first, then the other wires of ``face.Wires`` (holes), each in
-    ``OrderedEdges`` order; every edge's pcurve is traversed in its orientation and, on periodic
+    ``OrderedEdges`` order, edges named ``edge<k>`` in wire order or ``edge_name(edge)`` (a solid's
+    edge key, :mod:`.sheet_skin`); every edge's pcurve is traversed in its orientation and, on periodic
     surfaces, shifted by whole periods so each loop is continuous in (u, v)
     (:func:`ght_cad.face_unroll.chain_loop`) and lies in ``face.ParameterRange``.
 
@@ -435,7 +436,8 @@ def face_data(face: "Part.Face", fast: bool = True) -> FaceData:
                 for e in edges:
                     e.shift[i] -= k * P
         loops.append(
-            [EdgeData(uv=e.uv, duv=e.duv, xyz=e.xyz, length_3d=e.length(), breaks=e.breaks(), name=f"edge{k}") for k, e in enumerate(edges)]
+            [EdgeData(uv=e.uv, duv=e.duv, xyz=e.xyz, length_3d=e.length(), breaks=e.breaks(),
+                      name=f"edge{k}" if edge_name is None else edge_name(e.edge)) for k, e in enumerate(edges)]
         )
     return FaceData(surface=surf, bounds=(u0, u1, v0, v1), wires=loops, reversed=face.Orientation == "Reversed")
 
@@ -586,10 +588,18 @@ class FlatPatternFeature(FeatureProxy):
             obj.addProperty("App::PropertyFloat", "ThicknessUsed", "Output", "Sheet thickness the pattern was made with (0: none)")
         if "FormingTable" not in have:
             obj.addProperty("App::PropertyStringList", "FormingTable", "Output", "Bend lines: neutral bending radius at both ruling ends and angle turned")
+        if "WholeSolid" not in have:  # documents saved before: a face as before
+            obj.addProperty("App::PropertyBool", "WholeSolid", "Input", "Unfold the whole sheet solid of the Source into one blank (issue 23); a selected face is then the base face")
+            obj.WholeSolid = False
+        if "BendTable" not in have:
+            obj.addProperty("App::PropertyStringList", "BendTable", "Output", "Whole solid: one row per bend (angle, inside radius, K, bend allowance, bend deduction, direction)")
+            obj.addProperty("App::PropertyInteger", "BaseFaceUsed", "Output", "Whole solid: number of the face that kept its place (FaceN of the Source)")
+            obj.addProperty("App::PropertyStringList", "CutEdges", "Output", "Whole solid: shared edges cut to open cycles of the face graph")
 
     def restored(self, obj: Any) -> None:
         self._sheet_properties(obj)
-        set_read_only(obj, ("AreaFlat", "Area3D", "MaxRelativeError", "ThicknessUsed", "FormingTable"))
+        set_read_only(obj, ("AreaFlat", "Area3D", "MaxRelativeError", "ThicknessUsed", "FormingTable", "BendTable",
+                            "BaseFaceUsed", "CutEdges"))
 
     def sheet(self, obj: Any, face: Any) -> tuple[Any, Any]:
         """``(sheet or None, face to unroll)``: the Thickness/KFactor/Side properties, or with
@@ -629,6 +639,8 @@ class FlatPatternFeature(FeatureProxy):
             raise GHTError(f"{obj.Label}: BendLines={int(obj.BendLines)} is not allowed; allowed: 0 or more bend lines")
         opts = dict(rulings=int(obj.BendLines), best_effort=bool(obj.BestEffort), samples=65)
         self._sheet_properties(obj)
+        if bool(obj.WholeSolid):
+            return self.blank(obj).pattern
         face = face_of_source(obj)
         sheet, face = self.sheet(obj, face)
         if face is None:
@@ -637,7 +649,37 @@ class FlatPatternFeature(FeatureProxy):
         label = src.Label + "".join(f".{x}" for x in (subs or [])[:1] if x)
         return unroll_face_data(face_data(face), label=label, sheet=sheet, **opts)
 
+    def blank(self, obj: Any) -> Any:
+        """The whole Source solid unfolded into one blank per sheet solid
+        (:func:`ght_cad.blank.unfold_skins` on the skins :func:`.sheet_skin.sheet_skins` finds):
+        bends on their neutral surface at ``KFactor``, the selected face (if any) as base face.
+
+        Raises:
+            BlankError: no sheet, a sharp edge, an ambiguous skin, overlapping pieces, a bad face.
+        """
+        from ght_cad.blank import BlankError, unfold_skins
+
+        from .sheet_skin import shape_of_source, sheet_skins
+
+        src, subs = obj.Source if obj.Source else (None, [])
+        if src is None:
+            raise GHTError(f"{obj.Label}: no Source linked")
+        base = None
+        subs = [x for x in (subs or []) if x]
+        if subs:
+            if not (subs[0].startswith("Face") and subs[0][4:].isdigit()):
+                raise BlankError(f"{src.Label}.{subs[0]} is not a face; allowed: a face (FaceN) as base face, or none")
+            base = int(subs[0][4:])
+        K = float(obj.KFactor)
+        if not (0.0 <= K <= 1.0):
+            raise BlankError(f"{obj.Label}: KFactor={K!r} is not allowed; the ANSI K-factor lies in [0, 1]")
+        skins, n = sheet_skins(shape_of_source(src), base_face=base, name=str(src.Label))
+        out = unfold_skins(skins, k_factor=K, base_face=base, rulings=int(obj.BendLines), face_count=n)
+        self._blanks = out
+        return out
+
     def compute(self, obj: Any) -> None:
+        self._blanks = None
         pat = self.pattern(obj)
         lo = np.min([p.bbox()[0] for p in pat.panels], axis=0)
         hi = np.max([p.bbox()[1] for p in pat.panels], axis=0)
@@ -666,6 +708,14 @@ class FlatPatternFeature(FeatureProxy):
         sh = pat.sheet
         obj.ThicknessUsed = float(sh["thickness"]) if sh else 0.0
         obj.FormingTable = pat.forming_table().splitlines() if sh else []
+        blanks = getattr(self, "_blanks", None)
+        if blanks is not None:  # whole solid: the bend table and what the walk did
+            obj.ThicknessUsed = float(blanks.blanks[0].thickness)
+            obj.BendTable = blanks.bend_table().splitlines()
+            obj.BaseFaceUsed = int(blanks.blanks[0].base_face)
+            obj.CutEdges = [e for b in blanks.blanks for e in b.cut_edges]
+        else:
+            obj.BendTable, obj.BaseFaceUsed, obj.CutEdges = [], 0, []
         obj.Shape = Part.makeCompound(faces + bends)
 
 
@@ -687,10 +737,21 @@ def make_flat_pattern(
     thickness: float = 0.0,
     k_factor: float = 0.5,
     side: str = "normal",
+    whole_solid: bool | None = None,
 ) -> Any:
     """Create the flat pattern of a developable feature (or of its face ``sub``); with a
-    ``thickness`` (or a face of a solid plate) the pattern is the sheet's neutral surface."""
+    ``thickness`` (or a face of a solid plate) the pattern is the sheet's neutral surface.
+
+    ``whole_solid``: unfold the whole sheet solid into one blank, ``sub`` (if given) its base face;
+    None: True for a Source with a solid, no face given and no surface of its own (a Part
+    feature, a PartDesign Body, an imported STEP), else False."""
+    if whole_solid is None:
+        proxy = getattr(source, "Proxy", None)
+        own = hasattr(proxy, "surface") or hasattr(proxy, "inside_face")
+        shape = getattr(source, "Shape", None)
+        whole_solid = not sub and not own and shape is not None and bool(shape.Solids)
     obj = new_feature(doc or source.Document, name, FlatPatternFeature, ViewProviderFlatPattern)
+    obj.WholeSolid = bool(whole_solid)
     obj.Source = (source, [sub] if sub else [])
     obj.BendLines = int(bend_lines)
     obj.Thickness = float(thickness)

@@ -628,6 +628,27 @@ def main():
 
     step("reopen", reopen)
 
+    if "GHT_FlatPattern" in _base.COMMANDS:
+        def whole_solid():
+            # issue 23: a Part L-bracket (R 3, T 2, flanges 40/25, width 50) selected as a whole object:
+            # the Flat pattern command unfolds the solid into one face, the bend table in its properties
+            from freecad.ght_workbench.tests.fc_blank import bracket_shape
+
+            bdoc = App.newDocument("blank")
+            src = bdoc.addObject("Part::Feature", "Bracket")
+            src.Shape = bracket_shape()
+            bdoc.recompute()
+            created, ok = run_command(bdoc, "GHT_FlatPattern", [src])
+            flat = [o for o in created if getattr(o, "Proxy", None) and o.Proxy.Type == "GHT::FlatPattern"][0]
+            flat.KFactor = 0.42
+            bdoc.recompute()
+            return {"created": len(created), "valid": ok and flat.Shape.isValid(), "whole_solid": bool(flat.WholeSolid),
+                    "faces": len(flat.Shape.Faces),
+                    "area": flat.Shape.Faces[0].Area if flat.Shape.Faces else 0.0, "bend_table": list(flat.BendTable),
+                    "failed": _base.failed(flat)}
+
+        step("GHT_FlatPattern whole solid", whole_solid)
+
 
 def finish():
     try:
