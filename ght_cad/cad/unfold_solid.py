@@ -38,7 +38,7 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 
 from ._ocp import TopoDS, TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from ..blank import BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, k_factor_table, unfold_skins
+from ..blank import DIST_TOL, BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, classify_skin, k_factor_table, unfold_skins
 from .occ import unwrap
 from .unroll_faces import _SurfEval, face_data
 
@@ -46,10 +46,6 @@ __all__ = ["sheet_skins", "unfold", "blank_plates"]
 
 #: interior sample points per face (at most)
 _SAMPLES = 6
-#: relative tolerance on the distance of a skin point to the other skin (of T) and on antiparallel normals
-_DIST_TOL = 1e-6
-#: largest angle (degrees) between two skin faces' normals across a shared edge that counts as tangent
-_SHARP_DEG = 1e-3
 
 
 def _face_points(face: Any, ad: BRepAdaptor_Surface) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -175,97 +171,25 @@ def _solid_skin(solid: Any, sname: str, fmap: Any, number_of: dict[int, int], ba
             w, i = best
             hf = inter.Face(i)
             nh = _normal_at(hf, inter.UParameter(i), inter.VParameter(i))
-            row.append((float(w), float(nh @ n) < -1.0 + _DIST_TOL, idx_of.get(fmap.FindIndex(hf), -1)))
+            row.append((float(w), float(nh @ n) < -1.0 + DIST_TOL, idx_of.get(fmap.FindIndex(hf), -1)))
         rays.append(row)
-    # thickness: the largest face whose rays all leave at one distance through an opposite face
-    T = None
-    for i in sorted(range(len(faces)), key=lambda i: -areas[i]):
-        row = rays[i]
-        if row and all(ok for _, ok, _ in row):
-            ds = [d for d, _, _ in row]
-            if max(ds) - min(ds) <= _DIST_TOL * max(ds):
-                T = float(np.mean(ds))
-                break
-    if T is None:
-        raise BlankError(f"{sname}: no sheet: no face lies at a constant distance from an opposite face "
-                         f"(largest face F{nums[int(np.argmax(areas))]}); allowed: sheet solids of one thickness")
-    skin_of = []
-    for i, row in enumerate(rays):
-        good = [ok and abs(d - T) <= _DIST_TOL * T for d, ok, _ in row]
-        skin_of.append(bool(row) and sum(good) * 2 > len(row))
-    if all(skin_of):
-        raise BlankError(f"{sname}: no sheet: every face lies at distance {T:.9g} from an opposite face, no thickness "
-                         "walls separate two sides (a block); allowed: sheet solids")
-    big = max(areas[i] for i in range(len(faces)) if skin_of[i])
-    if T > 0.25 * math.sqrt(big):
-        raise BlankError(f"{sname}: no sheet: its thickness {T:.9g} is more than a quarter of the square root of its "
-                         f"largest skin face's area {big:.9g} (a block); allowed: sheets thinner than that")
     # edges shared by two faces of the solid
     emap = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(solid, TopAbs_EDGE, TopAbs_FACE, emap)
     eindex = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(solid, TopAbs_EDGE, eindex)
-    shared: dict[str, tuple[int, int]] = {}
+    edges: dict[str, tuple[int, int]] = {}
+    edge_of: dict[str, Any] = {}
     for k in range(1, emap.Extent() + 1):
         edge = emap.FindKey(k)
         anc = [idx_of.get(fmap.FindIndex(TopoDS.Face_s(x))) for x in emap.FindFromIndex(k)]
         anc = list(dict.fromkeys(a for a in anc if a is not None))
-        if len(anc) != 2 or not (skin_of[anc[0]] and skin_of[anc[1]]):
-            continue
-        key = f"E{eindex.FindIndex(edge)}"
-        ang = _edge_angle(TopoDS.Edge_s(edge), faces[anc[0]], faces[anc[1]])
-        if ang > _SHARP_DEG:
-            raise BlankError(f"{sname}: sharp edge {key} between skin faces F{nums[anc[0]]} and F{nums[anc[1]]}: "
-                             f"they meet at {ang:.6g} deg (a bend of zero radius); allowed: bends with an inside "
-                             "radius > 0 (tangent faces)")
-        shared[key] = (anc[0], anc[1])
-    for i, row in enumerate(rays):
-        if not skin_of[i]:
-            continue
-        bad = [d for d, ok, _ in row if not (ok and abs(d - T) <= _DIST_TOL * T)]
-        if bad:
-            raise BlankError(f"{sname}: ambiguous skin: face F{nums[i]} lies at distance {T:.9g} from the other skin "
-                             f"at {len(row) - len(bad)} of {len(row)} points but {min(bad):.9g} at others; allowed: "
-                             "sheets of one thickness whose faces pair up")
-    # connected sets of skin faces
-    comp = [-1] * len(faces)
-    adj: dict[int, list[int]] = {}
-    for a, b in shared.values():
-        adj.setdefault(a, []).append(b)
-        adj.setdefault(b, []).append(a)
-    ncomp = 0
-    for i in range(len(faces)):
-        if skin_of[i] and comp[i] < 0:
-            stack = [i]
-            comp[i] = ncomp
-            while stack:
-                x = stack.pop()
-                for y in adj.get(x, []):
-                    if comp[y] < 0:
-                        comp[y] = ncomp
-                        stack.append(y)
-            ncomp += 1
-    if ncomp != 2:
-        what = ("one closed skin: no thickness walls separate two sides (a block)" if ncomp == 1 else
-                f"{ncomp} separate sets of faces at distance {T:.9g}")
-        raise BlankError(f"{sname}: {'no sheet' if ncomp == 1 else 'ambiguous skin'}: the faces at distance {T:.9g} "
-                         f"from an opposite face form {what}; allowed: one sheet solid with an inside and an outside skin")
-    partner: dict[int, int] = {}
-    for i, row in enumerate(rays):
-        if not skin_of[i]:
-            continue
-        hits = [h for _, _, h in row if h >= 0]
-        other = [h for h in hits if comp[h] != comp[i]]
-        if not hits or len(other) != len(hits):
-            raise BlankError(f"{sname}: ambiguous skin: face F{nums[i]}'s opposite points lie on its own side of the "
-                             "sheet; allowed: an inside and an outside skin")
-        partner[i] = max(set(other), key=other.count)
-    area_c = [sum(areas[i] for i in range(len(faces)) if comp[i] == c) for c in (0, 1)]
-    ref = int(np.argmin(area_c))
-    if base_face is not None and base_face in nums:
-        bi = nums.index(base_face)
-        if skin_of[bi]:
-            ref = comp[bi]
+        if len(anc) == 2:
+            key = f"E{eindex.FindIndex(edge)}"
+            edges[key], edge_of[key] = (anc[0], anc[1]), edge
+    T, comp, partner, shared, ref = classify_skin(
+        sname, nums, areas, rays, edges, lambda key, a, b: _edge_angle(TopoDS.Edge_s(edge_of[key]), faces[a], faces[b]),
+        base_face)
     sel = [i for i in range(len(faces)) if comp[i] == ref]
 
     def edge_name(e: Any) -> str:

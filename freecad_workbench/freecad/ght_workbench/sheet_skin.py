@@ -11,8 +11,8 @@ faces are sorted into the sheet's two skins and its walls, as the OCP adapter do
   point (``(q - p)·(-n) >= (1 - 1e-6) |q - p|``), inside that face (``isPartOfDomain``), whose
   outward normal is opposite (``n_q·n <= -1 + 1e-6``); the nearest such foot is where the ray
   leaves the material, at distance ``d``;
-* the classification is the core's (:func:`ght_cad.blank.classify_skin` when the core has it,
-  else the same rules here): ``T`` from the largest face whose probes all agree, skin faces
+* the classification is the core's (:func:`ght_cad.blank.classify_skin`, shared with the OCP
+  adapter): ``T`` from the largest face whose probes all agree, skin faces
   (most probes at ``T`` through an opposite face), walls, the shared edges of skin faces
   (tangent within 1e-3 degrees, else a sharp edge is refused), exactly two connected skins.
 
@@ -31,7 +31,7 @@ import numpy as np
 
 import Part  # noqa: F401  (FreeCAD's geometry: the shapes passed in are Part shapes)
 
-from ght_cad.blank import BlankError, SheetSkin, SkinFace
+from ght_cad.blank import DIST_TOL, BlankError, SheetSkin, SkinFace, classify_skin
 
 from .flat_pattern import face_data
 
@@ -39,10 +39,6 @@ __all__ = ["sheet_skins", "shape_of_source"]
 
 #: interior sample points per face (at most)
 _SAMPLES = 6
-#: relative tolerance on the distance of a skin point to the other skin (of T) and on antiparallel normals
-_DIST_TOL = 1e-6
-#: largest angle (degrees) between two skin faces' normals across a shared edge that counts as tangent
-_SHARP_DEG = 1e-3
 
 
 def shape_of_source(obj: Any) -> Any:
@@ -95,13 +91,13 @@ def _probe(p: np.ndarray, n: np.ndarray, faces: list[Any], own: int) -> tuple[fl
         q = np.array(tuple(g.Surface.value(u, v)), dtype=float)
         d = q - p
         dist = float(np.linalg.norm(d))
-        if not dist > 0 or dist >= best[0] or float(d @ -n) < (1.0 - _DIST_TOL) * dist:
+        if not dist > 0 or dist >= best[0] or float(d @ -n) < (1.0 - DIST_TOL) * dist:
             continue
         if not g.isPartOfDomain(u, v):
             continue
         nq = np.array(tuple(g.normalAt(u, v)), dtype=float)
         nq = nq / max(float(np.linalg.norm(nq)), 1e-300)
-        best = (dist, float(nq @ n) <= -1.0 + _DIST_TOL, j)
+        best = (dist, float(nq @ n) <= -1.0 + DIST_TOL, j)
     return best
 
 
@@ -162,16 +158,10 @@ def _solid_skin(solid: Any, sname: str, face_no: Any, base_face: int | None) -> 
             k = edge_no(e)
             if k and i not in ancestors.setdefault(k, []):
                 ancestors[k].append(i)
-    T, skin_of, shared, partner, comp = classify_skin(
+    T, comp, partner, shared, ref = classify_skin(
         sname, nums, areas, rays,
-        {f"E{k}": (a[0], a[1]) for k, a in ancestors.items() if len(a) == 2},
-        lambda key, a, b: _edge_angle(edges[int(key[1:]) - 1], faces[a], faces[b]))
-    area_c = [sum(areas[i] for i in range(len(faces)) if comp[i] == c) for c in (0, 1)]
-    ref = int(np.argmin(area_c))
-    if base_face is not None and base_face in nums:
-        bi = nums.index(base_face)
-        if skin_of[bi]:
-            ref = comp[bi]
+        {f"E{k}": (a[0], a[1]) for k, a in sorted(ancestors.items()) if len(a) == 2},
+        lambda key, a, b: _edge_angle(edges[int(key[1:]) - 1], faces[a], faces[b]), base_face)
     sel = [i for i in range(len(faces)) if comp[i] == ref]
 
     def edge_name(e: Any) -> str:
@@ -181,92 +171,3 @@ def _solid_skin(solid: Any, sname: str, face_no: Any, base_face: int | None) -> 
     sh = {k: (nums[a], nums[b]) for k, (a, b) in shared.items() if comp[a] == ref}
     walls = [nums[i] for i in range(len(faces)) if i not in sel]
     return SheetSkin(sname, T, skin_faces, sh, walls)
-
-
-def classify_skin(sname: str, nums: list[int], areas: list[float], rays: list[list[tuple[float, bool, int]]],
-                  edges: dict[str, tuple[int, int]], angle: Any) -> tuple[float, list[bool], dict[str, tuple[int, int]],
-                                                                           dict[int, int], list[int]]:
-    """Kernel-free classification of a solid's faces from its probes (module doc).
-
-    Args:
-        sname: the solid's name for messages; nums: face numbers; areas: face areas.
-        rays: per face, ``(distance, opposite normal, hit face index)`` per probe.
-        edges: edge key -> the two face indices sharing it.
-        angle: ``angle(key, a, b)`` -> degrees between the faces' normals at the edge.
-
-    Returns:
-        ``(T, skin_of, shared, partner, comp)``: thickness, per face whether it is skin, the shared
-        edges of skin faces, each skin face's opposite face index, each face's skin (0, 1; -1 wall).
-
-    Raises:
-        BlankError: no sheet, a sharp edge, an ambiguous skin.
-    """
-    n = len(nums)
-    T = None
-    for i in sorted(range(n), key=lambda i: -areas[i]):
-        row = rays[i]
-        if row and all(ok for _, ok, _ in row):
-            ds = [d for d, _, _ in row]
-            if max(ds) - min(ds) <= _DIST_TOL * max(ds):
-                T = float(np.mean(ds))
-                break
-    if T is None:
-        raise BlankError(f"{sname}: no sheet: no face lies at a constant distance from an opposite face "
-                         f"(largest face F{nums[int(np.argmax(areas))]}); allowed: sheet solids of one thickness")
-    skin_of = [bool(row) and sum(ok and abs(d - T) <= _DIST_TOL * T for d, ok, _ in row) * 2 > len(row) for row in rays]
-    big = max(areas[i] for i in range(n) if skin_of[i]) if any(skin_of) else max(areas)
-    if T > 0.25 * math.sqrt(big):  # before the edges: a block's faces all face an opposite face
-        raise BlankError(f"{sname}: no sheet: its thickness {T:.9g} is more than a quarter of the square root of its "
-                         f"largest face's area {big:.9g} (a block); allowed: sheets thinner than that")
-    shared: dict[str, tuple[int, int]] = {}
-    for key, (a, b) in sorted(edges.items(), key=lambda kv: int(kv[0][1:])):
-        if not (skin_of[a] and skin_of[b]):
-            continue
-        ang = float(angle(key, a, b))
-        if ang > _SHARP_DEG:
-            raise BlankError(f"{sname}: sharp edge {key} between skin faces F{nums[a]} and F{nums[b]}: they meet at "
-                             f"{ang:.6g} deg (a bend of zero radius); allowed: bends with an inside radius > 0 (tangent faces)")
-        shared[key] = (a, b)
-    for i, row in enumerate(rays):
-        if skin_of[i]:
-            bad = [d for d, ok, _ in row if not (ok and abs(d - T) <= _DIST_TOL * T)]
-            if bad:
-                raise BlankError(f"{sname}: ambiguous skin: face F{nums[i]} lies at distance {T:.9g} from the other skin "
-                                 f"at {len(row) - len(bad)} of {len(row)} points but {min(bad):.9g} at others; allowed: "
-                                 "sheets of one thickness whose faces pair up")
-    comp = [-1] * n
-    adj: dict[int, list[int]] = {}
-    for a, b in shared.values():
-        adj.setdefault(a, []).append(b)
-        adj.setdefault(b, []).append(a)
-    ncomp = 0
-    for i in range(n):
-        if skin_of[i] and comp[i] < 0:
-            stack, comp[i] = [i], ncomp
-            while stack:
-                x = stack.pop()
-                for y in adj.get(x, []):
-                    if comp[y] < 0:
-                        comp[y] = ncomp
-                        stack.append(y)
-            ncomp += 1
-    if ncomp != 2:
-        what = ("one closed skin: no thickness walls separate two sides (a block)" if ncomp == 1 else
-                f"{ncomp} separate sets of faces at distance {T:.9g}")
-        raise BlankError(f"{sname}: {'no sheet' if ncomp == 1 else 'ambiguous skin'}: the faces at distance {T:.9g} "
-                         f"from an opposite face form {what}; allowed: one sheet solid with an inside and an outside skin")
-    partner: dict[int, int] = {}
-    for i, row in enumerate(rays):
-        if not skin_of[i]:
-            continue
-        hits = [h for _, _, h in row if h >= 0]
-        other = [h for h in hits if comp[h] != comp[i]]
-        if not hits or len(other) != len(hits):
-            raise BlankError(f"{sname}: ambiguous skin: face F{nums[i]}'s opposite points lie on its own side of the "
-                             "sheet; allowed: an inside and an outside skin")
-        partner[i] = max(set(other), key=other.count)
-    area_c = [sum(areas[i] for i in range(n) if comp[i] == c) for c in (0, 1)]
-    if T > 0.25 * math.sqrt(min(area_c)):
-        raise BlankError(f"{sname}: no sheet: its thickness {T:.9g} is more than a quarter of the square root of the "
-                         f"skin's area {min(area_c):.9g} (a block); allowed: sheets thinner than that")
-    return T, skin_of, shared, partner, comp
