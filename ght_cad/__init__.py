@@ -77,6 +77,7 @@ _LAZY: dict[str, str] = {
     "GHTSurface": "ght_cad.patch",
     "developable_loft": "ght_cad.loft",
     "unfold": "ght_cad.cad.unfold_solid",
+    "approximate": "ght_cad.approximation",
 }
 
 
