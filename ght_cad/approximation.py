@@ -562,11 +562,11 @@ class ApproximationResult:
         }
 
     def flat_pattern(self, **kwargs: Any) -> Any:
-        """All panels unrolled on one sheet with seam marks (:func:`ght_cad.unroll.unroll_composite`;
-        labels P1..PN in seam order)."""
+        """All panels unrolled on one sheet with seam marks (:func:`ght_cad.unroll.unroll_composite`
+        of the exact developables, whose fans and apexes it handles; labels P1..PN in seam order)."""
         from .unroll import unroll_composite
 
-        return unroll_composite(self.surfaces, **kwargs)
+        return unroll_composite([p.exact if p.exact is not None else p.surface for p in self.panels], **kwargs)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -815,7 +815,7 @@ def approximate(
     say = progress or (lambda s: None)
     t0 = time.perf_counter()
     tgt = as_target(target)
-    info: dict[str, Any] = {"target": tgt.name}
+    info: dict[str, Any] = {"target": tgt.name, "bounds": list(tgt.bounds)}
     if direction == "auto":
         est = {d: _estimate(_Frame(tgt, d), tol) for d in ("u", "v")}
         direction = min(est, key=lambda d: est[d])

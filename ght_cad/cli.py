@@ -940,6 +940,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, metavar="PNG", type=_out_path, help="PNG file to write")
     common(sp)
     sp.set_defaults(func=cmd_plot_basis)
+
+    from .approximate_cli import add_parser as _add_approximate  # issue 24: logic in its own module
+
+    _add_approximate(sub, common, _EPILOG)
     return p
 
 
