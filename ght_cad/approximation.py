@@ -826,6 +826,7 @@ def approximate(
     best: tuple[float, int] | None = None
     f = float(safety)
     history = []
+    panels: list[Panel] = []
     for attempt in range(8):
         ys = _march(frame, tol, f, max_panels, min_width=1e-6)
         n = len(ys) - 1

@@ -1,0 +1,108 @@
+"""Benchmark: developable approximation (issue 24) -- panel count and time against tolerance.
+
+Targets (as B-spline faces, read through the OCP adapter):
+
+* ``cap``: spherical cap, radius 1,000 mm, polar angle 0..60 deg (OCCT's exact rational sphere);
+* ``hull``: one side of a ship-like hull, 6 m long (tests/test_approximate.py::hull_point).
+
+For each tolerance: ``ght_cad.approximate`` (panels, largest deviation by its own two-way measure,
+wall time) beside the naive baseline of the issue: equally spaced isolines of the target (same
+direction) as rails on the target, a developable between each pair (the rulings of
+``det(a', b', b - a) = 0``, the equation ``developable_loft`` traces, solved per ruling), deviation
+measured one way (panel points projected onto the target); the baseline count is the smallest N
+whose every strip is within tol (found by doubling and bisection). A figure of panels vs tolerance
+is written to docs/img/approximate_panels.png (``--png`` to change).
+
+Run: ``python bench/bench_approximate.py [--tols 2,1,0.5,0.25] [--targets cap,hull] [--png FILE]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
+
+
+def targets() -> dict[str, object]:
+    from test_approximate import bspline_face, cap_face, hull_point
+
+    from ght_cad.cad.approximate import face_target
+
+    return {"cap": face_target(cap_face()), "hull": face_target(bspline_face(hull_point, 14, 10))}
+
+
+def baseline_count(target: object, direction: str, tol: float, start: int) -> int:
+    """Smallest N of equally spaced on-target isoline strips whose deviation is <= tol."""
+    from ght_cad.approximation import _Frame, _Seam, _strip_range
+
+    fr = _Frame(target, direction)
+
+    def ok(n: int) -> bool:
+        ys = np.linspace(0.0, 1.0, n + 1)
+        seams = [_Seam(fr, y) for y in ys]
+        for a, b in zip(seams[:-1], seams[1:]):
+            lo, hi = _strip_range(fr, a, b)
+            if max(-lo, hi) > tol:
+                return False
+        return True
+
+    lo, hi = max(start - 1, 0), max(start, 1)
+    while not ok(hi):
+        lo, hi = hi, hi * 2
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if ok(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tols", default="2,1,0.5,0.25")
+    ap.add_argument("--targets", default="cap,hull")
+    ap.add_argument("--png", default=os.path.join(os.path.dirname(__file__), "..", "docs", "img", "approximate_panels.png"))
+    args = ap.parse_args()
+    from ght_cad.approximation import approximate
+
+    tols = [float(x) for x in args.tols.split(",")]
+    tg = targets()
+    rows = []
+    print(f"{'target':6} {'tol':>6} {'panels':>6} {'max dev':>9} {'time s':>7} {'baseline':>8} {'ratio':>6}")
+    for name in args.targets.split(","):
+        for tol in tols:
+            t0 = time.perf_counter()
+            res = approximate(tg[name], tol, max_panels=200)
+            dt = time.perf_counter() - t0
+            nb = baseline_count(tg[name], res.direction, tol, len(res.panels))
+            rows.append((name, tol, len(res.panels), res.max_deviation, dt, nb))
+            print(f"{name:6} {tol:6.3g} {len(res.panels):6d} {res.max_deviation:9.4g} {dt:7.1f} {nb:8d} "
+                  f"{nb / len(res.panels):6.2f}", flush=True)
+    if args.png:
+        from ght_cad.plotting import _figure, _save
+
+        fig = _figure("convergence")
+        ax = fig.add_subplot(1, 1, 1)
+        for name in args.targets.split(","):
+            r = [x for x in rows if x[0] == name]
+            ax.plot([x[1] for x in r], [x[2] for x in r], "o-", label=f"{name}: ght_cad.approximate")
+            ax.plot([x[1] for x in r], [x[5] for x in r], "s--", label=f"{name}: equal isolines (baseline)")
+        ax.set_xscale("log")
+        ax.set_xlabel("tolerance (mm)")
+        ax.set_ylabel("developable panels")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        ax.set_title("Panels needed against tolerance")
+        _save(fig, args.png)
+        print(f"figure: {args.png}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,257 @@
+"""Developable approximation of non-developable surfaces (issue 24): ``ght_cad.approximate``,
+the OCP adapter and ``ght-cad approximate``.
+
+Deviations are checked by an independent distance (OCCT ``BRepExtrema_DistShapeShape`` between
+sampled points and the faces), not by the algorithm's own estimate.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OCP")
+
+from OCP.BRep import BRep_Tool  # noqa: E402
+from OCP.BRepAdaptor import BRepAdaptor_Surface  # noqa: E402
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeVertex  # noqa: E402
+from OCP.BRepExtrema import BRepExtrema_DistShapeShape  # noqa: E402
+from OCP.BRepGProp import BRepGProp  # noqa: E402
+from OCP.BRepTools import BRepTools  # noqa: E402
+from OCP.Geom import Geom_RectangularTrimmedSurface, Geom_SphericalSurface  # noqa: E402
+from OCP.GeomConvert import GeomConvert  # noqa: E402
+from OCP.GProp import GProp_GProps  # noqa: E402
+from OCP.gp import gp_Ax3, gp_Pnt, gp_Vec  # noqa: E402
+
+import ght_cad  # noqa: E402
+from ght_cad.approximation import SurfaceTarget, approximate  # noqa: E402
+from ght_cad.cad.approximate import face_target, panels_shell  # noqa: E402
+from ght_cad.cad.unroll_faces import shape_faces  # noqa: E402
+from ght_cad.errors import GHTError  # noqa: E402
+
+
+def _face(geom):
+    from build123d import Face
+
+    return Face(BRepBuilderAPI_MakeFace(geom, 1e-7).Face())
+
+
+def cap_face(radius: float = 1000.0, polar_deg: float = 60.0):
+    """Spherical cap (polar angle 0..polar_deg) as an exact rational B-spline face (OCCT's sphere
+    conversion: periodic in longitude, the pole a collapsed row)."""
+    sph = Geom_SphericalSurface(gp_Ax3(), radius)
+    lat0 = math.pi / 2 - math.radians(polar_deg)
+    tr = Geom_RectangularTrimmedSurface(sph, 0.0, 2 * math.pi, lat0, math.pi / 2)
+    return _face(GeomConvert.SurfaceToBSplineSurface_s(tr))
+
+
+def bspline_face(fun, nu: int = 12, nv: int = 12, degree: int = 3):
+    """A B-spline face interpolating ``fun(s, t)`` on an nu × nv grid (OCCT interpolation)."""
+    from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
+    from OCP.TColgp import TColgp_Array2OfPnt
+
+    arr = TColgp_Array2OfPnt(1, nu, 1, nv)
+    for i, s in enumerate(np.linspace(0, 1, nu)):
+        for j, t in enumerate(np.linspace(0, 1, nv)):
+            arr.SetValue(i + 1, j + 1, gp_Pnt(*map(float, fun(s, t))))
+    from OCP.GeomAbs import GeomAbs_C2
+
+    srf = GeomAPI_PointsToBSplineSurface(arr, degree, degree, GeomAbs_C2, 1e-6).Surface()
+    return _face(srf)
+
+
+def _dist(p, shape) -> float:
+    v = BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex()
+    d = BRepExtrema_DistShapeShape(v, shape)
+    assert d.IsDone()
+    return d.Value()
+
+
+def _face_grid(face, nu: int, nv: int) -> np.ndarray:
+    ad = BRepAdaptor_Surface(face)
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    pts = [ad.Value(u, v).Coord() for u in np.linspace(u0, u1, nu) for v in np.linspace(v0, v1, nv)]
+    return np.array(pts)
+
+
+def two_way(target_face, shell, n_target=(24, 12), n_panel=(12, 5)) -> float:
+    """Largest OCCT distance target samples -> panels and panel samples -> target."""
+    tf = getattr(target_face, "wrapped", target_face)
+    sh = getattr(shell, "wrapped", shell)
+    d1 = max(_dist(p, sh) for p in _face_grid(tf, *n_target))
+    d2 = max(_dist(p, tf) for f in shape_faces(sh) for p in _face_grid(f, *n_panel))
+    return max(d1, d2)
+
+
+def twist_deg(face, n: int = 41) -> float:
+    """Largest angle between the normals at 10 % and 90 % across of a degree-1 B-spline face."""
+    ad = BRepAdaptor_Surface(face)
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+    worst = 0.0
+    for u in np.linspace(u0, u1, n):
+        ns = []
+        for v in (v0 + 0.1 * (v1 - v0), v0 + 0.9 * (v1 - v0)):
+            ad.D1(u, v, p, du, dv)
+            ns.append(np.cross(du.Coord(), dv.Coord()))
+        a, b = ns
+        na, nb = np.linalg.norm(a), np.linalg.norm(b)
+        if na < 1e-9 or nb < 1e-9:
+            continue
+        worst = max(worst, math.degrees(math.acos(min(1.0, abs(a @ b) / (na * nb)))))
+    return worst
+
+
+def face_area(face) -> float:
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(face, props, 1e-10)
+    return props.Mass()
+
+
+def cone_target() -> SurfaceTarget:
+    """A frustum of a cone (developable), u = angle 0..π, v = slant 0..1."""
+    r0, r1, h = 300.0, 150.0, 400.0
+
+    def jet(u, v, order):
+        r = r0 + (r1 - r0) * v
+        c, s = np.cos(u), np.sin(u)
+        z = np.zeros_like(u)
+        S = np.stack([r * c, r * s, h * v], 1)
+        Su = np.stack([-r * s, r * c, z], 1)
+        Sv = np.stack([(r1 - r0) * c, (r1 - r0) * s, z + h], 1)
+        out = [S, Su, Sv]
+        if order >= 2:
+            out += [np.stack([-r * c, -r * s, z], 1), np.zeros_like(S), np.stack([-(r1 - r0) * s, (r1 - r0) * c, z], 1)]
+        return out
+
+    return SurfaceTarget(jet, (0.0, math.pi, 0.0, 1.0), "cone")
+
+
+def test_cone_is_one_panel():
+    res = approximate(cone_target(), 0.1)
+    assert len(res.panels) == 1
+    size = res.size
+    assert res.max_deviation <= 1e-6 * size
+    p = res.panels[0]
+    assert p.theta_max_deg <= 1e-3
+    # area of the half frustum: π/2 (r0 + r1) slant
+    slant = math.hypot(150.0, 400.0)
+    assert abs(p.area - 0.5 * math.pi * (300 + 150) * slant) <= 1e-6 * p.area
+
+
+def test_bad_arguments_and_too_few_panels():
+    t = cone_target()
+    for bad in (0.0, -1.0, float("nan"), "1"):
+        with pytest.raises(GHTError, match="tol="):
+            approximate(t, bad)
+    with pytest.raises(GHTError, match="direction="):
+        approximate(t, 1.0, direction="w")
+    with pytest.raises(GHTError, match="not allowed"):
+        approximate(object(), 1.0)
+    # a hemisphere-like cap cannot be met within 1 mm by 2 panels: the message names the best deviation
+    with pytest.raises(GHTError, match=r"best deviation reached [0-9.]+ with \d+ panels|more than 2 strips"):
+        ght_cad.approximate(cap_face(), 1.0, max_panels=2)
+
+
+def test_direction_is_along_meridians_for_the_cap():
+    from ght_cad.approximation import _estimate, _Frame
+
+    t = face_target(cap_face())
+    est = {d: _estimate(_Frame(t, d), 1.0) for d in "uv"}
+    # rulings along the meridians (v = latitude) need far fewer strips than along latitude circles
+    assert est["v"] < 0.3 * est["u"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("tol, max_panels", [(1.0, 14), (0.25, 28)])
+def test_spherical_cap(tol, max_panels, tmp_path):
+    from ght_cad.cad.occ import read_step, write_step
+
+    face = cap_face()
+    res = ght_cad.approximate(face, tol, max_panels=max_panels)
+    assert len(res.panels) <= max_panels
+    assert res.direction == "v"
+    shell = panels_shell(res)
+    step = write_step(shell, tmp_path / "panels.step")
+    back = read_step(step)
+    faces = shape_faces(back)
+    assert len(faces) == len(res.panels)
+    # independent two-way deviation (OCCT distances), within tol (0.1 % for sampling)
+    assert two_way(face, back) <= tol * 1.001
+    # every exported panel developable
+    assert max(twist_deg(f) for f in faces) <= 0.01
+    # flat pattern areas = STEP face areas
+    pattern = res.flat_pattern()
+    flat = sorted(p.area_flat for p in pattern.panels)
+    step_areas = sorted(face_area(f) for f in faces)
+    for a, b in zip(flat, step_areas):
+        assert abs(a - b) <= 1e-6 * b
+    # watertight: one shell, every seam shared (no free edge but the two outer boundary circles/pole)
+    from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
+
+    fb = ShapeAnalysis_FreeBounds(back, 1e-6 * res.size)
+    from OCP.TopAbs import TopAbs_WIRE
+    from OCP.TopExp import TopExp_Explorer
+
+    exp = TopExp_Explorer(fb.GetClosedWires(), TopAbs_WIRE)
+    n_wires = 0
+    while exp.More():
+        n_wires += 1
+        exp.Next()
+    assert n_wires == 1  # only the rim circle (the pole is a point)
+
+
+@pytest.mark.slow
+def test_saddle_patch():
+    # z = x y / L with the patch along its principal directions (x = (X - Y)/√2, y = (X + Y)/√2):
+    # z = (X² - Y²) / (2 L), X, Y in [-500, 500]
+    L = 2000.0
+    face = bspline_face(lambda s, t: (1000 * s - 500, 1000 * t - 500,
+                                      ((1000 * s - 500) ** 2 - (1000 * t - 500) ** 2) / (2 * L)), 9, 9)
+    tol = 2.0
+    res = ght_cad.approximate(face, tol, max_panels=30)
+    shell = panels_shell(res)
+    assert two_way(face, shell) <= tol * 1.001
+    assert max(twist_deg(f) for f in shape_faces(shell.wrapped)) <= 0.01
+
+
+def hull_point(s: float, t: float) -> tuple[float, float, float]:
+    """One side of a ship-like hull, 6 m long, 1.5 m deep: s along the length, t from keel to
+    sheer; sections ``y = B(s) (2t - t²)`` (round bilge), fine at the ends, keel rising at the ends."""
+    x = 6000.0 * s
+    half = 1.0 - 0.8 * (2 * s - 1) ** 4
+    y = 900.0 * half * (2 * t - t * t) + 20.0
+    z = 1500.0 * t + 250.0 * (2 * s - 1) ** 2 * (1 - t)
+    return x, y, z
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="hull side at 2 mm: the final two-way measure exceeds tol on some strips (open)", strict=False)
+def test_hull_side():
+    face = bspline_face(hull_point, 14, 10)
+    tol = 2.0
+    res = ght_cad.approximate(face, tol, max_panels=40)
+    shell = panels_shell(res)
+    assert two_way(face, shell) <= tol * 1.001
+    assert max(twist_deg(f) for f in shape_faces(shell.wrapped)) <= 0.01
+
+
+@pytest.mark.slow
+def test_cli_approximate(tmp_path):
+    from ght_cad.cad.occ import write_step
+    from ght_cad.cli import main
+
+    step = write_step(cap_face(), tmp_path / "cap.step")
+    out = tmp_path / "out"
+    assert main(["approximate", str(step), "--tol", "1", "--out", str(out)]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["panels"] <= 14 and rep["max_deviation"] <= 1.0
+    for name in ("panels.step", "flat.dxf", "flat.svg", "deviation.png", "report.md"):
+        assert (out / name).stat().st_size > 0
+    for p in rep["panel_report"]:
+        assert abs(p["flat_area"] - p["area"]) <= 1e-6 * p["area"]
+    # too few panels: exit 2 naming the best deviation
+    assert main(["approximate", str(step), "--tol", "1", "--max-panels", "3", "--out", str(tmp_path / "o2")]) == 2
