@@ -12,7 +12,7 @@ import pytest
 from ght_cad.cli import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, build_parser, main
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-COMMANDS = ["demo", "run", "curve", "surface", "optimize", "unroll", "export", "plot-basis", "batch"]
+COMMANDS = ["demo", "run", "curve", "surface", "optimize", "unroll", "export", "plot-basis", "batch", "approximate"]
 
 # exact quarter cone (spec section 1), no optimization block: fast
 CONE = """
