@@ -425,3 +425,28 @@ def test_design_limits_refused_before_allocating(body: str, key: str, tmp_path: 
     p.write_text(body)
     rc, _, err = _run(["run", str(p), "--out", str(tmp_path / "out"), "--no-progress"], capsys)
     assert rc == EXIT_USAGE and f"key '{key}'" in err and str(p) in err, err
+
+
+def test_step_reader_crash_and_hang_in_its_worker_give_exit_2(cylinder_step: bytes, tmp_path: Path, capsys,
+                                                              monkeypatch) -> None:
+    """OCCT's reader runs in a forked worker: one that crashes (a mutated file made OCCT segfault) or
+    runs past the limit (killed) gives exit 2 with one line, and this process lives on."""
+    import signal
+    import time
+
+    import ght_cad.design.step_input as si
+
+    if not hasattr(os, "fork"):
+        pytest.skip("no fork: the reader runs in this process")
+    p = tmp_path / "part.step"
+    p.write_bytes(cylinder_step)
+    monkeypatch.setattr(si, "_transfer_step", lambda path, units: os.kill(os.getpid(), signal.SIGSEGV))
+    rc, _, err = _run(["unroll", str(p)], capsys)
+    assert rc == EXIT_USAGE and "crashed" in err and "SIGSEGV" in err and str(p) in err, err
+    monkeypatch.setattr(si, "_transfer_step", lambda path, units: time.sleep(60))
+    monkeypatch.setenv("GHT_CAD_STEP_TIMEOUT", "1")
+    t0 = time.perf_counter()
+    rc, _, err = _run(["unroll", str(p)], capsys)
+    assert rc == EXIT_USAGE and "did not finish within 1 s" in err, err
+    assert time.perf_counter() - t0 < 20.0
+    assert len(err.strip().splitlines()) == 1

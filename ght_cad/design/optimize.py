@@ -759,7 +759,9 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
     if not np.isfinite(res.fun) and not start_ok:
         if guard is not None and guard.n_refused:
             raise _sheet_infeasible(design, spec, guard, names, start)
-        raise GHTError(f"{design.source}: optimization found no admissible shape parameters")
+        raise GHTError(f"{design.source}: key 'optimize.parameters': optimization found no admissible shape parameters "
+                       f"(every candidate of {spec.method} over {', '.join(names)} gave a surface that cannot be built); "
+                       "allowed: parameters and bounds where the surface builds (check the curves or planes)")
     x = np.clip(np.asarray(res.x, dtype=float), -1.0, 1.0)
     best = float(res.fun)
     rmin = math.nan
