@@ -38,6 +38,7 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 
 from ._ocp import TopoDS, TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
+from .._vec import cross
 from ..blank import DIST_TOL, BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, classify_skin, k_factor_table, unfold_skins
 from .occ import unwrap
 from .unroll_faces import _SurfEval, face_data
@@ -63,7 +64,7 @@ def _face_points(face: Any, ad: BRepAdaptor_Surface) -> list[tuple[np.ndarray, n
         if BRepClass_FaceClassifier(face, gp_Pnt2d(u, v), tol).State() != TopAbs_IN:
             continue
         ad.D1(u, v, p, du, dv)
-        n = np.cross(np.array(du.Coord()), np.array(dv.Coord()))
+        n = cross(np.array(du.Coord()), np.array(dv.Coord()))
         ln = np.linalg.norm(n)
         if ln == 0:
             continue
@@ -78,7 +79,7 @@ def _normal_at(face: Any, u: float, v: float) -> np.ndarray:
     ad = BRepAdaptor_Surface(face)
     p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
     ad.D1(u, v, p, du, dv)
-    n = np.cross(np.array(du.Coord()), np.array(dv.Coord()))
+    n = cross(np.array(du.Coord()), np.array(dv.Coord()))
     n = n / np.linalg.norm(n)
     return -n if face.Orientation() == TopAbs_REVERSED else n
 
