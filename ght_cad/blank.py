@@ -543,7 +543,7 @@ def unfold_skin(
         measure_panel(panel)
         panel.bend_lines = np.asarray(lines, dtype=float).reshape(-1, 2, 2)
         h = panel.texts[0][3] if panel.texts else 1.0
-        panel.forming_texts = [(x, y, s, 0.5 * h, a) for x, y, s, _, a in texts]
+        panel.bend_texts = [(x, y, s, 0.5 * h, a) for x, y, s, _, a in texts]
         out_panels = [panel]
     else:
         out_panels = []

@@ -409,6 +409,9 @@ class FlatPanel:
     texts: list[tuple[float, float, str, float]] = field(default_factory=list)
     #: sheet forming labels (x, y, text, height, rotation in degrees): layer FORMING (ght_cad.sheet)
     forming_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
+    #: bend annotations (x, y, text, height, rotation in degrees): layer BEND (a blank's bend
+    #: direction, angle and inside radius, ght_cad.blank)
+    bend_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     report: DistortionReport | None = None
     area_flat: float = float("nan")
     _arcs: dict[float, list[tuple[np.ndarray, np.ndarray, list[str]]]] = field(
@@ -469,6 +472,7 @@ class FlatPanel:
         self.marks = [m + delta for m in self.marks]
         self.texts = [(float(x + delta[0]), float(y + delta[1]), s, h) for x, y, s, h in self.texts]
         self.forming_texts = [(float(x + delta[0]), float(y + delta[1]), s, h, a) for x, y, s, h, a in self.forming_texts]
+        self.bend_texts = [(float(x + delta[0]), float(y + delta[1]), s, h, a) for x, y, s, h, a in self.bend_texts]
 
     def bbox(self, loops: list[np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Lower-left and upper-right corners of the outline (``loops``: :meth:`loop_polylines`
@@ -1001,6 +1005,11 @@ class FlatPattern:
         return [t for p in self.panels for t in p.forming_texts]
 
     @property
+    def bend_labels(self) -> list[tuple[float, float, str, float, float]]:
+        """Bend annotations of all panels (x, y, text, height, rotation in degrees): layer BEND."""
+        return [t for p in self.panels for t in p.bend_texts]
+
+    @property
     def sheet(self) -> dict[str, Any] | None:
         """Sheet data of the first panel unrolled with a thickness (``panel.info["sheet"]``:
         thickness, K, side, edge lengths inside/neutral/outside, forming rows), else None."""
@@ -1111,9 +1120,10 @@ class FlatPattern:
         for x, y, s, h in self.labels:
             t = msp.add_text(s, height=h, dxfattribs={"layer": "LABELS"})
             t.set_placement((x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
-        for x, y, s, h, a in self.forming_labels:
-            t = msp.add_text(s, height=h, rotation=a, dxfattribs={"layer": "FORMING"})
-            t.set_placement((x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        for layer, texts in (("FORMING", self.forming_labels), ("BEND", self.bend_labels)):
+            for x, y, s, h, a in texts:
+                t = msp.add_text(s, height=h, rotation=a, dxfattribs={"layer": layer})
+                t.set_placement((x, y), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
         with atomic_path(path) as tmp:
             doc.saveas(tmp)
         return Path(path)
@@ -1166,10 +1176,11 @@ class FlatPattern:
             put(0, "TEXT"), put(8, "LABELS"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
             put(40, float(h)), put(1, _dxf_ascii(text)), put(72, 1), put(73, 2)
             put(11, float(x)), put(21, float(y)), put(31, 0.0)
-        for x, y, text, h, a in self.forming_labels:
-            put(0, "TEXT"), put(8, "FORMING"), put(10, float(x)), put(20, float(y)), put(30, 0.0)
-            put(40, float(h)), put(1, _dxf_ascii(text)), put(50, float(a)), put(72, 1), put(73, 2)
-            put(11, float(x)), put(21, float(y)), put(31, 0.0)
+        for layer, texts in (("FORMING", self.forming_labels), ("BEND", self.bend_labels)):
+            for x, y, text, h, a in texts:
+                put(0, "TEXT"), put(8, layer), put(10, float(x)), put(20, float(y)), put(30, 0.0)
+                put(40, float(h)), put(1, _dxf_ascii(text)), put(50, float(a)), put(72, 1), put(73, 2)
+                put(11, float(x)), put(21, float(y)), put(31, 0.0)
         put(0, "ENDSEC"), put(0, "EOF")
         return "\n".join(out) + "\n"
 
@@ -1225,6 +1236,10 @@ class FlatPattern:
         for p, q in self.bend_lines:
             (x1, y1), (x2, y2) = tr(p), tr(q)
             out.append(f'<line x1="{x1:.9g}" y1="{y1:.9g}" x2="{x2:.9g}" y2="{y2:.9g}"/>')
+        for x, y, s, h, a in self.bend_labels:
+            X, Y = tr(np.array([x, y]))
+            out.append(f'<text x="{X:.9g}" y="{Y:.9g}" font-size="{h:.6g}" text-anchor="middle" dominant-baseline="middle" '
+                       f'fill="red" stroke="none" transform="rotate({-a:.6g} {X:.9g} {Y:.9g})">{escape(s)}</text>')
         out.append("</g>")
         out.append(f'<g id="MARKS" inkscape:groupmode="layer" inkscape:label="MARKS" stroke="blue" stroke-width="{sw:.6g}">')
         for mk in self.marks:
@@ -1275,6 +1290,8 @@ class FlatPattern:
             ax.text(x, y, s, ha="center", va="center", color="green", fontsize=9)
         for x, y, s, h, a in self.forming_labels:  # sheet: bend radius and angle along each bend line
             ax.text(x, y, s, ha="center", va="center", color="magenta", fontsize=5, rotation=a)
+        for x, y, s, h, a in self.bend_labels:  # a blank's bends: direction, angle, inside radius
+            ax.text(x, y, s, ha="center", va="center", color="red", fontsize=5, rotation=a)
         ax.set_aspect("equal")
         ax.set_xlabel(self.units)
         e = self.errors

@@ -119,6 +119,9 @@ def test_cli_default_two_parts_and_outputs(tmp_path: Path, capsys) -> None:
 
     doc = ezdxf.readfile(dxf)
     assert len([e for e in doc.modelspace() if e.dxf.layer == "BEND" and e.dxftype() == "LINE"]) == 6
+    texts = sorted(e.dxf.text for e in doc.modelspace() if e.dxf.layer == "BEND" and e.dxftype() == "TEXT")
+    assert len(texts) == 3 and all(" deg R" in t for t in texts), texts
+    assert sum(" UP " in t for t in texts) == 2 and sum(" DOWN " in t for t in texts) == 1, texts
     # the flat plates: volume = area x T
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
