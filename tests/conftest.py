@@ -28,3 +28,11 @@ def freecadcmd_or_skip() -> str:
             pytest.fail("freecadcmd is not installed but CI=true: .ci/run must install freecad-python3")
         pytest.skip("freecadcmd (Debian's FreeCAD) is not installed")
     return exe
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """A FreeCAD test (a separate ``freecadcmd`` process, seconds to start) is also ``slow``, so the
+    fast loop ``pytest -m "not slow"`` leaves it out without a second marker in every module."""
+    for item in items:
+        if item.get_closest_marker("freecad") is not None and item.get_closest_marker("slow") is None:
+            item.add_marker(pytest.mark.slow)

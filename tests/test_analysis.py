@@ -155,6 +155,7 @@ def test_g2_ght_chain_has_no_curvature_jump_bezier_chain_on_same_points_does(sha
             assert res["bezier"]["orders"][j][1] < 2
 
 
+@pytest.mark.slow
 def test_comparison_example_and_png(tmp_path):
     rng = np.random.default_rng(21)
     shapes = [(0.5, -0.8, -1.0), (-0.6, 0.7, -0.8), (0.2, 0.9, -1.0)]

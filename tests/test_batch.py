@@ -29,7 +29,7 @@ import pytest
 from ght_cad.batch import run_batch
 from ght_cad.cli import main
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]  # process pools and dask clusters
 
 FILES = ["flat_pattern.dxf", "flat_pattern.png", "flat_pattern.svg", "model.step", "report.json", "report.md"]
 

@@ -12,7 +12,7 @@ from ght_cad.cli import main
 from ght_cad.design import unroll_step
 from ght_cad.errors import NotDevelopableError
 
-pytestmark = pytest.mark.timeout(600)
+pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]  # process pools over STEP files
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_batch.py"
 

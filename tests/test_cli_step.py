@@ -234,6 +234,7 @@ def _cli_json(argv: list[str]) -> tuple[int, dict, str]:
     return proc.returncode, obj, proc.stderr
 
 
+@pytest.mark.slow
 def test_json_stdout_is_clean_of_kernel_console_output(tmp_path: Path) -> None:
     """OCCT prints STEP parse errors from C++ to fd 1; with --json they must end up on stderr."""
     bad = tmp_path / "bad.step"

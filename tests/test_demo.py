@@ -19,6 +19,8 @@ from ght_cad.plotting import SIZES
 
 from dxf_read import dxf_outline_areas, svg_outline_areas
 
+pytestmark = pytest.mark.slow  # the whole demo pipeline in a subprocess
+
 EXPECTED_FILES = {
     "model.step",
     "flat_pattern.dxf",

@@ -438,6 +438,7 @@ def test_hull_plate_header_describes_its_join() -> None:
     assert list(stem.control_points[0]) == list(sheer.control_points[-1])
 
 
+@pytest.mark.slow
 def test_planes_optimization_rejects_degenerate_candidates(tmp_path: Path, capsys) -> None:
     """AL of the quarter cone's dual curve is smallest at mu = nu = gamma = -1, where the dual curve
     is stationary at both ends and the surface cannot be built. PSO clips onto that corner; the

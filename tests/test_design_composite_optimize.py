@@ -111,6 +111,7 @@ def run_result(tmp_path_factory) -> tuple[Path, dict, str]:
     return out, json.loads((out / "report.json").read_text()), stdout
 
 
+@pytest.mark.slow
 def test_run_writes_step_dxf_and_report(run_result) -> None:
     """One JSON object on stdout; STEP = one valid shell of two faces sharing the joint ruling;
     DXF with ONE closed outline (the two strips meet at G2, so they unroll as one blank since
@@ -148,6 +149,7 @@ def test_run_writes_step_dxf_and_report(run_result) -> None:
     assert "| quarter → second-quarter | G2 | G2 | yes |" in md and "Per strip (CVEn" in md
 
 
+@pytest.mark.slow
 def test_objective_strictly_lower_joints_kept_strips_developable(run_result) -> None:
     """best < initial on the example; per-strip values sum to the totals; the joint measures G2
     (requested) after optimization, on the report and on the strips rebuilt independently; every
@@ -176,6 +178,7 @@ def test_objective_strictly_lower_joints_kept_strips_developable(run_result) -> 
         assert np.allclose(s["control_planes"], seg.planes, rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_reported_objective_recomputed_independently(run_result) -> None:
     """Rebuild the composite from the reported shape parameters and integrate CVEn of each dual
     curve here (numpy Gauss–Legendre, 64 and 96 nodes): equal to the report to 1e-9 relative."""
@@ -197,6 +200,7 @@ def test_reported_objective_recomputed_independently(run_result) -> None:
     assert math.isclose(sum(gl_fairness(s.dual_curve, 96)["CVEn"] for s in start), o["initial_value"], rel_tol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("objective, weights", [("AL", None), ("En", None), ("weighted", [1.0, 0.5, 0.01])])
 def test_other_objectives_never_worse_and_recomputed(objective: str, weights) -> None:
     """AL, En and weighted: best <= initial, the value recomputed here to 1e-9, joint still G2."""

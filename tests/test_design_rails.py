@@ -203,6 +203,7 @@ def test_hopper_exact_in_core_and_in_the_step(hopper) -> None:
     assert len(r["flat_pattern"]["panels"]) == 1
 
 
+@pytest.mark.slow
 def test_dory_panels_exact_and_cover_their_rails(dory) -> None:
     """Each dory panel (keel–chine, chine–sheer): θ_max ≤ 1e-8° in the core, ≤ 0.01° on its STEP
     faces; every rail covered end to end by the faces' edges (1e-6 of the size); the DXF outline
@@ -426,6 +427,7 @@ def test_rails_objective_override_refused() -> None:
         optimize_design(load_design(HULL), {"objective": "R"}, progress=False)
 
 
+@pytest.mark.slow
 def test_hull_plate_example_end_to_end(tmp_path: Path) -> None:
     """The hull plate example: exact loft (θ_max ≤ 1e-8°), optimized rails exported, one panel whose
     DXF area equals the STEP face area (1e-6)."""

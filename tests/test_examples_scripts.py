@@ -15,6 +15,8 @@ import pytest
 
 from dxf_read import entity_area, outline_bulges
 
+pytestmark = pytest.mark.slow  # every example script in a subprocess
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 

@@ -24,6 +24,10 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.slow  # processes killed mid-run
+
 
 REPO = Path(__file__).resolve().parents[1]
 DUCT = (REPO / "examples" / "design_duct.toml").read_text()

@@ -78,6 +78,7 @@ OBJECTIVES = st.sampled_from([("CVEn", (1.0, 0.0, 0.0)), ("En", (1.0, 0.0, 0.0))
                               ("weighted", (0.3, 2.0, 0.01))])
 
 
+@pytest.mark.slow
 @settings(max_examples=12, deadline=None)
 @given(st.lists(st.floats(-0.99, 0.99), min_size=6, max_size=6), OBJECTIVES)
 def test_duct_g2_gradient_matches_fd(x: list[float], obj) -> None:
@@ -86,6 +87,7 @@ def test_duct_g2_gradient_matches_fd(x: list[float], obj) -> None:
     check(d, DUCT_NAMES, x, *obj)
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(st.lists(st.floats(-0.9, 0.9), min_size=9, max_size=9), OBJECTIVES, st.sampled_from(["G3", "G1"]))
 def test_three_strips_gradient_matches_fd(x: list[float], obj, cont: str) -> None:
@@ -142,6 +144,7 @@ def test_degenerate_candidate_is_inf_with_zero_gradient() -> None:
     assert v == math.inf and np.array_equal(g, np.zeros(6))
 
 
+@pytest.mark.slow
 def test_hybrid_uses_the_exact_gradient_with_fewer_evaluations() -> None:
     """``method = "hybrid"`` on the duct: with the exact gradient (njev > 0) it reaches the same
     optimum (to 1e-6 relative) as with finite differences, with fewer objective evaluations

@@ -65,6 +65,7 @@ def check(A: np.ndarray, B: np.ndarray, x: np.ndarray, margin: float = 0.25, key
     return errs
 
 
+@pytest.mark.slow
 @settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.floats(-0.8, 0.8), min_size=6, max_size=6))
 def test_hull_rails_gradient_matches_fd(x: list[float]) -> None:
@@ -74,6 +75,7 @@ def test_hull_rails_gradient_matches_fd(x: list[float]) -> None:
     check(CHINE, SHEER, np.asarray(x), hyp=True)
 
 
+@pytest.mark.slow
 def test_reversed_rail_swapped_rails_and_regression_penalty() -> None:
     """Rails swapped (fan_a, main, fan_a: t fixed on the fans, s moving), rail b given the other way round (traced reversed: ``∂b~^(q)(s) = (-1)^q ∂b^(q)(1-s)``),
     and a margin large enough for the regression penalty to be positive on the main part."""
@@ -99,6 +101,7 @@ def test_value_and_grad_values_and_no_fallback_where_structure_is_fixed() -> Non
     assert np.allclose(G[0], (g["fan_share"] + 0.01 * g["fairness"])[[1, 3]], rtol=1e-12, atol=0)
 
 
+@pytest.mark.slow
 def test_fallback_to_fd_where_the_rails_meet() -> None:
     """Rails sharing their first point: the first ruling has zero length, the fairness integrand
     ``|d'|²`` is a limit there and the exact derivative is not finite: LoftGradientFallback, and
@@ -116,6 +119,7 @@ def test_fallback_to_fd_where_the_rails_meet() -> None:
     assert np.allclose(G[0], (fs - f[0]) / 1e-7, rtol=1e-12, atol=0)
 
 
+@pytest.mark.slow
 def test_hybrid_uses_the_exact_loft_gradient() -> None:
     """``minimize(problem, method="hybrid")`` takes the exact gradient (njev > 0) and reaches the
     finite-difference run's optimum (to 1e-6 relative) with fewer loft evaluations."""

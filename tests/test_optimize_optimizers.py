@@ -49,6 +49,7 @@ CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fun,dim,half,pop,iters,tol,methods", CASES,
                          ids=[f"{c[0].__name__}-{c[1]}d" for c in CASES])
 def test_known_minimum(fun, dim, half, pop, iters, tol, methods):

@@ -55,6 +55,7 @@ def test_archive_cap_keeps_extremes():
         A.add([[0.0]], [[1.0, 2.0, 3.0]])
 
 
+@pytest.mark.slow
 def test_pareto_front_of_dual_fairness():
     p = default_dual_problem()
     seen_x, seen_f = [], []

@@ -76,6 +76,7 @@ def test_strip_optimization_lowers_theta_max():
     assert after["R"] == pytest.approx(r.fun, rel=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("opt", [igwo, pso])
 def test_strip_two_parameters_agree_with_dense_grid(opt):
     """Over (a.mu, b.nu) a 161 x 161 grid cannot beat the optimizer by more than 1e-6 relative."""
@@ -110,6 +111,7 @@ def test_dual_measures_match_core_curve(mu, nu, gamma):
     assert np.allclose(m, _fairness_reference(U), rtol=1e-10)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("objective", ["AL", "En", "CVEn"])
 def test_dual_fairness_lowered_and_developable(objective):
     p = default_dual_problem(objective)

@@ -258,6 +258,7 @@ with outdir.OutputFolder(out) as f:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", range(8))
 def test_kill_inside_commit_then_one_run_gives_exactly_its_files(tmp_path: Path, k: int) -> None:
     """SIGKILL before the k-th rename of a commit (manifest writes and file moves alike)."""

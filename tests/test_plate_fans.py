@@ -189,6 +189,7 @@ LOFTS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, T, side", [("hull", 4.0, "normal"), ("hull", 25.0, "normal"), ("hull_swapped", 4.0, "reverse"),
                                            ("hopper", 0.01, "normal"), ("hopper", 0.1, "normal")])
 def test_plate_of_a_loft_with_fans(name: str, T: float, side: str) -> None:
@@ -337,6 +338,7 @@ def _hull_design(tmp_path: Path, side: str, swap: bool = False) -> Path:
     return p
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("side, swap", [("normal", False), ("reverse", True)])
 def test_run_hull_plate_with_fans(tmp_path, capsys, side: str, swap: bool) -> None:
     from ght_cad.cli import EXIT_OK, main

@@ -72,6 +72,7 @@ def check_pointed_plate(loft, sheet: Sheet) -> dict:
 
 
 # -- the loft and the limit normal at the point --------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("both", [False, True])
 def test_pointed_loft_is_exact_and_its_pattern_too(both: bool) -> None:
     loft = bow(both)
@@ -141,6 +142,7 @@ def test_tangent_rails_at_the_point_are_refused() -> None:
 
 
 # -- the plate ------------------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("both, T, side", [(False, 4.0, "normal"), (False, 4.0, "reverse"), (False, 60.0, "normal"),
                                            (True, 4.0, "normal"), (True, 20.0, "reverse")])
 def test_plate_of_a_pointed_loft(both: bool, T: float, side: str) -> None:
@@ -159,6 +161,7 @@ def test_plate_of_a_pointed_loft(both: bool, T: float, side: str) -> None:
     assert deg == (2 if both else 1)
 
 
+@pytest.mark.slow
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(dy1=st.floats(-200.0, 200.0), dz2=st.floats(-200.0, 200.0), dz0=st.floats(-300.0, 300.0),
        both=st.booleans(), T=st.floats(0.5, 60.0), side=st.sampled_from(["normal", "reverse"]))

@@ -195,6 +195,7 @@ PINNED = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method, pop, it", list(PINNED))
 def test_without_a_sheet_the_optimization_is_bit_identical(method: str, pop: int, it: int) -> None:
     best, nfev, njev, xhex = PINNED[(method, pop, it)]
@@ -261,6 +262,7 @@ def test_run_rails_whose_free_optimum_is_infeasible(tmp_path, capsys) -> None:
     assert "Sheet constraint (T = 6 mm" in md and "the constraint was active" in md
 
 
+@pytest.mark.slow
 def test_an_infeasible_start_is_said_and_a_feasible_design_found(tmp_path, capsys, monkeypatch) -> None:
     free = optimize_design(design(bracket(method="hybrid", pop=6, it=6)), progress=False)  # radius 4.37
     text = bracket(_sheet(6.0, 0.5), method="pso", pop=6, it=3, start=free.shape)
