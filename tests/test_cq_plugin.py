@@ -70,6 +70,7 @@ def test_developable_loft_on_the_workplane() -> None:
                             cq.Edge.makeLine(cq.Vector(0, 5, 3), cq.Vector(0, 8, 10)))
 
 
+@pytest.mark.slow
 def test_the_plugin_needs_no_build123d(tmp_path: Path) -> None:
     """With build123d made unimportable (the [cadquery] extra installs none), the plugin's curves,
     loft and STEP export work and build123d is never imported."""

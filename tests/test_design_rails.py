@@ -171,6 +171,7 @@ def size_of(points: np.ndarray) -> float:
 # ---------------------------------------------------------------------------------------------
 # one rails surface (hopper) and the two rails surfaces of the dory
 # ---------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_hopper_exact_in_core_and_in_the_step(hopper) -> None:
     """θ_max ≤ 1e-8° in the core and ≤ 0.01° on the STEP faces read back (OCCT normals at both
     ends of 129 rulings per face); both rails covered end to end by the faces' edges within 1e-6
@@ -452,6 +453,7 @@ def test_quasi_developable_example_kept() -> None:
     assert d.optimize.objective == "R"
 
 
+@pytest.mark.slow
 def test_export_and_unroll_commands_take_every_surface(tmp_path: Path, capsys) -> None:
     """`ght-cad export` of a [[surfaces]] design: one STEP shell with both panels' faces, a DXF with
     both labelled panels, a JSON with a section per surface; `ght-cad unroll` gives the same sheet."""

@@ -374,6 +374,7 @@ def hopper_pattern() -> FlatPattern:
     return unroll_surfaces(build_surfaces(load_design(EXAMPLES / "design_hopper_transition.toml")))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("chord_tol", [1e-3, 0.1])
 def test_hopper_outline_within_chord_tolerance(hopper_pattern: FlatPattern, chord_tol: float, tmp_path) -> None:
     """The hopper (rails loft: its rails develop to curves that are neither lines nor arcs): every

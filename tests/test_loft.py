@@ -244,6 +244,7 @@ def test_refusal_writes_the_sign_plot(tmp_path) -> None:
     assert Image.open(png).size == (800, 800)
 
 
+@pytest.mark.slow
 def test_bad_input() -> None:
     line, arc = hopper_rails()
     nan_rail = CallableRail(lambda t: np.column_stack([t, np.where(t > 0.5, np.nan, 0 * t), 0 * t]),

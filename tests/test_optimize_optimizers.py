@@ -68,6 +68,7 @@ TEN_D = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fun,half,tols", TEN_D, ids=[c[0].__name__ + "-10d" for c in TEN_D])
 def test_ten_dimensional_cases(fun, half, tols):
     for m, tol in tols.items():

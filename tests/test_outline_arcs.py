@@ -56,6 +56,7 @@ def fourier_curve(coef: np.ndarray):
     return f
 
 
+@pytest.mark.slow
 @given(st.lists(st.floats(-1.0, 1.0), min_size=16, max_size=16), st.floats(-6.0, -2.0), st.floats(-1.0, 3.0),
        st.floats(-math.pi, math.pi))
 def test_curve_within_chord_tolerance(c: list[float], log_tol: float, log_scale: float, angle: float) -> None:

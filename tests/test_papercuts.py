@@ -43,6 +43,7 @@ def test_no_dead_cadquery_plugin_entry_point_and_readme_says_how_to_activate():
     assert "no entry point" in readme or "loads no plugins" in readme
 
 
+@pytest.mark.slow
 def test_unroll_is_one_coherent_module_that_can_be_called():
     """``ght_cad.unroll`` is the submodule and callable as the stable function of spec section 9;
     every documented spelling works in a fresh interpreter (import order matters)."""

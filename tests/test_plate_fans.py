@@ -208,6 +208,7 @@ def test_material_on_the_concave_side_of_an_apex_stays_refused(name: str, side: 
     assert exc.value.constraint == "apex"
 
 
+@pytest.mark.slow
 @settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(dz0=st.floats(-150.0, 150.0), dy0=st.floats(-150.0, 150.0), dx3=st.floats(-300.0, 300.0),
        dz3=st.floats(-150.0, 150.0), swap=st.booleans(), T=st.floats(0.5, 30.0), side=st.sampled_from(["normal", "reverse"]))

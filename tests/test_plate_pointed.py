@@ -200,6 +200,7 @@ def test_pointed_plate_step_names_and_readers(tmp_path) -> None:
 
 
 # -- the design run --------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_run_bow_plate_with_a_sheet(tmp_path, capsys) -> None:
     from ght_cad.cli import main
 
@@ -216,6 +217,7 @@ def test_run_bow_plate_with_a_sheet(tmp_path, capsys) -> None:
     assert all(math.isfinite(r["radius_a"]) and math.isfinite(r["radius_b"]) for r in sh["forming"])
 
 
+@pytest.mark.slow
 def test_run_plated_skiff_with_a_pointed_side_panel(tmp_path, capsys) -> None:
     """Two surfaces, the side loft pointed at the bow, one [sheet] (examples/design_skiff_plated.toml):
     the shell orientation asks the pointed loft for a, a', a'' on parameters near and far from the

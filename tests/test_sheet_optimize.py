@@ -237,6 +237,7 @@ def test_a_boundary_optimum_is_held_inside_by_the_margin() -> None:
     assert free.best_value < o.best_value < o.initial_value
 
 
+@pytest.mark.slow
 def test_run_rails_whose_free_optimum_is_infeasible(tmp_path, capsys) -> None:
     text = bracket(method="hybrid", pop=6, it=6)
     free = optimize_design(design(text), progress=False)

@@ -125,6 +125,7 @@ def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
     assert rc == EXIT_USAGE and "--thickness=5.0 does not match the plate solid bottom in the file" in err, err
 
 
+@pytest.mark.slow
 def test_neutral_patterns_as_for_one_surface() -> None:
     """Each panel is its surface's neutral pattern exactly as a single [surface] unrolls it."""
     from ght_cad.design import unroll_surfaces

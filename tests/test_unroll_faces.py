@@ -468,6 +468,7 @@ def test_full_sphere_best_effort_is_refused_naming_poles() -> None:
         unroll(bd.Sphere(5.0).faces()[0], best_effort=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("arc", [10.0, 45.0])
 def test_sphere_gore_best_effort(arc: float) -> None:
     """A sphere sector (a gore, Δu = arc): rulings between its two meridians (u-isolines open,
