@@ -36,14 +36,14 @@ WORKBENCH = ROOT / "freecad_workbench" / "freecad"
 LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
 
 _LAYER_OF = {
-    "core": ["errors", "_validate", "_vec", "io", "outdir", "progress"],
+    "core": ["errors", "_validate", "_vec", "io", "outdir", "progress", "step_guard"],
     "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
     "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "join_panels",
-                 "outline_arcs"],
+                 "outline_arcs", "blank", "approximation"],
     "optimize": ["optimize"],
     "kernel": ["cad"],
-    "app": ["cli", "design", "batch", "sweep", "demo"],
+    "app": ["cli", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
 }
 
 #: Imports from a lower layer into a higher one that exist today: (importer, imported).
@@ -53,6 +53,7 @@ ALLOWED_UPWARD = {
     # surfaces -> kernel: to_face and the unroll dispatch of CAD faces (issue 27: a registry)
     ("ght_cad.developable", "ght_cad.cad.developable_faces"),
     ("ght_cad.loft", "ght_cad.cad.developable_faces"),
+    ("ght_cad.approximation", "ght_cad.cad.approximate"),
     ("ght_cad.unroll", "ght_cad.cad.unroll_faces"),
     ("ght_cad.flat_pattern", "ght_cad.cad.unroll_faces"),
     # surfaces -> optimize: the loft's own optimization problem (issue 27: move it to optimize)
@@ -69,9 +70,14 @@ KNOWN_CYCLES = [
      "ght_cad.cad.unroll_faces"},
     # developables: to_face through the OCP adapter
     {"ght_cad.developable", "ght_cad.cad.developable_faces"},
+    # approximation: a CAD face as the target through the OCP adapter
+    {"ght_cad.approximation", "ght_cad.cad.approximate"},
+    # FreeCAD workbench: the Flat pattern feature and the sheet-skin reader use each other
+    {"ght_workbench.flat_pattern", "ght_workbench.sheet_skin"},
     # the application: batch runs designs, design files read STEP through batch's helpers, the CLI
     # runs both, and the demo (which the CLI runs) runs a design
-    {"ght_cad.batch", "ght_cad.cli", "ght_cad.demo", "ght_cad.design", "ght_cad.design.step_input"},
+    {"ght_cad.batch", "ght_cad.cli", "ght_cad.demo", "ght_cad.design", "ght_cad.design.step_input",
+     "ght_cad.approximate_cli", "ght_cad.unfold_step"},
 ]
 
 
