@@ -204,3 +204,26 @@ def test_freeform_bend_either_side(sign: int) -> None:
     row = res.blanks[0].bends[0]
     assert abs(row["angle_deg"] - 90.0) < 1e-6 and row["kind"] not in ("cylinder", "cone")
     assert res.pattern.panels[0].bend_lines.shape[0] > 2  # tangent lines + rulings
+
+
+def test_centre_bend_lines_and_outside_base_face() -> None:
+    """``bend_lines="centre"``: one line a bend, half way between the tangent lines; a base face on
+    the outside skin unfolds the outside skin to the same neutral blank."""
+    prof = u_channel()
+    solid = profile_solid(prof)
+    tan = ght_cad.unfold(solid, k_factor=K)
+    cen = ght_cad.unfold(solid, k_factor=K, bend_lines="centre")
+    assert cen.pattern.panels[0].bend_lines.shape == (2, 2, 2)
+    assert abs(cen.pattern.area / tan.pattern.area - 1) < 1e-12
+    skin_faces = tan.blanks[0].faces
+    from ght_cad.cad.unfold_solid import sheet_skins
+
+    skins, _ = sheet_skins(solid)
+    partner = {f.number: f.partner for f in skins[0].faces}
+    out_base = partner[tan.blanks[0].base_face]
+    o = ght_cad.unfold(solid, k_factor=K, base_face=out_base)
+    assert o.blanks[0].base_face == out_base and set(o.blanks[0].faces).isdisjoint(skin_faces)
+    assert abs(o.pattern.area / (prof.blank_area(K)) - 1) < 1e-6
+    for row in o.blanks[0].bends:
+        a = math.radians(row["angle_deg"])
+        assert abs(row["bend_lines_distance"] / ((row["inside_radius"] + K * 2.0) * a) - 1) < 1e-9
