@@ -169,3 +169,39 @@ def freeform_bend(sign: int, T: float = 2.0, W: float = 40.0):
         return (L + k * T * math.pi / 2) * W
 
     return bd.Solid(mk.Shape()), area
+
+
+def cone_bend(T: float = 2.0, W: float = 40.0, L1: float = 30.0, L2: float = 20.0, r1: float = 3.0, r2: float = 8.0):
+    """An L whose bend is a cone segment: inside radius r1 at z = 0 growing linearly to r2 at z = W
+    (axis z, semi-angle α = atan((r2 - r1)/W)); flanges in the tangent planes y = -r(z) and x = r(z);
+    both z-sections drawn with thickness T / cos α so the skins lie T apart along the normals;
+    ruled loft of the two sections. Returns the solid and ``area(K)``: flanges ``(L1 + L2) s`` and
+    the neutral cone (radii ``r + K T cos α``, slant ``s = W / cos α``, a quarter turn about the
+    axis) ``π/4 (r1 + r2 + 2 K T cos α) s``."""
+    import build123d as bd
+
+    al = math.atan((r2 - r1) / W)
+    ts = T / math.cos(al)
+
+    def section(r: float, z: float):
+        def P(x: float, y: float):
+            return bd.Vector(x, y, z)
+
+        def c(rr: float, a: float):
+            return P(rr * math.cos(a), rr * math.sin(a))
+
+        ro = r + ts
+        return bd.Wire([bd.Edge.make_line(P(-L1, -r), P(0, -r)),
+                        bd.Edge.make_three_point_arc(c(r, -math.pi / 2), c(r, -math.pi / 4), c(r, 0)),
+                        bd.Edge.make_line(P(r, 0), P(r, L2)), bd.Edge.make_line(P(r, L2), P(ro, L2)),
+                        bd.Edge.make_line(P(ro, L2), P(ro, 0)),
+                        bd.Edge.make_three_point_arc(c(ro, 0), c(ro, -math.pi / 4), c(ro, -math.pi / 2)),
+                        bd.Edge.make_line(P(0, -ro), P(-L1, -ro)), bd.Edge.make_line(P(-L1, -ro), P(-L1, -r))])
+
+    solid = bd.Solid.make_loft([section(r1, 0.0), section(r2, W)], ruled=True)
+    s = W / math.cos(al)
+
+    def area(k: float) -> float:
+        return (L1 + L2) * s + math.pi / 4 * (r1 + r2 + 2 * k * T * math.cos(al)) * s
+
+    return solid, area

@@ -227,3 +227,15 @@ def test_centre_bend_lines_and_outside_base_face() -> None:
     for row in o.blanks[0].bends:
         a = math.radians(row["angle_deg"])
         assert abs(row["bend_lines_distance"] / ((row["inside_radius"] + K * 2.0) * a) - 1) < 1e-9
+
+
+def test_cone_segment_bend() -> None:
+    from sheet_parts import cone_bend
+
+    solid, area = cone_bend()
+    res = ght_cad.unfold(solid, k_factor=K)
+    assert len(res.pattern.panels) == 1
+    assert abs(res.pattern.area / area(K) - 1) < 1e-6, (res.pattern.area, area(K))
+    row = res.blanks[0].bends[0]
+    assert row["kind"] == "cone" and abs(row["angle_deg"] - 90.0) < 1e-9
+    assert res.pattern.panels[0].bend_lines.shape == (2, 2, 2)
