@@ -302,11 +302,12 @@ class _Seam:
         r1 = j[1] + d * self.f.normal_dx(t, y, j) + self.delta(t, 1)[:, None] * n
         return [r, r1]
 
-    def rail(self) -> "SeamCurve":
+    def rail(self, by_arc_length: bool = True) -> "SeamCurve":
         """The seam as a B-spline curve fitted to ``1e-9`` of the target size (ends interpolated):
         both panels of the seam are lofted from this one curve."""
-        if getattr(self, "_rail", None) is None:
-            from scipy.interpolate import CubicSpline
+        key = "_rail" if by_arc_length else "_rail_x"
+        if getattr(self, key, None) is None:
+            from scipy.interpolate import PchipInterpolator
 
             from .bspline import fit_function
 
@@ -315,8 +316,8 @@ class _Seam:
             x = np.linspace(0.0, 1.0, 4097)
             P = self.eval(x, 0)[0]
             cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
-            if cum[-1] > 0 and np.all(np.diff(cum) > 0):
-                xs = CubicSpline(cum / cum[-1], x)
+            if by_arc_length and cum[-1] > 0 and np.all(np.diff(cum) > 0):
+                xs = PchipInterpolator(cum / cum[-1], x)  # monotone, local: no ringing at a kink
 
                 def func(t: np.ndarray) -> np.ndarray:
                     return self.eval(np.clip(xs(t), 0.0, 1.0), 0)[0]
@@ -325,8 +326,8 @@ class _Seam:
                     return self.eval(t, 0)[0]
             ends = self.eval(np.array([0.0, 1.0]), 0)[0]
             data = fit_function(func, tol=1e-9 * self.f.size, degree=7, end_derivatives=([ends[0]], [ends[1]]))
-            self._rail = SeamCurve(data.knots, data.poles, data.degree)
-        return self._rail
+            setattr(self, key, SeamCurve(data.knots, data.poles, data.degree))
+        return getattr(self, key)
 
 
 class SeamCurve:
@@ -683,14 +684,19 @@ def _build_panel(frame: _Frame, A: _Seam, B: _Seam) -> Any:
         return ConeStrip(A.rail(), B.eval(np.array([0.5]), 0)[0][0])
     if A.point:
         return ConeStrip(B.rail(), A.eval(np.array([0.5]), 0)[0][0])
+    from .errors import NotDevelopableError
     from .loft import developable_loft
 
-    return developable_loft(A.rail(), B.rail(), orientation="same", samples=65)
+    try:
+        return developable_loft(A.rail(), B.rail(), orientation="same", samples=65)
+    except NotDevelopableError:  # the arc-length rails failed: the target's own parameters
+        return developable_loft(A.rail(False), B.rail(False), orientation="same", samples=65)
 
 
 def _project_panel(panel: Any, X: np.ndarray, iters: int = 8) -> np.ndarray:
     """Closest points of ``X`` on the ruled panel ``a(λ) + w (b(λ) - a(λ))`` (start: nearest of a
-    257 × 17 grid; then Gauss–Newton in (λ, w), clamped to [0, 1]²)."""
+    257 × 17 grid; then Gauss–Newton in (λ, w), clamped to [0, 1]², a step kept only where it
+    brings the point closer, else halved; the closest point met is returned)."""
     from scipy.spatial import cKDTree
 
     lg = np.linspace(0, 1, 257)
@@ -701,13 +707,32 @@ def _project_panel(panel: Any, X: np.ndarray, iters: int = 8) -> np.ndarray:
     _, idx = cKDTree(G.reshape(-1, 3)).query(X)
     lam = lg[idx // wg.size]
     w = wg[idx % wg.size]
-    for _ in range(iters):
+    best = np.full(X.shape[0], np.inf)
+    best_p = np.zeros_like(X)
+    scale = np.ones(X.shape[0])
+    prev = (lam, w)
+    for it in range(iters + 1):
         a, a1 = panel.a(lam), panel.a(lam, 1)
         b, b1 = panel.b(lam), panel.b(lam, 1)
         P = a + w[:, None] * (b - a)
+        r = X - P
+        dist = np.linalg.norm(r, axis=1)
+        better = dist < best
+        best = np.where(better, dist, best)
+        best_p[better] = P[better]
+        # a step that did not reduce the distance (near a fan's apex, where a' = 0) is halved
+        scale = np.where(better, np.minimum(1.0, 2 * scale), 0.5 * scale)
+        lam = np.where(better, lam, prev[0])
+        w = np.where(better, w, prev[1])
+        if it == iters:
+            break
+        if not np.all(better):
+            a, a1 = panel.a(lam), panel.a(lam, 1)
+            b, b1 = panel.b(lam), panel.b(lam, 1)
+            r = X - (a + w[:, None] * (b - a))
         Pl = a1 + w[:, None] * (b1 - a1)
         Pw = b - a
-        r = X - P
+        prev = (lam, w)
         aa = np.sum(Pl * Pl, 1) + 1e-300
         bb = np.sum(Pl * Pw, 1)
         cc = np.sum(Pw * Pw, 1) + 1e-300
@@ -715,10 +740,9 @@ def _project_panel(panel: Any, X: np.ndarray, iters: int = 8) -> np.ndarray:
         g2 = np.sum(Pw * r, 1)
         det = aa * cc - bb * bb
         det = np.where(np.abs(det) > 1e-300, det, 1e-300)
-        lam = np.clip(lam + np.clip((cc * g1 - bb * g2) / det, -0.05, 0.05), 0, 1)
-        w = np.clip(w + np.clip((aa * g2 - bb * g1) / det, -0.5, 0.5), 0, 1)
-    a, b = panel.a(lam), panel.b(lam)
-    return a + w[:, None] * (b - a)
+        lam = np.clip(lam + scale * np.clip((cc * g1 - bb * g2) / det, -0.05, 0.05), 0, 1)
+        w = np.clip(w + scale * np.clip((aa * g2 - bb * g1) / det, -0.5, 0.5), 0, 1)
+    return best_p
 
 
 def _strip_grid(frame: _Frame, A: _Seam, B: _Seam, nx: int, ny: int) -> tuple[np.ndarray, np.ndarray]:

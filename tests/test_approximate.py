@@ -229,11 +229,11 @@ def hull_point(s: float, t: float) -> tuple[float, float, float]:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="hull side at 2 mm: the final two-way measure exceeds tol on some strips (open)", strict=False)
 def test_hull_side():
     face = bspline_face(hull_point, 14, 10)
     tol = 2.0
     res = ght_cad.approximate(face, tol, max_panels=40)
+    assert len(res.panels) <= 16
     shell = panels_shell(res)
     assert two_way(face, shell) <= tol * 1.001
     assert max(twist_deg(f) for f in shape_faces(shell.wrapped)) <= 0.01
