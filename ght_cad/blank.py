@@ -550,6 +550,10 @@ def unfold_skin(
         for n in order:
             p = panels[n]
             _apply_motion(p, motion[n])
+            for loop in p.loops:  # shared edges by the skin's own 3-D edges (a bend's are on its neutral surface)
+                for e in loop:
+                    if e.name in skin.shared:
+                        e.xyz_fn, e.xyz = _edge_uv(by_num[n].data, e.name).xyz, None
             out_panels.append(p)
         mark_shared_edges(out_panels)
         layout_panels(out_panels)
@@ -611,8 +615,10 @@ def _apply_motion(panel: Any, m: _Motion) -> None:
     if panel.bend_lines.size:
         bl = panel.bend_lines
         panel.bend_lines = np.stack([m(bl[:, 0]), m(bl[:, 1])], axis=1)
+    texts = [(m(np.array([x, y]) + off), s, h) for x, y, s, h in panel.texts]
     panel.offset = np.zeros(2)
-    panel.texts, panel.forming_texts, panel.marks = [], [], []
+    panel.texts = [(float(p[0]), float(p[1]), s, h) for p, s, h in texts]
+    panel.forming_texts, panel.marks = [], []
     panel.development = None
 
 

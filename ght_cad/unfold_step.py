@@ -78,17 +78,19 @@ def unfold_step(
     from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
-    if not TopExp_Explorer(shape, TopAbs_SOLID).More():
+    if not TopExp_Explorer(shape, TopAbs_SOLID).More() or _loose_faces(shape):
         if force:
-            raise BlankError(f"{p}: the file holds no solid; blank options apply to sheet solids")
-        return None
+            raise BlankError(f"{p}: the file holds faces outside any solid; blank options apply to files of sheet solids")
+        return None  # faces (or faces beside solids): the per-face unroll
     from .cad.unfold_solid import sheet_skins
 
     try:
         skins, n = sheet_skins(shape, base_face=base_face)
     except BlankError as exc:
-        if not force and (thickness is not None or k_factor is not None or din_k_factor is not None) and _plates(p):
-            return None  # ght_cad's plate solids (named inside/outside faces): the per-face unroll reports them
+        if not force and (thickness is not None or ((k_factor is not None or din_k_factor is not None) and _plates(p))):
+            # an explicit --thickness asks for every face's neutral surface (the per-face sheet unroll);
+            # ght_cad's plate solids (named inside/outside faces): the per-face unroll reports them
+            return None
         raise BlankError(f"{p}: {exc}") from None
     if not force and all(len(s.faces) == 1 and not s.shared for s in skins):
         return None
@@ -112,6 +114,26 @@ def unfold_step(
         raise BlankError(f"{p}: {exc}") from None
     declared = _step_unit(file_unit) or (file_unit.strip().lower() if file_unit and file_unit.strip() else None)
     return StepBlanks(unfolded, unit, declared, n, shape)
+
+
+def _loose_faces(shape: Any) -> bool:
+    """The shape holds faces that belong to no solid."""
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    n_all = n_solid = 0
+    exp = TopExp_Explorer(shape, TopAbs_FACE)
+    while exp.More():
+        n_all += 1
+        exp.Next()
+    exp = TopExp_Explorer(shape, TopAbs_SOLID)
+    while exp.More():
+        sub = TopExp_Explorer(exp.Current(), TopAbs_FACE)
+        while sub.More():
+            n_solid += 1
+            sub.Next()
+        exp.Next()
+    return n_all > n_solid
 
 
 def _plates(p: Path) -> bool:

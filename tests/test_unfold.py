@@ -239,3 +239,23 @@ def test_cone_segment_bend() -> None:
     row = res.blanks[0].bends[0]
     assert row["kind"] == "cone" and abs(row["angle_deg"] - 90.0) < 1e-9
     assert res.pattern.panels[0].bend_lines.shape == (2, 2, 2)
+
+
+def test_overlap_refusal_and_split(monkeypatch) -> None:
+    """The crossing detector finds a figure eight's crossing and none on a square; a blank whose
+    pieces overlap is refused naming the faces and the area, or split into one panel per face with
+    matching marks (the detector's verdict forced here: an extruded profile's strip cannot overlap)."""
+    import ght_cad.blank as blank
+
+    eight = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    assert len(blank._crossings(blank._segments([eight]), 1e-9)) == 1
+    assert len(blank._crossings(blank._segments([square]), 1e-9)) == 0
+    solid = profile_solid(bracket())
+    monkeypatch.setattr(blank, "_overlaps", lambda *a: ("F1, F3", 12.5))
+    with pytest.raises(BlankError, match=r"overlap .*F1, F3.*12\.5"):
+        ght_cad.unfold(solid, k_factor=K)
+    res = ght_cad.unfold(solid, k_factor=K, allow_split=True)
+    assert len(res.pattern.panels) == 3
+    assert abs(res.pattern.area / bracket().blank_area(K) - 1) < 1e-9
+    assert sum(len(p.marks) for p in res.pattern.panels) > 0
