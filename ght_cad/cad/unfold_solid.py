@@ -151,8 +151,8 @@ def _solid_skin(solid: Any, sname: str, fmap: Any, number_of: dict[int, int], ba
 
     box = Bnd_Box()
     BRepBndLib.Add_s(solid, box)
-    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-    size = max(xmax - xmin, ymax - ymin, zmax - zmin)
+    # CornerMin/CornerMax on OCP 7.9 and 8 alike (OCP 8's Bnd_Box.Get() returns a struct it cannot convert)
+    size = float(np.max(np.array(box.CornerMax().Coord()) - np.array(box.CornerMin().Coord())))
     inter.Load(solid, 1e-9 * size)
     areas = [_area(f) for f in faces]
     rays: list[list[tuple[float, bool, int]]] = []  # per face: (distance, opposite normal, hit face index)
