@@ -200,15 +200,23 @@ PINNED = {
 def test_without_a_sheet_the_optimization_is_bit_identical(method: str, pop: int, it: int) -> None:
     best, nfev, njev, xhex = PINNED[(method, pop, it)]
     plain = optimize_design(design(bracket(method=method, pop=pop, it=it)), progress=False)
-    assert (plain.best_value, plain.nfev, plain.njev) == (best, nfev, njev)
-    assert [float(v).hex() for v in plain.x] == xhex
+    # the same trajectory: the same evaluation counts exactly; values to rounding. The hybrid's
+    # L-BFGS-B finish goes through BLAS, whose kernel depends on the CPU: on this session's
+    # machine the pinned run ends 1.5e-14 (relative) lower with x 3.3e-13 away, the pinned main
+    # included, so last bits are not portable; PSO (no BLAS) stays bit-identical.
+    assert (plain.nfev, plain.njev) == (nfev, njev)
+    assert abs(plain.best_value - best) <= 1e-12 * abs(best)
+    x = np.array([float.fromhex(h) for h in xhex])
+    assert np.max(np.abs(np.asarray(plain.x) - x)) <= 1e-10
+    if method == "pso":
+        assert [float(v).hex() for v in plain.x] == xhex and plain.best_value == best
     assert plain.sheet is None and "sheet" not in plain.summary()
     # T = 0 is no sheet; a sheet thin enough never to refuse a candidate leaves the search untouched
     zero = optimize_design(design(bracket(_sheet(0.0), method=method, pop=pop, it=it)), progress=False)
     thin = optimize_design(design(bracket(_sheet(0.01), method=method, pop=pop, it=it)), progress=False)
     assert zero.sheet is None
     for o in (zero, thin):
-        assert (o.best_value, o.nfev, o.njev) == (best, nfev, njev)
+        assert (o.best_value, o.nfev, o.njev) == (plain.best_value, nfev, njev)  # bit-identical in one run
         np.testing.assert_array_equal(o.x, plain.x)
         np.testing.assert_array_equal(o.history, plain.history)
     assert thin.sheet["candidates_refused"] == 0 and thin.sheet["active"] is False
