@@ -220,9 +220,11 @@ def test_unsupported_input_is_refused() -> None:
 
 
 def test_zero_length_ruling_is_degenerate() -> None:
-    surf = CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 0.0))
-    with pytest.raises(GHTError, match="ruling length"):
-        RuledDevelopment(surf)
+    """Two identical rails: refused at construction as degenerate (zero width), issue 26."""
+    from ght_cad.errors import DegenerateGeometryError
+
+    with pytest.raises(DegenerateGeometryError, match="zero width"):
+        CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 0.0))
 
 
 def test_stable_name_is_callable() -> None:
