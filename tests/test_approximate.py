@@ -51,7 +51,7 @@ def cap_face(radius: float = 1000.0, polar_deg: float = 60.0):
 def bspline_face(fun, nu: int = 12, nv: int = 12, degree: int = 3):
     """A B-spline face interpolating ``fun(s, t)`` on an nu × nv grid (OCCT interpolation)."""
     from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
-    from OCP.TColgp import TColgp_Array2OfPnt
+    from ght_cad.cad._ocp import TColgp_Array2OfPnt
 
     arr = TColgp_Array2OfPnt(1, nu, 1, nv)
     for i, s in enumerate(np.linspace(0, 1, nu)):

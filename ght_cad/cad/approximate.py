@@ -17,7 +17,7 @@ from typing import Any
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
 from OCP.TopAbs import TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS
+from ._ocp import TopoDS
 
 from ..approximation import ApproximationResult, SurfaceTarget, approximate
 from ..errors import ConversionError, GHTError
