@@ -120,6 +120,9 @@ def _transfer_step_in_worker(path: Path, units: str | None) -> tuple[Any, str, s
         if pid == 0:  # the worker: never returns, never runs the parent's exit handlers
             code = 3
             try:
+                import faulthandler
+
+                faulthandler.disable()  # a crash is reported by the parent; no dump on a copied stderr fd
                 null = os.open(os.devnull, os.O_WRONLY)  # the kernel's own parser messages, a crash report
                 os.dup2(null, 1)
                 os.dup2(null, 2)
