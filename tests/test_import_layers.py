@@ -39,7 +39,7 @@ _LAYER_OF = {
     "core": ["errors", "_validate", "_vec", "io", "outdir", "progress", "step_guard"],
     "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
-    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "pattern", "faces", "join_panels",
+    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "pattern", "faces", "developables", "join_panels",
                  "outline_arcs", "blank", "approximation"],
     "optimize": ["optimize"],
     "kernel": ["cad"],
