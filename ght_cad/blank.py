@@ -21,8 +21,8 @@ the solid's edge keys, the thickness ``T`` and which edges two skin faces share.
   both tangent lines of every bend (or its centre line) as bend lines, the rulings of freeform
   bends, and a bend table (angle ``A``, inside radius ``R``, ``K``, bend allowance
   ``BA = (R + K T) A``, bend deduction ``BD = 2 (R + T) tan(A / 2) - BA``, direction up/down);
-* refuses a blank whose pieces overlap in the plane (crossing outline segments; overlap area
-  estimated on a grid) unless split into separate panels with matching edge marks.
+* refuses a blank whose pieces overlap in the plane (crossing outline segments; the overlap area
+  of the crossing faces' outlines by Green's theorem, :func:`_overlap_area`) unless split into separate panels with matching edge marks.
 
 The blank's length across a bend is therefore ``Σ flange lengths to the tangent lines +
 Σ (R + K T) A`` exactly as the closed form (a freeform bend: inside length + ``K T`` × turn angle).
@@ -48,6 +48,7 @@ __all__ = [
     "KFactorTable",
     "K_TABLES",
     "k_factor_table",
+    "k_factor_rows",
     "SkinFace",
     "SheetSkin",
     "Blank",
@@ -147,13 +148,44 @@ def k_factor_table(spec: str | os.PathLike) -> KFactorTable:
         rows.append((r, k / 2 if din else k))
     if not rows:
         raise BlankError(f"{p}: no 'R/T K' rows; allowed: one pair a line")
-    ratios = [r for r, _ in rows]
+    return k_factor_rows([(r, k) for r, k in rows], name=p.name, where=str(p), source=f"file {p}" + (" (DIN k)" if din else ""))
+
+
+def k_factor_rows(rows: Sequence[Sequence[float]], *, name: str = "table", where: str = "k_factor_table",
+                  din: bool = False, source: str = "") -> KFactorTable:
+    r"""A K-factor table from ``(R/T, K)`` rows: ``K(R/T) = K_i`` for ``r_i <= R/T < r_{i+1}``.
+
+    Args:
+        rows: ``(r_i, K_i)`` pairs, ``r_0 = 0``, ``r_i`` ascending; ANSI ``K`` in [0, 1] (DIN
+            ``k = 2K`` in [0, 2] with ``din``).
+        name: the table's name; where: what the messages name (a file, a design key).
+        din: the values are DIN ``k = 2K``.
+
+    Raises:
+        BlankError: no rows, a row that is not two finite numbers, ratios not starting at 0 or not
+            ascending, K outside [0, 1] (naming ``where`` and the value).
+    """
+    out: list[tuple[float, float]] = []
+    for i, row in enumerate(rows):
+        try:
+            if isinstance(row, (str, bytes)) or len(row) != 2:
+                raise TypeError
+            r, k = (float(x) for x in row)
+            if any(isinstance(x, bool) for x in row) or not (math.isfinite(r) and math.isfinite(k)):
+                raise TypeError
+        except (TypeError, ValueError):
+            raise BlankError(f"{where}: row {i + 1} {row!r} is not an [R/T, K] pair of numbers; allowed: "
+                             "two finite numbers a row") from None
+        out.append((r, k / 2 if din else k))
+    if not out:
+        raise BlankError(f"{where}: no [R/T, K] rows; allowed: at least one row, the first at R/T = 0")
+    ratios = [r for r, _ in out]
     if ratios[0] != 0.0 or any(b <= a for a, b in zip(ratios, ratios[1:])):
-        raise BlankError(f"{p}: R/T values {ratios} must start at 0 and ascend")
-    for r, k in rows:
-        if not (math.isfinite(k) and 0.0 <= k <= 1.0):
-            raise BlankError(f"{p}: K={k!r} at R/T={r:g} is outside [0, 1] (ANSI K; DIN k = 2K lies in [0, 2])")
-    return KFactorTable(p.name, tuple(ratios), tuple(k for _, k in rows), f"file {p}" + (" (DIN k)" if din else ""))
+        raise BlankError(f"{where}: R/T values {ratios} must start at 0 and ascend")
+    for r, k in out:
+        if not 0.0 <= k <= 1.0:
+            raise BlankError(f"{where}: K={k!r} at R/T={r:g} is outside [0, 1] (ANSI K; DIN k = 2K lies in [0, 2])")
+    return KFactorTable(name, tuple(ratios), tuple(k for _, k in out), source or where)
 
 
 # -- the skin --------------------------------------------------------------------------------------
@@ -305,6 +337,17 @@ def _curvature(face: Any, ruled: str, u: float, v: float) -> tuple[float, np.nda
     return float(sxx @ n) / float(w @ w), n
 
 
+def _gaussian_curvature(face: Any) -> float:
+    r"""Gaussian curvature ``K = (L N - M²) / (E G - F²)`` at the middle of the face's parameter box
+    (first fundamental form ``E = S_u·S_u``, ``F = S_u·S_v``, ``G = S_v·S_v``; second ``L = S_uu·n``,
+    ``M = S_uv·n``, ``N = S_vv·n``); 0 on a developable face."""
+    u0, u1, v0, v1 = face.bounds
+    n, d = _outward(face, 0.5 * (u0 + u1), 0.5 * (v0 + v1))
+    E, F, G = d[1] @ d[1], d[1] @ d[2], d[2] @ d[2]
+    L, M, N = d[3] @ n, d[5] @ n, d[4] @ n
+    return float((L * N - M * M) / (E * G - F * F))
+
+
 def _edge_uv(face: Any, name: str) -> Any:
     for wire in face.wires:
         for e in wire:
@@ -412,8 +455,12 @@ def unfold_skin(
 
                 ruled = ruling_direction(fd.surface, fd.bounds)[0]
                 if ruled is None:
+                    kg = _gaussian_curvature(fd)
                     raise BlankError(f"{skin.name}: face F{f.number} ({kind}) is not developable: it is not ruled "
-                                     "(no straight isolines); allowed: planes, cylinders, cones and developable ruled faces")
+                                     f"(no straight isolines) and its Gaussian curvature at the middle of its parameter "
+                                     f"box is {kg:.6g} /{units}^2 (radius 1/sqrt|K| = {1 / math.sqrt(abs(kg)) if kg else math.inf:.6g} "
+                                     f"{units}; a developable face has 0); allowed: planes, cylinders, cones and "
+                                     "developable ruled faces")
             u0, u1, v0, v1 = fd.bounds
             kap, _ = _curvature(fd, ruled, 0.5 * (u0 + u1), 0.5 * (v0 + v1))
             inside = kap > 0  # bends towards its outward side: the concave (inside) skin of the bend
@@ -528,8 +575,8 @@ def unfold_skin(
     overlap = _overlaps(merged, panels, motion, order)
     if overlap is not None and not allow_split:
         faces_txt, area = overlap
-        raise BlankError(f"{skin.name}: pieces of the blank overlap in the plane (faces {faces_txt}, overlap area about "
-                         f"{area:.4g} {units}^2); allowed: --allow-split (allow_split=True) to keep them apart as "
+        raise BlankError(f"{skin.name}: pieces of the blank overlap in the plane (faces {faces_txt}, overlap area "
+                         f"{area:.9g} {units}^2); allowed: --allow-split (allow_split=True) to keep them apart as "
                          "separate panels with matching marks, or another base face")
     if overlap is None:
         ruling3 = [panels[n].ruling_lengths_3d for n in order]
@@ -718,10 +765,43 @@ def _crossings(segs: np.ndarray, eps: float) -> np.ndarray:
     return np.stack([i[hit], j[hit]], axis=1)
 
 
+def _oriented(loops: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """A region's loops with the outer loop counter-clockwise and the holes clockwise."""
+    from .flat_pattern import _shoelace
+
+    out = []
+    for i, lp in enumerate(loops):
+        ccw = _shoelace(lp) > 0
+        out.append(lp if ccw == (i == 0) else lp[::-1])
+    return out
+
+
+def _overlap_area(a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> float:
+    r"""Area of the intersection of two polygonal regions (loops: outer first, then holes) by
+    Green's theorem: ``∂(A ∩ B) = (∂A ∩ B) ∪ (∂B ∩ A)``, so with ``∂A``, ``∂B`` oriented (outer
+    loop counter-clockwise, holes clockwise)
+
+        area(A ∩ B) = ½ Σ_{s ⊂ ∂A ∩ B} (x_0 y_1 - x_1 y_0) + ½ Σ_{s ⊂ ∂B ∩ A} (x_0 y_1 - x_1 y_0),
+
+    the boundary segments clipped to the other region (:func:`ght_cad.flat_pattern.clip_segments`).
+    Exact for the polygons (the outline polylines of the faces)."""
+    from .flat_pattern import clip_segments
+
+    total = 0.0
+    for p, q in ((a, b), (b, a)):
+        segs = clip_segments(_segments(_oriented(p)), list(q))
+        if len(segs):
+            total += 0.5 * float(np.sum(segs[:, 0, 0] * segs[:, 1, 1] - segs[:, 1, 0] * segs[:, 0, 1]))
+    return total
+
+
 def _overlaps(loops: list[list[Any]], panels: dict[int, Any], motion: dict[int, _Motion],
               order: list[int]) -> tuple[str, float] | None:
     """None when the blank's loops do not cross each other or themselves; else (the faces whose
-    edges cross, the overlap area estimated on a 200 x 200 grid over the blank's box)."""
+    edges cross, the overlap area). The area is the sum over the pairs of distinct faces whose
+    edges cross of their placed outlines' intersection area (:func:`_overlap_area`, exact for the
+    outline polygons); a face crossing only itself is estimated on a 200 x 200 grid over the
+    blank's box (cells covered twice)."""
     from .flat_pattern import _inside
 
     polys, owner = [], []
@@ -734,7 +814,6 @@ def _overlaps(loops: list[list[Any]], panels: dict[int, Any], motion: dict[int, 
         polys.append(np.concatenate(pts, axis=0))
         owner.append(who)
     allpts = np.concatenate(polys)
-    size = float(np.ptp(allpts, axis=0).max())
     segs = _segments(polys)
     cross = _crossings(segs, 1e-9)
     # a crossing closer than 1e-9 of the size to a segment end is a touching joint, not an overlap
@@ -742,6 +821,11 @@ def _overlaps(loops: list[list[Any]], panels: dict[int, Any], motion: dict[int, 
         return None
     names = [w for who in owner for w in who]
     faces = sorted({names[a] for a, b in cross} | {names[b] for a, b in cross}, key=lambda s: int(s[1:]))
+    placed = {n: [motion[n](lp) for lp in panels[n].loop_polylines()] for n in order}
+    pairs = sorted({tuple(sorted((int(names[a][1:]), int(names[b][1:])))) for a, b in cross})
+    distinct = [(i, j) for i, j in pairs if i != j]
+    if distinct:
+        return ", ".join(faces), float(sum(_overlap_area(placed[i], placed[j]) for i, j in distinct))
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     g = 200
     xs = lo[0] + (np.arange(g) + 0.5) / g * (hi[0] - lo[0])
@@ -750,11 +834,8 @@ def _overlaps(loops: list[list[Any]], panels: dict[int, Any], motion: dict[int, 
     pts = np.stack([X.ravel(), Y.ravel()], axis=1)
     count = np.zeros(len(pts), dtype=int)
     for n in order:
-        p = panels[n]
-        lps = [motion[n](lp) for lp in p.loop_polylines()]
-        count += _inside(pts, lps).astype(int)
+        count += _inside(pts, placed[n]).astype(int)
     cell = (hi[0] - lo[0]) * (hi[1] - lo[1]) / g ** 2
-    del size
     return ", ".join(faces), float((count > 1).sum() * cell)
 
 
@@ -838,6 +919,57 @@ DIST_TOL = 1e-6
 SHARP_DEG = 1e-3
 
 
+def _check_pairing(sname: str, nums: Sequence[int], T: float, skin_of: Sequence[bool],
+                   rays: Sequence[Sequence[tuple[float, bool, int]]], edges: dict[str, tuple[int, int]]) -> None:
+    """Refuse a solid whose faces at distance T pair up in more than one way (an ambiguous skin).
+
+    Skin faces sharing an edge lie on one side of the sheet, a face and the faces its probes reach
+    at T on opposite sides: a two-colouring of the skin faces under these relations. A cycle with an
+    odd number of "opposite" relations (e.g. a bar of square section T x T: top opposite bottom and
+    left opposite right, yet top shares an edge with left and right) has none: no inside and
+    outside skin exist.
+
+    Raises:
+        BlankError: naming the faces of the contradiction and the distance T.
+    """
+    rel: dict[int, list[tuple[int, int, str]]] = {}
+    for key, (a, b) in edges.items():
+        if skin_of[a] and skin_of[b] and a != b:
+            rel.setdefault(a, []).append((b, 0, f"shares edge {key} with"))
+            rel.setdefault(b, []).append((a, 0, f"shares edge {key} with"))
+    for i, row in enumerate(rays):
+        for d, ok, h in row:
+            if skin_of[i] and h >= 0 and h != i and skin_of[h] and ok and abs(d - T) <= DIST_TOL * T:
+                rel.setdefault(i, []).append((h, 1, f"lies at {d:.9g} opposite"))
+                rel.setdefault(h, []).append((i, 1, f"lies at {d:.9g} opposite"))
+    side: dict[int, int] = {}
+    via: dict[int, tuple[int, str]] = {}
+    for start in (i for i in range(len(nums)) if skin_of[i]):
+        if start in side:
+            continue
+        side[start] = 0
+        queue = deque([start])
+        while queue:
+            x = queue.popleft()
+            for y, flip, how in rel.get(x, []):
+                want = side[x] ^ flip
+                if y not in side:
+                    side[y], via[y] = want, (x, how)
+                    queue.append(y)
+                elif side[y] != want:
+                    def chain(z: int) -> list[str]:
+                        out = []
+                        while z in via:
+                            p, h = via[z]
+                            out.append(f"F{nums[z]} {h} F{nums[p]}")
+                            z = p
+                        return out
+                    steps = "; ".join(chain(x)[::-1] + [f"F{nums[y]} {how} F{nums[x]}"] + chain(y))
+                    raise BlankError(f"{sname}: ambiguous skin: the faces at distance {T:.9g} from an opposite face pair "
+                                     f"up in more than one way ({steps}): no inside and outside skin separate them; "
+                                     "allowed: a sheet whose faces at distance T form exactly two sides")
+
+
 def classify_skin(sname: str, nums: Sequence[int], areas: Sequence[float],
                   rays: Sequence[Sequence[tuple[float, bool, int]]], edges: dict[str, tuple[int, int]],
                   angle: Callable[[str, int, int], float], base_face: int | None = None,
@@ -891,6 +1023,7 @@ def classify_skin(sname: str, nums: Sequence[int], areas: Sequence[float],
     if T > 0.25 * math.sqrt(big):
         raise BlankError(f"{sname}: no sheet: its thickness {T:.9g} is more than a quarter of the square root of its "
                          f"largest skin face's area {big:.9g} (a block); allowed: sheets thinner than that")
+    _check_pairing(sname, nums, T, skin_of, rays, edges)
     shared: dict[str, tuple[int, int]] = {}
     for key, (a, b) in edges.items():
         if not (skin_of[a] and skin_of[b]):

@@ -205,3 +205,71 @@ def cone_bend(T: float = 2.0, W: float = 40.0, L1: float = 30.0, L2: float = 20.
         return (L1 + L2) * s + math.pi / 4 * (r1 + r2 + 2 * k * T * math.cos(al)) * s
 
     return solid, area
+
+
+def _bend_solid(centre, r_in: float, T: float, a0: float, a1: float, plane: str, length: float):
+    """A circular bend: the annulus sector ``r_in .. r_in + T`` about ``centre`` from angle ``a0`` to
+    ``a1`` in the xz plane (``plane="xz"``, extruded along +y) or the yz plane (``"yz"``, along +x)."""
+    import build123d as bd
+
+    def P(r: float, a: float):
+        p, q = centre[0] + r * math.cos(a), centre[1] + r * math.sin(a)
+        return bd.Vector(p, 0.0, q) if plane == "xz" else bd.Vector(0.0, p, q)
+
+    am = 0.5 * (a0 + a1)
+    ro = r_in + T
+    e = [bd.Edge.make_three_point_arc(P(r_in, a0), P(r_in, am), P(r_in, a1)), bd.Edge.make_line(P(r_in, a1), P(ro, a1)),
+         bd.Edge.make_three_point_arc(P(ro, a1), P(ro, am), P(ro, a0)), bd.Edge.make_line(P(ro, a0), P(r_in, a0))]
+    return bd.Solid.extrude(bd.Face(bd.Wire(e)), bd.Vector(0, length, 0) if plane == "xz" else bd.Vector(length, 0, 0))
+
+
+def crossed_flanges(A: float = 60.0, B: float = 50.0, T: float = 2.0, R: float = 3.0, F: float = 20.0, e: float = 15.0):
+    """A base plate ``[0, A] x [0, B] x [0, T]`` with two flanges on adjacent edges: at x = A bent
+    **up** 90 deg (inside radius R), at y = B bent **down** 90 deg (inside radius R); each flange's
+    flat part (height F) runs ``e`` past the shared corner (the first to y = B + e, the second to
+    x = A + e) while its bend covers only the plate's edge. In 3-D the flanges lie above z = T + R
+    and below z = -R: the part does not intersect itself. In the flat both flanges start at the
+    neutral bend allowance ``BA = (R + K T) π/2`` from the plate's edges, so for ``BA < e < BA + F``
+    they overlap in the square ``[A + BA, A + e] x [B + BA, B + e]``. Returns the solid,
+    ``overlap(K) = (e - BA)²`` and ``area(K) = A B + BA (A + B) + F (B + e) + F (A + e)``, the sum of
+    the faces' own flat areas (plate, two bends, two flanges)."""
+    import build123d as bd
+
+    plate = bd.Solid.make_box(A, B, T)
+    # up at x = A: centre (A, T + R) in xz, inside (top skin) from -90 deg to 0; flange x in [A+R, A+R+T]
+    bend1 = _bend_solid((A, T + R), R, T, -math.pi / 2, 0.0, "xz", B)
+    flange1 = bd.Solid.make_box(T, B + e, F).translate((A + R, 0, T + R))
+    # down at y = B: centre (B, -R) in yz, inside (bottom skin) from 90 deg to 0; flange y in [B+R, B+R+T]
+    bend2 = _bend_solid((B, -R), R, T, 0.0, math.pi / 2, "yz", A)
+    flange2 = bd.Solid.make_box(A + e, T, F).translate((0, B + R, -R - F))
+    solid = plate + bend1 + flange1 + bend2 + flange2
+
+    def ba(k: float) -> float:
+        return (R + k * T) * math.pi / 2
+
+    def overlap(k: float) -> float:
+        return max(0.0, min(e, ba(k) + F) - ba(k)) ** 2
+
+    def area(k: float) -> float:  # the faces' own flat areas (plate, two bends, two flanges)
+        return A * B + ba(k) * (A + B) + F * (B + e) + F * (A + e)
+
+    return solid, overlap, area
+
+
+def spherical_shell(R: float = 50.0, T: float = 2.0, a: float = 15.0):
+    """A doubly curved sheet: the shell between the spheres of radii R and R + T about the origin,
+    cut to ``|y|, |z| < a`` around +x. Its skins lie exactly T apart (along the radii), but they are
+    not developable: Gaussian curvature ``1/R²`` (inside) and ``1/(R + T)²`` (outside)."""
+    import build123d as bd
+
+    shell = bd.Solid.make_sphere(R + T) - bd.Solid.make_sphere(R)
+    box = bd.Solid.make_box(2 * (R + T), 2 * a, 2 * a).translate((0, -a, -a))
+    return shell & box
+
+
+def square_bar(T: float = 2.0, L: float = 100.0):
+    """A bar of cross-section T x T and length L: each long face lies T from the opposite one, so
+    both pairings (top/bottom and front/back) are sheets of thickness T: the skin is ambiguous."""
+    import build123d as bd
+
+    return bd.Solid.make_box(L, T, T)

@@ -203,6 +203,54 @@ def sheet_part_label(design: Design, i: int) -> str:
     return f"{design.name} part {i + 1}"
 
 
+def inside_radius(surface: Any, side: str, thickness: float, *, samples: int = 513) -> float:
+    r"""The smallest inside bending radius of a sheet on the surface (spec 6.1).
+
+    Over :func:`sheet_parts`, at ``samples`` rulings and both ruling ends (the grid of
+    :func:`ght_cad.sheet.check_offset`): the design surface has the signed bending radius
+    ``ρ_0 = (X_u·e)/ω`` (:func:`ght_cad.sheet.bending_radius`), the other skin ``ρ_0 + σ T``
+    (``σ = +1`` for ``side="normal"``, -1 for ``"reverse"``), and the inside radius of the bend is
+    the smaller one, ``R = min(|ρ_0|, |ρ_0 + σ T|)``; apex ends (a stationary boundary, the point of
+    a cone or fan) are skipped as in ``check_offset``. ``inf`` for a flat surface.
+    """
+    from ..ruled import SINGULAR_NORMAL_TOL
+    from ..sheet import bending_radius
+
+    sigma = 1.0 if side == "normal" else -1.0
+    u = np.linspace(0.0, 1.0, samples)
+    uu, vv = np.concatenate([u, u]), np.concatenate([np.zeros_like(u), np.ones_like(u)])
+    best = math.inf
+    for part in sheet_parts(surface):
+        rho = bending_radius(part, uu, vv)
+        g = np.linalg.norm(part.ruling(u), axis=1)
+        tang = np.concatenate([np.linalg.norm(part.a(u, 1), axis=1), np.linalg.norm(part.b(u, 1), axis=1)])
+        rho = np.where(tang <= SINGULAR_NORMAL_TOL * np.concatenate([g, g]), np.inf, rho)
+        fin = np.isfinite(rho)
+        if fin.any():
+            r = np.minimum(np.abs(rho[fin]), np.abs(rho[fin] + sigma * thickness))
+            best = min(best, float(r.min()))
+    return best
+
+
+def table_k_factor(sheet: Any, surface: Any) -> Any:
+    r"""The ``[sheet]`` with its ``k_factor_table`` read at the surface's ``R / T``.
+
+    ``K = table(R / T)``, ``R`` the smallest inside bending radius (:func:`inside_radius`: the
+    tightest bend, where K matters most; ``R = inf`` on a flat surface, the table's last row);
+    the sheet unchanged when it has no table or ``T = 0``.
+
+    Args:
+        sheet: a :class:`ght_cad.design.schema.SheetSpec`; surface: the built surface.
+
+    Returns:
+        The SheetSpec with ``k_factor = table(R/T)`` and ``k_factor_ratio = R/T``.
+    """
+    if sheet is None or sheet.k_factor_table is None or sheet.thickness <= 0:
+        return sheet
+    R = inside_radius(surface, sheet.side, sheet.thickness)
+    return replace(sheet, k_factor=float(sheet.k_factor_table(R, sheet.thickness)), k_factor_ratio=R / sheet.thickness)
+
+
 def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int = 513) -> float:
     r"""The sheet check the run applies to a built surface (spec 6.1), on every part.
 
@@ -348,6 +396,8 @@ def build_surface(design: Design, shape: dict[str, float] | None = None,
                 raise
             raise type(exc)(msg + what) from None
         raise type(exc)(f"{design.source}: key '{spec.key}'{what}: {msg}") from None
+    if design.sheet is not None and design.sheet.k_factor_table is not None:
+        design = replace(design, sheet=table_k_factor(design.sheet, surf))  # K by this surface's R/T
     return BuiltSurface(design, surf, curves, sh)
 
 

@@ -53,6 +53,15 @@ def _curve_max_curvature(c: Any) -> float | None:
     return float(fin.max()) if fin.size else None
 
 
+def _table_entry(sheet: Any) -> dict[str, Any]:
+    """``[sheet] k_factor_table``: the table's name, its rows and the ``R/T`` K was read at."""
+    tab = sheet.k_factor_table
+    if tab is None:
+        return {}
+    return {"k_factor_table": {"name": tab.name, "ratios": list(tab.ratios), "k_factors": list(tab.k_factors),
+                               "source": tab.source}, "k_factor_ratio": sheet.k_factor_ratio}
+
+
 def _curves_report(curves: dict[str, Any]) -> list[dict[str, Any]]:
     """Per curve: degree, dimension, shape parameters, control points, arc length, max curvature."""
     return [
@@ -224,7 +233,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             if design.optimize is None and built is not None:
                 # [sheet]: the plate's check (the one the B-rep and the flat pattern apply) before anything
                 # else is computed; with [optimize] every candidate is checked and so is the result
-                check_sheet(design, built.surface)
+                check_sheet(built.design, built.surface)  # its K read from k_factor_table at its R/T, if any
             # 3. optimization
             if design.optimize is not None:
                 step("optimize")
@@ -236,6 +245,9 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                     report["curves"] = _curves_report(curves)
                     report["joins"] = joins
                 built = build_surface(design, opt.shape, curves=curves)
+                if design.sheet is not None and design.sheet.k_factor_table is not None:
+                    # candidates were checked with the table's largest K; the result with its own (R/T)
+                    check_sheet(built.design, built.surface)
                 report["optimization"] = opt.summary()
             # 4. measures
             step("measure")
@@ -274,7 +286,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                     report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
                                        # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)
                                        "volume_closed_form": None if None in closed else float(sum(closed)),
-                                       **design.sheet.to_sheet().as_dict()}
+                                       **built.design.sheet.to_sheet().as_dict(), **_table_entry(built.design.sheet)}
                 if "step" in want_files:
                     if plates:
                         from ..cad.sheet_solid import write_plate_step

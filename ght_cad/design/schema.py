@@ -210,6 +210,12 @@ class SheetSpec:
     #: orientation: the first surface's normal carried consistently across the shared rails) or
     #: ``"surface"`` (each surface's own normal); one surface: its own normal either way
     side_reference: str = "shell"
+    #: ``k_factor_table``: a :class:`ght_cad.blank.KFactorTable` giving K by the surface's ``R / T``
+    #: (R its smallest inside bending radius, :func:`ght_cad.design.build.table_k_factor`); until a
+    #: built surface resolves it, ``k_factor`` is the table's largest K (the strictest neutral offset)
+    k_factor_table: Any = None
+    #: ``R / T`` the table was read at (set with ``k_factor`` when a built surface resolves it)
+    k_factor_ratio: float | None = None
 
     def to_sheet(self) -> Any:
         """The :class:`ght_cad.sheet.Sheet`."""
@@ -250,6 +256,13 @@ class Design:
             sd.pop("key", None)
             if sd.get("sheet", 0) is None:  # no per-surface sheet overrides: as before
                 sd.pop("sheet")
+        if d["sheet"] is not None:
+            tab = self.sheet.k_factor_table if self.sheet is not None else None
+            for k in ("k_factor_table", "k_factor_ratio"):
+                d["sheet"].pop(k)
+            if tab is not None:  # as the file gives it: a table's name, or its [R/T, K] rows
+                d["sheet"]["k_factor_table"] = (tab.name if tab.name in ("ansi", "din") else
+                                                [[r, k] for r, k in zip(tab.ratios, tab.k_factors)])
         if d["sheet"] is not None and len(self.surfaces) <= 1:
             d["sheet"].pop("side_reference")  # one surface: its own normal (as before)
         if len(self.surfaces) <= 1 and all(s.name is None for s in self.surfaces):
@@ -556,18 +569,24 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     sheet = None
     st = ck.table(data, "sheet", "sheet")
     if st is not None:
-        ck.keys(st, "sheet", ("thickness", "k_factor", "din_k_factor", "side", "side_reference"))
+        ck.keys(st, "sheet", ("thickness", "k_factor", "din_k_factor", "k_factor_table", "side", "side_reference"))
         if not surfaces:
             raise ck.fail("sheet", "needs a [surface] table or [[surfaces]] (the sheet is the surfaces' plate)")
         T = ck.number(st, "thickness", "sheet", required=True, lo=0.0, allowed="a length >= 0")
-        if "k_factor" in st and "din_k_factor" in st:
-            raise ck.fail("sheet.din_k_factor", "given together with sheet.k_factor; allowed: one of them (DIN k = 2K)")
+        given = [k for k in ("k_factor", "din_k_factor", "k_factor_table") if k in st]
+        if len(given) > 1:
+            raise ck.fail(f"sheet.{given[1]}", f"given together with sheet.{given[0]}; allowed: one of k_factor, "
+                          "din_k_factor (DIN k = 2K), k_factor_table (K by R/T)")
+        table = None
         if "din_k_factor" in st:
             K = ck.number(st, "din_k_factor", "sheet", lo=0.0, hi=2.0, required=True) / 2.0
+        elif "k_factor_table" in st:
+            table = _k_factor_table(ck, st["k_factor_table"], source)
+            K = max(table.k_factors)  # until a built surface gives its R/T (the strictest neutral offset)
         else:
             K = ck.number(st, "k_factor", "sheet", 0.5, lo=0.0, hi=1.0)
         sheet = SheetSpec(T, K, ck.string(st, "side", "sheet", "normal", choices=("normal", "reverse")),
-                          ck.string(st, "side_reference", "sheet", "shell", choices=SIDE_REFERENCES))
+                          ck.string(st, "side_reference", "sheet", "shell", choices=SIDE_REFERENCES), k_factor_table=table)
     else:
         for spec in surfaces:
             if spec.sheet is not None:
@@ -651,6 +670,35 @@ def _parse_surfaces(ck: _Checker, data: dict, curves: list[CurveSpec]) -> list[S
             spec.sheet = _parse_sheet_override(ck, over, f"{path}.sheet")
         out.append(spec)
     return out
+
+
+#: what ``[sheet] k_factor_table`` allows (the messages)
+K_TABLE_ALLOWED = ("'ansi', 'din', a file of 'R/T K' lines (relative to the design file; a first line 'din' for "
+                   "DIN k = 2K) or an inline array of [R/T, K] rows (R/T from 0 ascending, K in [0, 1])")
+
+
+def _k_factor_table(ck: _Checker, value: Any, source: str) -> Any:
+    """``[sheet] k_factor_table`` (:func:`ght_cad.blank.k_factor_table` semantics: a built-in table by
+    name, a file of ``R/T K`` lines, or inline ``[[R/T, K], ...]`` rows of ANSI K)."""
+    from ..blank import K_TABLES, BlankError, k_factor_rows, k_factor_table
+
+    key = "sheet.k_factor_table"
+    try:
+        if isinstance(value, str):
+            if value.strip().lower() in K_TABLES:
+                return K_TABLES[value.strip().lower()]
+            path = Path(value).expanduser()
+            if not path.is_absolute() and not source.startswith("<"):
+                path = Path(source).parent / path
+            if not path.is_file():
+                raise ck.fail(key, f"{value!r} is neither a built-in table nor a file ({path} not found); allowed: "
+                              + K_TABLE_ALLOWED)
+            return k_factor_table(path)
+        if isinstance(value, list):
+            return k_factor_rows(value, name="inline", where="inline table", source=f"{source} [sheet] k_factor_table")
+    except BlankError as exc:
+        raise ck.fail(key, f"{' '.join(str(exc).split())}; allowed: {K_TABLE_ALLOWED}") from None
+    raise ck.fail(key, f"expected a string or an array, got {_tname(value)} {_short(value)}; allowed: {K_TABLE_ALLOWED}")
 
 
 #: keys of a ``[surfaces.sheet]`` table (overrides of the design's ``[sheet]`` for one surface)

@@ -37,7 +37,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import GHTError
-from .build import BuiltSurface, sheet_parts
+from .build import BuiltSurface, sheet_parts, table_k_factor
 from .schema import Design, DesignError, SheetSpec
 
 #: points along each boundary tested against the other surfaces' boundaries
@@ -83,7 +83,8 @@ class SurfaceSheet:
                 "side": self.requested.side, "side_reference": self.requested.side_reference,
                 "orientation": int(self.orientation), "side_on_own_normal": self.sheet.side,
                 "centre": self.centre, "normal_at_centre": self.normal, "material_direction": self.material,
-                "material_goes": _direction_words(np.asarray(self.material))}
+                "material_goes": _direction_words(np.asarray(self.material)),
+                **({"k_factor_ratio": self.sheet.k_factor_ratio} if self.sheet.k_factor_ratio is not None else {})}
 
 
 def _direction_words(m: np.ndarray) -> str:
@@ -259,6 +260,11 @@ def surface_sheets(design: Design, builts: Sequence[BuiltSurface]) -> tuple[list
         if req.side_reference == "shell":
             s *= o
         eff = replace(req, side="normal" if s > 0 else "reverse", side_reference="surface")
+        if "k_factor" in (spec.sheet or {}):  # the surface's own K wins over the design's table
+            req, eff = replace(req, k_factor_table=None), replace(eff, k_factor_table=None)
+        elif req.k_factor_table is not None:  # K by this surface's R/T, with its own thickness and side
+            eff = table_k_factor(eff, b.surface)
+            req = replace(req, k_factor=eff.k_factor, k_factor_ratio=eff.k_factor_ratio)
         parts = sheet_parts(b.surface)
         part = parts[len(parts) // 2]
         centre = np.asarray(part.evaluate(np.array([0.5]), np.array([0.5])), dtype=float).reshape(3)
