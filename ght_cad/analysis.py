@@ -29,6 +29,7 @@ import numpy as np
 from .composite import CompositeCurve
 from .curve import GHTCurve, curvature_from_derivatives
 from .errors import GHTError
+from ._quadrature import leggauss
 from ._validate import is_real
 from .io import atomic_path
 
@@ -187,7 +188,7 @@ def curvature_profile(curve: CurveLike, samples_per_segment: int = 200) -> dict[
     curve = _check_curve(curve)
     n = _check_samples(samples_per_segment)
     s = _sample_parameters(curve, n)
-    x, w = np.polynomial.legendre.leggauss(8)
+    x, w = leggauss(8)
     lo, hi = s[:-1], s[1:]
     h = 0.5 * (hi - lo)
     nodes = (lo[:, None] + h[:, None] * (x[None, :] + 1.0)).ravel()

@@ -47,6 +47,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ._quadrature import leggauss
 from .errors import GHTError
 from .ruled import RuledSurface
 from ._vec import cross as _cross
@@ -377,8 +378,8 @@ class BSplineRuled(RuledSurface):
         r"""3-D area ``∫∫ |(A' + w G') × G| dw du`` (``G = B - A``): Gauss–Legendre, 12 nodes per
         knot span in u and 8 in w (the integrand is smooth inside a span)."""
         k = np.unique(np.asarray(self.data.knots_u, dtype=float))
-        xu, wu = np.polynomial.legendre.leggauss(12)
-        xw, ww = np.polynomial.legendre.leggauss(8)
+        xu, wu = leggauss(12)
+        xw, ww = leggauss(8)
         lo, hi = k[:-1], k[1:]
         u = (0.5 * (hi - lo)[:, None] * (xu[None, :] + 1) + lo[:, None]).ravel()
         wt = (0.5 * (hi - lo)[:, None] * wu[None, :]).ravel()

@@ -11,12 +11,12 @@ Leibniz' rule, ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``.
 
 from __future__ import annotations
 
-from functools import lru_cache
 from math import comb, factorial
 from typing import Any, Sequence
 
 import numpy as np
 
+from ._cache import readonly_cache
 from ._validate import as_parameter_array, check_degree, check_unit_interval
 from .errors import GHTError
 from .seeds import MAX_DERIVATIVE, Seed, ght_seed_parameter_derivatives, make_seed
@@ -128,12 +128,10 @@ def bernstein_log(t: np.ndarray, n: int) -> np.ndarray:
     return np.exp(logc + a + b)
 
 
-@lru_cache(maxsize=64)
+@readonly_cache(maxsize=64)
 def _binomials(q: int) -> np.ndarray:
     """``[C(q, 0), ..., C(q, q)]`` as a read-only float array."""
-    b = np.array([comb(q, j) for j in range(q + 1)], dtype=float)
-    b.setflags(write=False)
-    return b
+    return np.array([comb(q, j) for j in range(q + 1)], dtype=float)
 
 
 def basis_from_jets(bern: Sequence[np.ndarray], jets: Sequence[Sequence[np.ndarray]], derivative: int) -> np.ndarray:

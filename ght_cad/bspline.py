@@ -10,11 +10,12 @@ end knots, length ``len(poles) + degree + 1``), non-rational unless ``weights`` 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
+from ._cache import readonly_cache
+from ._quadrature import leggauss
 from .errors import ConversionError, GHTError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -261,14 +262,12 @@ def _banded_least_squares(
     return P
 
 
-@lru_cache(maxsize=32)
+@readonly_cache(maxsize=32)
 def _fit_nodes(degree: int) -> tuple[np.ndarray, np.ndarray]:
     """Per-span nodes on [0, 1] for a degree-p fit: ``p + 2`` Gauss–Legendre nodes (least squares)
     and ``max(16, 4(p+1))`` Chebyshev–Lobatto check points (read-only, cached per degree)."""
-    xg = 0.5 * (np.polynomial.legendre.leggauss(degree + 2)[0] + 1.0)
+    xg = 0.5 * (leggauss(degree + 2)[0] + 1.0)
     cheb = _chebyshev_lobatto(max(16, 4 * (degree + 1)))
-    xg.flags.writeable = False
-    cheb.flags.writeable = False
     return xg, cheb
 
 

@@ -7,7 +7,6 @@ the classical Bézier curve of degree ``n = m-2`` on ``P_k .. P_{k+n}``.
 
 from __future__ import annotations
 
-import functools
 from functools import cached_property
 from math import comb
 from typing import Any, Iterable
@@ -16,29 +15,14 @@ import numpy as np
 
 from ._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
 from .basis import MAX_DIRECT_DEGREE, _check_order, bernstein, bernstein_log, seed_basis
+from ._quadrature import gauss_legendre  # noqa: F401  (public here: ght_cad.curve.gauss_legendre)
+from ._quadrature import leggauss as _leggauss
 from .errors import DegenerateGeometryError, GHTError
 from .seeds import Seed, make_seed
 
 __all__ = ["GHTCurve", "gauss_legendre", "integrate"]
 
 _CHUNK = 1 << 15
-
-
-@functools.lru_cache(maxsize=64)
-def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``numpy.polynomial.legendre.leggauss(n)`` computed once per n (an eigenvalue problem of
-    size n; read-only arrays)."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    x.flags.writeable = False
-    w.flags.writeable = False
-    return x, w
-
-
-def gauss_legendre(n: int, a: float = 0.0, b: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on [a, b] (exact for polynomials of degree 2n-1)."""
-    x, w = _leggauss(int(n))
-    h = 0.5 * (b - a)
-    return a + h * (x + 1.0), h * w
 
 
 def integrate(
@@ -55,7 +39,7 @@ def integrate(
     ``f`` takes a 1-D array and returns a 1-D array. Panels double until two successive results
     agree to ``rtol`` (relative) or ``max_panels`` is reached.
     """
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = _leggauss(nodes)
     prev = None
     panels = 4
     while True:

@@ -15,11 +15,11 @@ Only numpy (>= 1.24) is used; no CAD kernel is imported.
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import numpy as np
 
+from ._cache import readonly_cache
 from .errors import GHTError
 from ._vec import einsum as _einsum
 from ._vec import stack as _stack
@@ -384,12 +384,10 @@ def _cheb_basis_of(U: np.ndarray, p: int) -> np.ndarray:
     return _cheb_basis_cached(np.asarray(U, dtype=float).tobytes(), int(p))
 
 
-@functools.lru_cache(maxsize=64)
+@readonly_cache(maxsize=64)
 def _cheb_basis_cached(key: bytes, p: int) -> np.ndarray:
     U = np.frombuffer(key, dtype=float)
-    M = _cheb_basis(U, p, _spans(U, p))
-    M.flags.writeable = False
-    return M
+    return _cheb_basis(U, p, _spans(U, p))
 
 
 def _cheb_basis(U: np.ndarray, p: int, spans: np.ndarray) -> np.ndarray:

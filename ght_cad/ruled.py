@@ -11,7 +11,6 @@ analytic derivatives; measures, sampling and conversion are shared.
 
 from __future__ import annotations
 
-import functools
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -19,6 +18,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ._cache import readonly_cache
 from ._validate import as_parameter_array
 from ._vec import cross as _cross
 from ._vec import dot as _dot
@@ -77,14 +77,12 @@ def _unit(v: np.ndarray) -> np.ndarray:
 SINGULAR_NORMAL_TOL = 1e-10
 
 
-@functools.lru_cache(maxsize=8)
+@readonly_cache(maxsize=8)
 def _theta_parameters(nodes: int, samples: int) -> np.ndarray:
     """The developability's parameters: the ``nodes`` Gauss–Legendre nodes on [0, 1], then
     ``samples`` uniform ones (ends included); made once per pair (read-only)."""
     t, _ = gauss_legendre(nodes)
-    uu = np.concatenate([t, np.linspace(0.0, 1.0, samples)])
-    uu.flags.writeable = False
-    return uu
+    return np.concatenate([t, np.linspace(0.0, 1.0, samples)])
 
 
 def _theta(a1: np.ndarray, b1: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

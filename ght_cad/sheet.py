@@ -41,6 +41,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ._quadrature import leggauss
 from .errors import GHTError
 from .ruled import SINGULAR_NORMAL_TOL, RuledSurface
 
@@ -657,7 +658,7 @@ def forming_rows(
         ``(rows, chart)``, chart = ``{"position", "radius_a", "radius_b"}`` on 257 rulings.
     """
     delta = sheet.neutral_offset
-    gx, gw = np.polynomial.legendre.leggauss(24)
+    gx, gw = leggauss(24)
     # the surface's breakpoints (a loft's joint rulings): the integrands (mid-line speed, turning
     # rate) jump there, so every rule is split at them (one rule across a joint was off by 5e-5 in
     # position and 0.06° in angle on the hull plate with fans); without breakpoints the same rules

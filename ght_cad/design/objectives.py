@@ -8,19 +8,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
 from ..errors import GHTError
 from .schema import PLANE_OBJECTIVES
 
 
-@functools.lru_cache(maxsize=8)
-def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Cached Gauss–Legendre nodes/weights on [0, 1] (numpy's leggauss costs an eigensolve)."""
-    from ..curve import gauss_legendre
-
-    t, w = gauss_legendre(n)
-    t.setflags(write=False)
-    w.setflags(write=False)
-    return t, w
 
 
 def dual_curve_objectives(curve: Any, nodes: int = 64) -> dict[str, float]:

@@ -5,22 +5,21 @@ Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable fro
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import Any, Callable
 
 import numpy as np
 
+from .._cache import readonly_cache
+from .._quadrature import leggauss
 from .._vec import cross as _cross, norm as _norm, stack as _stack
 from .adapter import SurfaceAdapter, U_FREE_DENSITY_KINDS
 
-@functools.lru_cache(maxsize=1)
+
 def _gauss12() -> tuple[np.ndarray, np.ndarray]:
-    """12-point Gauss–Legendre nodes and weights on [-1, 1] (computed once; read-only arrays)."""
-    xg, wg = np.polynomial.legendre.leggauss(12)
-    xg.flags.writeable = False
-    wg.flags.writeable = False
-    return xg, wg
+    """12-point Gauss–Legendre nodes and weights on [-1, 1] (:func:`ght_cad._quadrature.leggauss`:
+    computed once; read-only arrays)."""
+    return leggauss(12)
 
 
 def face_area(
@@ -103,13 +102,10 @@ def face_area(
     return totals[0] - sum(totals[1:]) if totals else 0.0
 
 
-@functools.lru_cache(maxsize=1)
+@readonly_cache(maxsize=1)
 def _edge_nodes_plain() -> tuple[np.ndarray, np.ndarray]:
     """:func:`_edge_nodes` without breaks (computed once; read-only arrays)."""
-    out = _edge_nodes_at(np.linspace(0.0, 1.0, 17))
-    for a in out:
-        a.flags.writeable = False
-    return out
+    return _edge_nodes_at(np.linspace(0.0, 1.0, 17))
 
 
 def _edge_nodes_at(te: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -6,16 +6,17 @@ distortion measures are defined in the docstring of :mod:`ght_cad.flat_pattern` 
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from .._cache import readonly_cache
 from ..errors import GHTError
 from .._vec import einsum as _einsum
 from .._vec import stack as _stack
+
 
 #: DXF $INSUNITS codes
 INSUNITS = {"unitless": 0, "in": 1, "ft": 2, "mm": 4, "cm": 5, "m": 6}
@@ -44,12 +45,10 @@ def _chords(p: np.ndarray) -> float:
     return float(np.sum(np.sqrt(_einsum("ij,ij->i", d, d))))
 
 
-@functools.lru_cache(maxsize=8)
+@readonly_cache(maxsize=8)
 def _unit_samples(n: int) -> np.ndarray:
     """``linspace(0, 1, n)``, made once per n (read-only)."""
-    t = np.linspace(0.0, 1.0, n)
-    t.flags.writeable = False
-    return t
+    return np.linspace(0.0, 1.0, n)
 
 
 def romberg_length(points: np.ndarray) -> float:
