@@ -173,6 +173,13 @@ def unroll_face_data(
 ) -> FlatPattern:
     """Unroll one face given by an adapter (see module doc for the maps used).
 
+    Steps: :func:`_check_face_extent`; :func:`_development_map` (closed form, or quadrature along
+    the straight isolines after the developability check); :func:`_boundary_loops` (outer loop
+    first); the rulings' ends and 3-D lengths (:func:`_ruling_ends`, :func:`_ruling_lengths_3d`)
+    and the bend lines clipped in (u, v) (:func:`_bend_rulings_uv`); one batched evaluation of the
+    map (:class:`_MapBatch`) for the outline samples, the rulings and the metric stencil; the
+    panel measured (:func:`ght_cad.flat_pattern.measure_panel`) and placed at the origin.
+
     Args:
         face: the face's surface, bounds and wires.
         best_effort: flatten a face that is not ruled / not developable within ``tol_deg``; a
@@ -204,7 +211,77 @@ def unroll_face_data(
             sphere); an unbounded face (infinite bounds, OCCT's 2e100) or one without wires; a
             hole outside the outer wire in (u, v).
     """
-    ev, bounds, kind = face.surface, face.bounds, face.surface.kind
+    _check_face_extent(face, label)
+    ev, bounds = face.surface, face.bounds
+    info: dict[str, Any] = {"best_effort": bool(best_effort)}
+    fsheet = None
+    if sheet is not None and not sheet.is_zero:  # the neutral surface replaces the face's own
+        from .sheet import FaceSheet
+
+        fsheet = FaceSheet(face, sheet, label)
+        ev = fsheet.neutral
+    dmap, ruled_dir, rs, mgrid, metric_jet = _development_map(face, ev, best_effort, tol_deg, label, info)
+    loops, loops_uv, k_out = _boundary_loops(face, dmap, fsheet, samples, label, info)
+    # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
+    bends = np.zeros((0, 2, 2))
+    g3 = gf = np.zeros(0)
+    if ruled_dir is not None:
+        tt = _unit_samples(129)
+        # the ruling ends' 3-D lengths from the prefetched boundary jets; one evaluation of the map
+        # for the ruling ends and the bend lines
+        ua, va, ub, vb = _ruling_ends(bounds, ruled_dir, tt)
+        n = tt.size
+        g3 = _ruling_lengths_3d(ev, rs, tt, (ua, va, ub, vb))
+    if mgrid is None:
+        mgrid = _metric_grid(bounds)
+    # the map's points in one call (it is pointwise; its per-call overhead dominated): the
+    # edges' outline samples, the ruling ends and bend lines, the metric's stencil
+    mU, mV, mhu, mhv = mgrid
+    sampled, ts, edge_uv = _edge_sample_uv(loops, loops_uv, samples)
+    clipped = None
+    if ruled_dir is not None:
+        ca, cva, cb, cvb, clipped = _bend_rulings_uv(bounds, ruled_dir, rulings, loops, sampled, ts, edge_uv)
+        ruling_uv = (np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
+    fmap = _MapBatch(dmap.map, [metric_stencil(mU, mV, mhu, mhv)] + ([ruling_uv] if ruled_dir is not None else [])
+                     + [edge_uv])
+    if sampled:
+        _seed_edge_samples(sampled, ts, fmap(*edge_uv))
+    if ruled_dir is not None:
+        pf = fmap(*ruling_uv)
+        gf = _norm(pf[:n] - pf[n:2 * n])
+        if rulings:
+            k = ca.size
+            bends = _stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
+    area_3d = face_area(ev, loops_uv, bounds[0], ev.breaks("u"), bounds[1] - bounds[0])
+    panel = FlatPanel(
+        label=label,
+        loops=loops,
+        bend_lines=bends if clipped is None else np.zeros((0, 2, 2)),  # measure_panel clips in the plane
+        ruling_lengths_3d=g3,
+        ruling_lengths_flat=gf,
+        area_3d=area_3d,
+        metric=_metric(ev, fmap, bounds, mgrid, None if metric_jet is None else metric_jet[1:3]),
+        info=info,
+        development=dmap,
+    )
+    measure_panel(panel)
+    if clipped is not None:
+        panel.bend_lines = bends  # clipped in (u, v) already
+    if fsheet is not None:
+        wires = [w for w in face.wires if w]  # the loops' order: outer (k_out) first
+        fsheet.finish(panel, dmap, rulings, [wires[k_out]] + wires[:k_out] + wires[k_out + 1:])
+    # place: bounding box at the origin
+    lo, _ = panel.bbox()
+    panel.translate(-lo)
+    return FlatPattern([panel], units=units)
+
+
+# -- the steps of unroll_face_data ------------------------------------------------------------------
+
+def _check_face_extent(face: FaceData, label: str) -> None:
+    """Refuse an unbounded or empty face (infinite bounds, OCCT's 2e100, u0 >= u1 or v0 >= v1) and
+    a face without boundary wires (:class:`DegenerateGeometryError` naming the face)."""
+    bounds = face.bounds
     if not all(math.isfinite(b) and abs(b) < 1e50 for b in bounds) or bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
         raise DegenerateGeometryError(
             f"face {label!r} is unbounded or empty: parameter bounds (u0, u1, v0, v1) = "
@@ -213,13 +290,25 @@ def unroll_face_data(
         )
     if not any(face.wires):
         raise DegenerateGeometryError(f"face {label!r} has no boundary wires; allowed: a face trimmed by boundary wires")
-    info: dict[str, Any] = {"best_effort": bool(best_effort)}
-    fsheet = None
-    if sheet is not None and not sheet.is_zero:  # the neutral surface replaces the face's own
-        from .sheet import FaceSheet
 
-        fsheet = FaceSheet(face, sheet, label)
-        ev = fsheet.neutral
+
+def _development_map(face: FaceData, ev: SurfaceAdapter, best_effort: bool, tol_deg: float, label: str,
+                     info: dict[str, Any]) -> tuple[Any, str | None, FaceRuledSurface | None,
+                                                    tuple[np.ndarray, np.ndarray, float, float] | None,
+                                                    list[np.ndarray] | None]:
+    r"""The development map ``F(u, v)`` of the face (module doc): a plane, cylinder or cone in closed
+    form (:class:`ClosedFormMap`), any other face by quadrature along its straight isolines
+    (:class:`_RuledFaceMap`) after :func:`ruling_direction` and the developability check
+    (``θ_max <= tol_deg``, spec section 5); ``info`` gets the method, the direction and the checks.
+
+    Returns:
+        ``(map, ruling direction ("u", "v" or None for a plane), the ruled surface or None,
+        the metric grid or None, the prefetched jets at the metric grid or None)``.
+
+    Raises:
+        NotDevelopableError, DegenerateGeometryError: as :func:`unroll_face_data`.
+    """
+    kind, bounds = face.surface.kind, face.bounds
     ruled_dir: str | None
     rs: FaceRuledSurface | None = None
     mgrid: tuple[np.ndarray, np.ndarray, float, float] | None = None
@@ -271,7 +360,23 @@ def unroll_face_data(
         # is affine along the rulings (then the ruling parameter is s itself)
         exact = min(info.get("deviation_u", math.inf), info.get("deviation_v", math.inf)) <= 1e-9
         dmap = _RuledFaceMap(rs, dev, ev, exact and not getattr(ev, "affine_ruled", False))
-    # boundary loops
+    return dmap, ruled_dir, rs, mgrid, metric_jet
+
+
+def _boundary_loops(face: FaceData, dmap: Any, fsheet: Any, samples: int, label: str, info: dict[str, Any]
+                    ) -> tuple[list[list[BoundaryEdge]], list[list[tuple[Callable, Callable]]], int]:
+    """The face's wires as boundary loops: per edge a :class:`BoundaryEdge` whose flat image is
+    ``F(u(t), v(t))`` (on a sheet: its 3-D image on the neutral surface), split at the surface's C0
+    parameter lines, and the edge's pcurve ``(t -> (u, v), t -> (u', v'))``.
+
+    The outer loop (the one enclosing the others in (u, v), :func:`outer_loop_index`) is put first
+    (``info["outer_wire_reordered"]`` when the adapter's first wire was not it) and every hole is
+    checked to lie inside it (:func:`_check_holes_inside`).
+
+    Returns:
+        ``(loops, loops_uv, k_out)``: k_out the index of the outer loop among the adapter's
+        non-empty wires.
+    """
     loops = []
     loops_uv = []
     c0 = getattr(face.surface, "c0_breaks", None)
@@ -306,85 +411,58 @@ def unroll_face_data(
         loops_uv.insert(0, loops_uv.pop(k_out))
         info["outer_wire_reordered"] = True
     _check_holes_inside(loops_uv, label)
-    # rulings (bend lines and ruling-length check) over the UV box, clipped later to the outline
+    return loops, loops_uv, k_out
+
+
+def _ruling_ends(bounds: Bounds, ruled_dir: str, t: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(u_a, v_a, u_b, v_b)``: the two ends of the rulings at ``t`` ∈ [0, 1] across the parameter
+    box (rulings along v: ``u = u0 + t Δu`` from ``v0`` to ``v1``; along u the roles swap)."""
     u0, u1, v0, v1 = bounds
-    bends = np.zeros((0, 2, 2))
-    g3 = gf = np.zeros(0)
-    if ruled_dir is not None:
-        tt = _unit_samples(129)
-        tb = np.arange(1, rulings + 1) / (rulings + 1)
+    if ruled_dir == "v":
+        uu = u0 + t * (u1 - u0)
+        return uu, np.full(t.shape, float(v0)), uu, np.full(t.shape, float(v1))
+    vv = v0 + t * (v1 - v0)
+    return np.full(t.shape, float(u0)), vv, np.full(t.shape, float(u1)), vv
 
-        def ends(t: np.ndarray) -> tuple[np.ndarray, ...]:
-            if ruled_dir == "v":
-                uu = u0 + t * (u1 - u0)
-                return uu, np.full(t.shape, float(v0)), uu, np.full(t.shape, float(v1))
-            vv = v0 + t * (v1 - v0)
-            return np.full(t.shape, float(u0)), vv, np.full(t.shape, float(u1)), vv
 
-        # the ruling ends' 3-D lengths from the prefetched boundary jets; one evaluation of the map
-        # for the ruling ends and the bend lines
-        ua, va, ub, vb = ends(tt)
-        n = tt.size
-        if rs is not None:
-            g3 = rs.ruling_lengths(tt)
-        else:  # a cylinder or cone (closed form): one evaluation of the ruling ends
-            p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
-            g3 = _norm(p3[:n] - p3[n:])
-    if mgrid is None:
-        mgrid = _metric_grid(bounds)
-    # the map's points in one call (it is pointwise; its per-call overhead dominated): the
-    # edges' outline samples, the ruling ends and bend lines, the metric's stencil
-    mU, mV, mhu, mhv = mgrid
-    sampled, ts, edge_uv = _edge_sample_uv(loops, loops_uv, samples)
+def _ruling_lengths_3d(ev: SurfaceAdapter, rs: FaceRuledSurface | None, t: np.ndarray,
+                       ends: tuple[np.ndarray, ...]) -> np.ndarray:
+    """3-D lengths ``|S(u_b, v_b) - S(u_a, v_a)|`` of the rulings at ``t`` with ``ends`` (:func:`_ruling_ends`):
+    from the ruled surface's prefetched boundary jets, or (a cylinder or cone in closed form) by one
+    evaluation of the ruling ends."""
+    ua, va, ub, vb = ends
+    if rs is not None:
+        return rs.ruling_lengths(t)
+    n = ua.size
+    p3 = ev.value(np.concatenate([ub, ua]), np.concatenate([vb, va]))
+    return _norm(p3[:n] - p3[n:])
+
+
+def _bend_rulings_uv(bounds: Bounds, ruled_dir: str, rulings: int, loops: list[list[BoundaryEdge]],
+                     sampled: list[BoundaryEdge], ts: np.ndarray, edge_uv: tuple[np.ndarray, np.ndarray]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Any]:
+    """The ends ``(u_a, v_a, u_b, v_b)`` of the ``rulings`` interior bend lines at
+    ``t = k / (rulings + 1)``, clipped in (u, v) to the face's loops where they are straight
+    (:func:`clip_rulings_uv`, when every edge was sampled here), and the clip's result (None: not
+    clipped, :func:`measure_panel` clips the flat lines instead)."""
+    u0, u1, v0, v1 = bounds
+    tb = np.arange(1, rulings + 1) / (rulings + 1)
     clipped = None
-    if ruled_dir is not None:
-        # bend lines: rulings clipped to the loops in (u, v), where they are straight lines
-        ca, cva, cb, cvb = ends(tb) if rulings else (np.zeros(0),) * 4
-        if rulings and len(sampled) == sum(len(lp) for lp in loops):
-            m = ts.size
-            pts = _stack(edge_uv, axis=1).reshape(len(sampled), m, 2)
-            if ruled_dir == "u":
-                pts = pts[..., ::-1]
-            first = np.cumsum([0] + [len(lp) for lp in loops])
-            polys = [pts[i:j, :-1].reshape(-1, 2) for i, j in zip(first[:-1], first[1:])]
-            lo_, hi_ = (v0, v1) if ruled_dir == "v" else (u0, u1)
-            clipped = clip_rulings_uv(polys, ca if ruled_dir == "v" else cva, lo_, hi_)
-            if clipped is not None:
-                kk, y0, y1 = clipped
-                if ruled_dir == "v":
-                    ca, cva, cb, cvb = ca[kk], y0, cb[kk], y1
-                else:
-                    ca, cva, cb, cvb = y0, cva[kk], y1, cvb[kk]
-        ruling_uv = (np.concatenate([ub, ua, ca, cb]), np.concatenate([vb, va, cva, cvb]))
-    fmap = _MapBatch(dmap.map, [metric_stencil(mU, mV, mhu, mhv)] + ([ruling_uv] if ruled_dir is not None else [])
-                     + [edge_uv])
-    if sampled:
-        _seed_edge_samples(sampled, ts, fmap(*edge_uv))
-    if ruled_dir is not None:
-        pf = fmap(*ruling_uv)
-        gf = _norm(pf[:n] - pf[n:2 * n])
-        if rulings:
-            k = ca.size
-            bends = _stack([pf[2 * n:2 * n + k], pf[2 * n + k:]], axis=1)
-    area_3d = face_area(ev, loops_uv, u0, ev.breaks("u"), u1 - u0)
-    panel = FlatPanel(
-        label=label,
-        loops=loops,
-        bend_lines=bends if clipped is None else np.zeros((0, 2, 2)),  # measure_panel clips in the plane
-        ruling_lengths_3d=g3,
-        ruling_lengths_flat=gf,
-        area_3d=area_3d,
-        metric=_metric(ev, fmap, bounds, mgrid, None if metric_jet is None else metric_jet[1:3]),
-        info=info,
-        development=dmap,
-    )
-    measure_panel(panel)
-    if clipped is not None:
-        panel.bend_lines = bends  # clipped in (u, v) already
-    if fsheet is not None:
-        wires = [w for w in face.wires if w]  # the loops' order: outer (k_out) first
-        fsheet.finish(panel, dmap, rulings, [wires[k_out]] + wires[:k_out] + wires[k_out + 1:])
-    # place: bounding box at the origin
-    lo, _ = panel.bbox()
-    panel.translate(-lo)
-    return FlatPattern([panel], units=units)
+    # bend lines: rulings clipped to the loops in (u, v), where they are straight lines
+    ca, cva, cb, cvb = _ruling_ends(bounds, ruled_dir, tb) if rulings else (np.zeros(0),) * 4
+    if rulings and len(sampled) == sum(len(lp) for lp in loops):
+        m = ts.size
+        pts = _stack(edge_uv, axis=1).reshape(len(sampled), m, 2)
+        if ruled_dir == "u":
+            pts = pts[..., ::-1]
+        first = np.cumsum([0] + [len(lp) for lp in loops])
+        polys = [pts[i:j, :-1].reshape(-1, 2) for i, j in zip(first[:-1], first[1:])]
+        lo_, hi_ = (v0, v1) if ruled_dir == "v" else (u0, u1)
+        clipped = clip_rulings_uv(polys, ca if ruled_dir == "v" else cva, lo_, hi_)
+        if clipped is not None:
+            kk, y0, y1 = clipped
+            if ruled_dir == "v":
+                ca, cva, cb, cvb = ca[kk], y0, cb[kk], y1
+            else:
+                ca, cva, cb, cvb = y0, cva[kk], y1, cvb[kk]
+    return ca, cva, cb, cvb, clipped

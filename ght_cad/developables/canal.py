@@ -16,6 +16,7 @@ from ..curve import GHTCurve
 from ..errors import DegenerateGeometryError, GHTError
 from .checks import _check_3d_curve
 
+
 # ----------------------------------------------------------------------------------------------
 # 5.5 canal surfaces
 # ----------------------------------------------------------------------------------------------

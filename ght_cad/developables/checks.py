@@ -15,6 +15,7 @@ from ..errors import EdgeOfRegressionError, GHTError
 from ..ruled import regression_v, RuledSurface
 from .jets import _fmt
 
+
 # ----------------------------------------------------------------------------------------------
 # generic check of a ruled strip against its striction/regression points
 # ----------------------------------------------------------------------------------------------

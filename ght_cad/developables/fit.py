@@ -15,6 +15,7 @@ from ..bspline import BSplineSurfaceData, fit_function
 from ..errors import ConversionError, GHTError
 from ..ruled import RuledSurface
 
+
 # ----------------------------------------------------------------------------------------------
 # B-spline data (compatible directrix poles)
 # ----------------------------------------------------------------------------------------------

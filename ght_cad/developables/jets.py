@@ -17,6 +17,7 @@ from ..basis import _check_order, evaluate_derivatives
 from ..curve import GHTCurve
 from ..errors import GHTError
 
+
 _Jet = list  # list of arrays: value and derivatives 0..K
 _JET_CACHE_SIZE = 8  # dual-curve jets kept per EnvelopeDevelopable
 _JET_CACHE_MAX = 4096  # largest parameter array whose jet is kept

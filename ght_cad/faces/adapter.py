@@ -14,6 +14,7 @@ import numpy as np
 from .._vec import stack as _stack
 from ..errors import GHTError
 
+
 Bounds = tuple[float, float, float, float]
 #: surface kinds with a structural ruling direction "v" (their v-isolines are straight lines)
 RULED_KINDS = ("plane", "cylinder", "cone", "extrusion")

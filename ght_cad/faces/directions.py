@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import DegenerateGeometryError
 from .adapter import Bounds, RULED_KINDS, SurfaceAdapter
 
+
 def _isoline_points(ev: SurfaceAdapter, bounds: Bounds, directions: Sequence[str]) -> dict[str, np.ndarray]:
     """Points of the nine isolines along each of ``directions`` (fixed other parameter at 0, 1/8,
     ..., 1 of its range, 33 points each): ``{direction: (9, 33, 3)}``, one surface evaluation."""

@@ -15,6 +15,7 @@ from ..errors import DegenerateGeometryError
 from ..pattern.model import _point_in_polygon, _unit_samples, BoundaryEdge
 from .area import _edge_nodes
 
+
 def loop_uv_area(loop: list[tuple[Callable, Callable]]) -> float:
     r"""Signed area a loop encloses in the parameter plane, ``∮ u dv`` (16 × 12-point
     Gauss–Legendre panels per edge, split at the pcurve's knots: exact for polynomial pieces).

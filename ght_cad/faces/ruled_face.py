@@ -15,6 +15,7 @@ from ..ruled import RuledSurface
 from .adapter import Bounds, surface_jet, SurfaceAdapter
 from .loops import _flat1
 
+
 class FaceRuledSurface(RuledSurface):
     r"""The ruled surface of a face whose ``ruled``-isolines are straight lines.
 

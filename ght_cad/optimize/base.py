@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import GHTError
 
+
 Objective = Callable[[np.ndarray], Any]
 #: Iterations used when neither ``max_iter`` nor ``max_nfev`` is given.
 DEFAULT_MAX_ITER = 200

@@ -16,6 +16,7 @@ from .base import (_COMMON_ARGS, _FinishDone, _int_option, _Run, _Stop, DEFAULT_
                    OptimizerState)
 from .population import differential_evolution, gwo, igwo, pso
 
+
 def _sobol(dim: int, n: int, rng: np.random.Generator) -> np.ndarray:
     """``n`` points of a scrambled Sobol' sequence in ``[0, 1)^dim`` (scipy.stats.qmc), drawn from ``rng``."""
     import warnings

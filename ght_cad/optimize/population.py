@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import GHTError
 from .base import _COMMON_ARGS, _float_option, _Run, _Stop, Objective, OptimizeResult, OptimizerState
 
+
 def pso(
     fun: Objective,
     bounds: Any,

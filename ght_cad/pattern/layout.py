@@ -15,6 +15,7 @@ from .._vec import einsum as _einsum
 from .._vec import stack as _stack
 from .model import BoundaryEdge, FlatPanel, _inside
 
+
 #: 3-D arc-length fractions of the edge-mark ticks (double tick near the start)
 MARK_FRACTIONS = (0.2, 0.25, 0.5, 0.75)
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..model import _MM_PER_UNIT, points_bbox
 
+
 #: SVG width/height unit and scale per model unit: SVG lengths know mm, cm, in (not m, ft), so
 #: ``1 m = 1000 mm`` and ``1 ft = 12 in``; the viewBox stays in model units (true-scale print).
 SVG_UNITS = {
