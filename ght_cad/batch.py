@@ -34,6 +34,7 @@ Exit code of :func:`run_batch`'s result: 0 all ok, 2 any bad input (none failed)
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -68,6 +69,12 @@ class BatchJob:
     data: dict[str, Any] | None = None
     error: str | None = None
     sweep: dict[str, Any] | None = None  # {"base": name, "values": {path: value}}
+    #: ``--chord-tol`` for this design's DXF/SVG (None: its ``[outputs] chord_tol``, else 1e-3 mm)
+    chord_tol: float | None = None
+
+    def task(self, **extra: Any) -> dict[str, Any]:
+        """The picklable task :func:`run_task` runs for this design (``extra``: e.g. ``marker``)."""
+        return {"folder": self.folder, "source": self.source, "data": self.data, "chord_tol": self.chord_tol, **extra}
 
 
 @dataclass
@@ -196,8 +203,8 @@ def _where() -> dict[str, Any]:
 def run_task(task: dict[str, Any]) -> dict[str, Any]:
     """Run one design through :func:`ght_cad.design.run_design` into a private temporary folder.
 
-    Runs in a worker (local process or Dask worker). ``task`` holds ``folder``, ``source`` and
-    ``data`` (the parsed TOML), optionally ``marker`` (a file written with the pid on start, so the
+    Runs in a worker (local process or Dask worker). ``task`` holds ``folder``, ``source``,
+    ``data`` (the parsed TOML) and ``chord_tol`` (over the file's; None: the file's), optionally ``marker`` (a file written with the pid on start, so the
     caller knows which designs were running in a process that died; the temporary folder is then
     made beside it, in the caller's private folder, which the caller removes at the end).
 
@@ -216,7 +223,7 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
         where = str(Path(task["marker"]).parent) if task.get("marker") else None
         with tempfile.TemporaryDirectory(prefix="ght-cad-batch.", dir=where) as tmp:
             folder = Path(tmp) / task["folder"]
-            out["report"] = run_design(design, folder, progress=False)
+            out["report"] = run_design(design, folder, progress=False, chord_tol=task.get("chord_tol"))
             out["files"] = {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
     except GHTError as exc:
         out.update(status=BAD, error=_one_line(exc))
@@ -353,8 +360,7 @@ def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, A
                                      initargs=(_worker_threads(workers),)) as ex:
                 futs = {}
                 for j in pending.values():
-                    task = {"folder": j.folder, "source": j.source, "data": j.data, "marker": str(markers / str(j.index))}
-                    futs[ex.submit(run_task, task)] = j
+                    futs[ex.submit(run_task, j.task(marker=str(markers / str(j.index))))] = j
                 procs = dict(getattr(ex, "_processes", None) or {})  # pid -> Process (all started at once with fork)
                 for fut in as_completed(futs):
                     j = futs[fut]
@@ -410,8 +416,7 @@ def _dask(jobs: list[BatchJob], scheduler: str,
     try:
         futs = {}
         for j in jobs:
-            task = {"folder": j.folder, "source": j.source, "data": j.data}
-            futs[client.submit(run_task, task, key=f"ght-cad-batch-{j.folder}-{os.getpid()}-{time.time_ns()}",
+            futs[client.submit(run_task, j.task(), key=f"ght-cad-batch-{j.folder}-{os.getpid()}-{time.time_ns()}",
                                pure=False)] = j
         for fut in as_completed(list(futs)):
             j = futs[fut]
@@ -445,6 +450,7 @@ def run_batch(
     jobs: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
+    chord_tol: float | None = None,
 ) -> BatchResult:
     """Run every design (and every sweep variant) and write ``DIR/<name>/``, ``batch.json``, ``batch.md``.
 
@@ -454,12 +460,15 @@ def run_batch(
         jobs: local worker processes (default: the machine's cores); ignored with ``scheduler``.
         scheduler: address of a ``dask.distributed`` scheduler (``tcp://host:port``).
         progress: progress bar over designs on stderr when it is a terminal.
+        chord_tol: DXF/SVG outline chord tolerance for every design, in each design's units; it
+            takes precedence over a file's ``[outputs] chord_tol`` (None: that key, else 1e-3 mm).
 
     Returns:
         :class:`BatchResult` (``exit_code``: 0 all ok, 2 bad input, 1 failed).
 
     Raises:
-        GHTError: no designs, ``jobs < 1``, ``out_dir`` is not a folder, an unreachable scheduler.
+        GHTError: no designs, ``jobs < 1``, ``chord_tol`` not > 0, ``out_dir`` is not a folder, an
+            unreachable scheduler.
     """
     from .outdir import StagedFiles
     from .progress import Progress
@@ -471,10 +480,14 @@ def run_batch(
         jobs = os.cpu_count() or 1
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise GHTError(f"jobs={jobs!r}; allowed: an integer >= 1")
+    if chord_tol is not None and not (isinstance(chord_tol, (int, float)) and chord_tol > 0 and math.isfinite(chord_tol)):
+        raise GHTError(f"chord_tol={chord_tol!r} is not allowed; allowed: a positive length in the designs' units")
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise GHTError(f"{out} exists and is not a folder; allowed: a folder or a new path")
     job_list, sweeps = collect_jobs(paths)
+    for j in job_list:
+        j.chord_tol = chord_tol
     rows: dict[int, dict[str, Any]] = {}
     for j in job_list:
         if j.error is not None:

@@ -330,7 +330,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     """``ght-cad demo``: :func:`ght_cad.demo.run_demo` into ``--out``."""
     from .demo import run_demo
 
-    report = run_demo(args.out, progress=not args.no_progress, quick=args.quick, **_wait_args(args))
+    report = run_demo(args.out, progress=not args.no_progress, quick=args.quick, chord_tol=_chord_tol(args),
+                      **_wait_args(args))
     _emit(args, {"command": "demo", **report}, _report_text)
     return EXIT_OK
 
@@ -347,7 +348,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _chord_tol(args: argparse.Namespace) -> float | None:
-    """``--chord-tol`` (None: the pattern's default, 1e-3 mm in its unit); refused unless > 0."""
+    """``--chord-tol`` (None: the design's ``[outputs] chord_tol``, else 1e-3 mm in the pattern's unit); refused
+    unless > 0 and finite. The option takes precedence over the design file's key."""
     tol = getattr(args, "chord_tol", None)
     if tol is not None and not (tol > 0 and math.isfinite(tol)):
         raise UsageError(f"--chord-tol={tol!r} is not allowed; allowed: a positive length in the pattern's units "
@@ -679,7 +681,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
                          "--scheduler a Dask cluster's workers")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError(f"--jobs {args.jobs}: allowed: an integer >= 1")
-    res = run_batch(args.designs, args.out, jobs=args.jobs, scheduler=args.scheduler, progress=not args.no_progress)
+    res = run_batch(args.designs, args.out, jobs=args.jobs, scheduler=args.scheduler, progress=not args.no_progress,
+                    chord_tol=_chord_tol(args))
     summary = res.as_dict()
     for r in summary["rows"]:
         if r["status"] != "ok":
@@ -741,7 +744,8 @@ def build_parser() -> argparse.ArgumentParser:
     def chord_tol_arg(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("--chord-tol", type=float, metavar="TOL",
                         help="DXF/SVG outlines: largest distance between a curved edge and the arcs written for "
-                             "it, in the pattern's units (default 1e-3 mm; straight and circular edges are exact)")
+                             "it, in the pattern's units (default: the design file's [outputs] chord_tol, else "
+                             "1e-3 mm; this option takes precedence; straight and circular edges are exact)")
 
     def design_arg(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("design", metavar="DESIGN.toml", help="design file (schema: docs/design-files.md)")
@@ -757,6 +761,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, metavar="DIR", type=_out_path, help="output folder (created; files are replaced atomically)")
     sp.add_argument("--quick", action="store_true", help="fewer optimizer iterations (for smoke tests)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    chord_tol_arg(sp)
     add_wait_options(sp)
     common(sp)
     sp.set_defaults(func=cmd_demo)
@@ -921,6 +926,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786 (needs pip install 'ght_cad[dask]'; "
                     "start workers with --nthreads 1)")
     sp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    chord_tol_arg(sp)
     common(sp)
     sp.set_defaults(func=cmd_batch)
 

@@ -22,7 +22,7 @@ def default_design_text() -> str:
 
 
 def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool = False, wait: bool = False,
-             timeout: float | None = None) -> dict[str, Any]:
+             timeout: float | None = None, chord_tol: float | None = None) -> dict[str, Any]:
     """Run the embedded default design into ``out_dir`` and return the report dictionary.
 
     Args:
@@ -31,16 +31,18 @@ def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool =
         quick: fewer optimizer iterations (smoke tests).
         wait, timeout: wait (at most ``timeout`` s) while another process writes ``out_dir``
             instead of refusing (see :func:`ght_cad.design.run_design`).
+        chord_tol: DXF/SVG outline chord tolerance in mm (None: 1e-3 mm).
 
     Returns:
         The report (also written as ``report.json`` and ``report.md``).
 
     Raises:
-        GHTError: the embedded design is invalid (a bug) or its geometry degenerates.
+        GHTError: the embedded design is invalid (a bug), its geometry degenerates, or ``chord_tol``
+            is not > 0.
     """
     from .design import parse_design_text, run_design
 
     design = parse_design_text(default_design_text(), source=f"<embedded {DEFAULT_DESIGN}>")
     if quick and design.optimize is not None:
         design.optimize.iterations = min(design.optimize.iterations, 10)
-    return run_design(design, out_dir, progress=progress, wait=wait, timeout=timeout)
+    return run_design(design, out_dir, progress=progress, wait=wait, timeout=timeout, chord_tol=chord_tol)

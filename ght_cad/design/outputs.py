@@ -325,7 +325,8 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
     Args:
         design: a validated design (:func:`load_design`).
         files: output paths; the suffix selects the content.
-        chord_tol: DXF/SVG outline chord tolerance in the design's units (None: 1e-3 mm,
+        chord_tol: DXF/SVG outline chord tolerance in the design's units; it takes precedence
+            over the file's ``[outputs] chord_tol`` (None: that key, else 1e-3 mm,
             :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
 
     Raises:
@@ -342,6 +343,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
     for f in files:
         if f.suffix.lower() not in allowed:
             raise DesignError(f"{f}: unknown output suffix {f.suffix!r}; allowed: {', '.join(allowed)}")
+    chord_tol = design.outputs.chord_tol if chord_tol is None else chord_tol  # --chord-tol over the file
     curves, _ = build_curves(design)
     builts = build_surfaces(design, curves)
     if not builts:

@@ -146,7 +146,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         progress: progress bar on stderr when it is a terminal (and a line when it has to wait).
         wait: wait while another process writes ``out_dir`` instead of refusing.
         timeout: with ``wait``, give up after this many seconds (None: no limit).
-        chord_tol: DXF/SVG outline chord tolerance in the design's units (None: 1e-3 mm,
+        chord_tol: DXF/SVG outline chord tolerance in the design's units; it takes precedence
+            over the file's ``[outputs] chord_tol`` (None: that key, else 1e-3 mm,
             :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
 
     Returns:
@@ -166,6 +167,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         raise GHTError(f"output folder path {os.fspath(out_dir)!r} is empty; allowed: a folder path")
     out = Path(out_dir)
     want_files = set(design.outputs.files)
+    chord_tol = design.outputs.chord_tol if chord_tol is None else chord_tol  # --chord-tol over the file
     from ..cad import KERNEL_HINT, kernel_available
 
     # without a kernel (core-only: FreeCAD's Python) everything but the B-rep and STEP is computed

@@ -191,6 +191,10 @@ class OutputSpec:
 
     files: list[str] = field(default_factory=lambda: list(FILE_OUTPUTS))
     figures: list[str] = field(default_factory=lambda: list(FIGURE_OUTPUTS))
+    #: ``[outputs] chord_tol``: largest distance between a curved (not line, not circle) boundary edge
+    #: and the arcs the DXF/SVG outline writes for it, in the design's units (None: 1e-3 mm,
+    #: :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`); ``--chord-tol`` takes precedence
+    chord_tol: float | None = None
 
 
 @dataclass
@@ -267,6 +271,8 @@ class Design:
             d["sheet"].pop("side_reference")  # one surface: its own normal (as before)
         if len(self.surfaces) <= 1 and all(s.name is None for s in self.surfaces):
             d.pop("surfaces")  # a single [surface]: as before
+        if d["outputs"]["chord_tol"] is None:  # the default: as before (TOML has no null)
+            d["outputs"].pop("chord_tol")
         return d
 
 
@@ -597,9 +603,12 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     outputs = OutputSpec()
     ot2 = ck.table(data, "outputs", "outputs")
     if ot2 is not None:
-        ck.keys(ot2, "outputs", ("files", "figures"))
+        ck.keys(ot2, "outputs", ("files", "figures", "chord_tol"))
         outputs = OutputSpec(ck.string_list(ot2, "files", "outputs", list(FILE_OUTPUTS), choices=FILE_OUTPUTS),
                              ck.string_list(ot2, "figures", "outputs", list(FIGURE_OUTPUTS), choices=FIGURE_OUTPUTS))
+        if "chord_tol" in ot2:
+            outputs.chord_tol = ck.number(ot2, "chord_tol", "outputs", lo=0.0, lo_open=True,
+                                          allowed=f"> 0 (a length in the design's units, {units}; default 1e-3 mm)")
     if not surfaces:
         for key, kinds in (("files", ("dxf", "svg")), ("figures", ("surface", "flat_pattern"))):
             explicit = ot2 is not None and key in ot2
