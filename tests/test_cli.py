@@ -339,7 +339,20 @@ def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
     assert dxf.stat().st_size > 0 and svg.read_text() != "old" and png.stat().st_size > 0
 
 
-def test_ctrl_c_that_surfaces_as_another_error_still_exits_130(monkeypatch, capsys) -> None:
+@pytest.fixture
+def python_sigint_handler():
+    """Python's own Ctrl-C handler during the test (the one :func:`ght_cad.cli._watch_sigint` wraps),
+    the inherited one restored after: a pytest started in the background by a non-interactive shell
+    (``pytest &``) inherits SIGINT ignored, which the CLI rightly keeps ignored (the test below then
+    failed with exit 1: the kill never arrived)."""
+    import signal
+
+    inherited = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, inherited)
+
+
+def test_ctrl_c_that_surfaces_as_another_error_still_exits_130(monkeypatch, capsys, python_sigint_handler) -> None:
     """A Ctrl-C that lands inside an extension's import can surface later as an ImportError of the
     half-initialized module (seen with OCP): the run still reports "interrupted", exit 130, and the
     SIGINT handler is restored afterwards."""
