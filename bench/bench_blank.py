@@ -30,7 +30,7 @@ K = 0.42
 def parts():
     import math
 
-    from sheet_parts import bracket, freeform_bend, profile_solid, tray, u_channel, z_profile
+    from sheet_parts import bracket, cone_bend, freeform_bend, profile_solid, tray, u_channel, z_profile
 
     hole = [(1, 30.0, 10.0)]
     yield "L-bracket", profile_solid(bracket()), lambda k: bracket().blank_area(k)
@@ -41,6 +41,8 @@ def parts():
     for sign in (-1, 1):
         solid, area = freeform_bend(sign)
         yield f"spline bend ({'convex' if sign < 0 else 'concave'} side)", solid, area
+    solid, area = cone_bend()
+    yield "cone-segment bend (R 3 -> 8)", solid, area
 
 
 def main() -> None:
