@@ -116,3 +116,34 @@ def test_run_plate_and_pattern_use_the_table(tmp_path: Path) -> None:
     assert a["flat_pattern"]["errors"] == b["flat_pattern"]["errors"]
     assert a["flat_pattern"]["sheet"] == b["flat_pattern"]["sheet"]
     assert a["design"]["sheet"]["k_factor_table"] == [[0.0, 0.30], [22.0, 0.45]]
+
+
+@pytest.mark.slow  # three two-surface sheet unrolls (~30 s on a loaded machine)
+def test_surfaces_read_the_table_at_their_own_thickness() -> None:
+    """``[[surfaces]]`` (tests/test_join_panels.py's wall: two lofts, smallest bending radius
+    148.77 on both): the table is read per surface at its own R/T, so with T = 2 (R/T = 74.1 or
+    74.4 by side) K = 0.4 and with a ``[surfaces.sheet] thickness = 1`` override (R/T = 147.8 or
+    148.8) K = 0.5; the patterns equal those of the explicit per-surface K."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_join_panels import _WALL
+
+    from ght_cad.design import build_surfaces, parse_design_text, unroll_surfaces
+
+    def pattern(upper: str, sheet: str):
+        txt = _WALL.replace('curve_b = "top"\n', 'curve_b = "top"\n\n[surfaces.sheet]\n' + upper + "\n")
+        txt = txt.replace("rulings = 6", 'rulings = 6\npanels = "per-surface"') + "\n[sheet]\nthickness = 2.0\n" + sheet + "\n"
+        return unroll_surfaces(build_surfaces(parse_design_text(txt, "wall.toml")))
+
+    a = pattern("thickness = 1.0", "k_factor_table = [[0, 0.4], [100, 0.5]]")
+    b = pattern("thickness = 1.0\nk_factor = 0.5", "k_factor = 0.4")
+    sheets = [p.info["sheet"] for p in a.panels]
+    assert [(s["thickness"], s["k_factor"]) for s in sheets] == [(2.0, 0.4), (1.0, 0.5)]
+    assert all(abs(s["min_bending_radius"] - 148.77) < 0.01 for s in sheets)
+    assert json.dumps([p.info["sheet"] for p in a.panels], sort_keys=True, default=str) == \
+        json.dumps([p.info["sheet"] for p in b.panels], sort_keys=True, default=str)
+    assert [p.area_flat for p in a.panels] == [p.area_flat for p in b.panels]
+    # a per-surface k_factor wins over the table
+    c = pattern("thickness = 1.0\nk_factor = 0.33", "k_factor_table = [[0, 0.4], [100, 0.5]]")
+    assert [p.info["sheet"]["k_factor"] for p in c.panels] == [0.4, 0.33]
