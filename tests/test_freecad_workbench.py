@@ -163,7 +163,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     expected = {
         "GHT_Curve", "GHT_CompositeCurve", "GHT_Developable", "GHT_SpineDevelopable", "GHT_FlatPattern",
         "GHT_Optimization", "GHT_RunOptimization", "GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG",
-        "GHT_DevelopableLoft", "GHT_Plate",
+        "GHT_DevelopableLoft", "GHT_Plate", "GHT_DevelopableApproximation",
     }
     assert expected <= set(res["commands"]), res["commands"]
     assert all(res["commands"].values()), res["commands"]
@@ -239,6 +239,14 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     assert lf["segments"] == ["main"] and lf["faces"] == 1 and lf["icon"], lf
     assert "RailA = RimA.Edge1" in lf["report"] and "fan share 0" in lf["report"], lf
     assert "RailB is not linked" in lf["unset"] and "Traceback" not in lf["unset"], lf
+    # issue 24: a selected cone face -> Developable approximation: one panel, its flat pattern as the
+    # child in the tree, both up to date (not Touched), the Report view clean; the double-click panel
+    ap = steps["GHT_DevelopableApproximation"]
+    v = ap["value"]
+    assert v["kinds"] == ["GHT::DevelopableApproximation", "GHT::FlatPattern"] and v["valid"] and v["panels"] == 1, v
+    assert not v["touched"] and not v["failed"] and v["children"] == ["GHT::FlatPattern"] and v["icon"], v
+    assert v["panel"]["handled"] and v["panel"]["dialog"] and "1 developable panel within" in v["panel"]["message"], v
+    assert not ap["tracebacks"] and not _report_lines(ap), ap
     # the plate of the default quarter cylinder (T = 1): one valid solid of six faces, its volume
     # (knot-split Shape.Volume) within 1e-8 of the closed form
     pl = steps["GHT_Plate"]["value"]

@@ -48,6 +48,7 @@ __all__ = [
     "set_read_only",
     "new_feature",
     "register_command",
+    "selected_links",
     "COMMANDS",
 ]
 
@@ -614,6 +615,22 @@ class BaseCommand:
             import FreeCADGui as Gui
 
             Gui.ActiveDocument.setEdit(obj.Name, 0)
+
+
+def selected_links(kind: str) -> list[tuple[Any, str]]:
+    """The GUI selection as links ``(object, "<kind>N")``: every selected sub-element named
+    ``kind...`` (``"Edge"``, ``"Face"``), and for a whole object selected without sub-elements its
+    only such element, when its shape has exactly one."""
+    import FreeCADGui as Gui
+
+    links = []
+    for sel in Gui.Selection.getSelectionEx():
+        subs = [s for s in sel.SubElementNames if s.startswith(kind)]
+        if subs:
+            links += [(sel.Object, s) for s in subs]
+        elif hasattr(sel.Object, "Shape") and len(getattr(sel.Object.Shape, kind + "s")) == 1:
+            links.append((sel.Object, kind + "1"))
+    return links
 
 
 def register_command(cmd: BaseCommand) -> None:

@@ -317,15 +317,9 @@ class CommandDevelopableLoft(BaseCommand):
     )
 
     def Activated(self) -> None:
-        import FreeCADGui as Gui
+        from ._base import selected_links
 
-        links = []
-        for sel in Gui.Selection.getSelectionEx():
-            edges = [s for s in sel.SubElementNames if s.startswith("Edge")]
-            if edges:
-                links += [(sel.Object, s) for s in edges]
-            elif hasattr(sel.Object, "Shape") and len(sel.Object.Shape.Edges) == 1:
-                links.append((sel.Object, "Edge1"))
+        links = selected_links("Edge")
         if len(links) != 2:
             App.Console.PrintError(f"Developable loft: select exactly two edges (rails); {len(links)} selected\n")
             return

@@ -16,6 +16,7 @@ FEATURE_MODULES = (
     "developable",
     "spine_developable",
     "developable_loft",
+    "developable_approximation",
     "plate",
     "flat_pattern",
     "optimization",
@@ -26,7 +27,7 @@ FEATURE_MODULES = (
 EXTRA_MODULES = ("joined_developable",)
 TOOLBARS = {
     "GHT curves": ["GHT_Curve", "GHT_CompositeCurve"],
-    "GHT surfaces": ["GHT_Developable", "GHT_SpineDevelopable", "GHT_JoinedDevelopable", "GHT_DevelopableLoft", "GHT_Plate", "GHT_FlatPattern"],
+    "GHT surfaces": ["GHT_Developable", "GHT_SpineDevelopable", "GHT_JoinedDevelopable", "GHT_DevelopableLoft", "GHT_DevelopableApproximation", "GHT_Plate", "GHT_FlatPattern"],
     "GHT optimization": ["GHT_Optimization", "GHT_RunOptimization"],
     "GHT export": ["GHT_ExportSTEP", "GHT_ExportDXF", "GHT_ExportSVG"],
 }

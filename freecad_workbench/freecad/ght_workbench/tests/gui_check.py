@@ -323,6 +323,42 @@ def main():
                 App.closeDocument(ldoc.Name)
                 App.setActiveDocument(doc.Name)
         step("GHT_DevelopableLoft", loft)
+    if "GHT_DevelopableApproximation" in _base.COMMANDS:
+        def approximation():
+            # a face selected as a user would (the lateral face of a Part cone: one panel, seconds),
+            # in its own document; the feature and its flat pattern child, then a double-click
+            adoc = App.newDocument("ApproxCheck")
+            cone = adoc.addObject("Part::Cone", "Cone")
+            cone.Radius1, cone.Radius2, cone.Height = 50.0, 20.0, 80.0
+            adoc.recompute()
+            try:
+                Gui.Selection.clearSelection()
+                Gui.Selection.addSelection(cone, "Face1")
+                before = {o.Name for o in adoc.Objects}
+                Gui.runCommand("GHT_DevelopableApproximation", 0)
+                adoc.recompute()
+                created = new_objects(adoc, before)
+                kinds = sorted(o.Proxy.Type for o in created)
+                ap = [o for o in created if o.Proxy.Type == "GHT::DevelopableApproximation"][0]
+                _base.ViewProviderBase.last_panel = None
+                handled = ap.ViewObject.Proxy.doubleClicked(ap.ViewObject)  # what a double-click in the tree does
+                QtWidgets.QApplication.processEvents()
+                panel = _base.ViewProviderBase.last_panel
+                info = {"handled": bool(handled), "dialog": bool(Gui.Control.activeDialog()),
+                        "message": getattr(panel, "message", None)}
+                if Gui.Control.activeDialog():
+                    Gui.Control.closeDialog()
+                Gui.ActiveDocument.resetEdit()
+                return {"created": len(created), "kinds": kinds, "valid": all(o.Shape.isValid() for o in created), "panels": ap.PanelCount,
+                        "touched": [o.Name for o in created if "Touched" in o.State], "failed": [o.Name for o in created if _base.failed(o)],
+                        "children": [c.Proxy.Type for c in ap.ViewObject.Proxy.claimChildren()],
+                        "icon": os.path.isfile(ap.ViewObject.Proxy.getIcon()), "panel": info}
+            finally:
+                if Gui.Control.activeDialog():
+                    Gui.Control.closeDialog()
+                App.closeDocument(adoc.Name)
+                App.setActiveDocument(doc.Name)
+        step("GHT_DevelopableApproximation", approximation)
     if "GHT_FlatPattern" in _base.COMMANDS and "developable" in ctx:
         step("GHT_FlatPattern", generic("GHT_FlatPattern", "developable", "GHT::FlatPattern", "flat"))
     if "GHT_Plate" in _base.COMMANDS and "developable" in ctx:

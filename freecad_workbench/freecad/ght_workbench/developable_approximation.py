@@ -1,0 +1,378 @@
+r"""Developable approximation (issue 24): a parametric feature that covers a selected face of any
+object (a Part feature, a PartDesign Body, an imported STEP) with exactly developable panels.
+
+The algorithm is the core's :func:`ght_cad.approximation.approximate` (strips between target
+isolines, each an exact developable loft between its two seam curves, spec 5.7; seams moved off
+the target so the deviation is split both ways; the direction of least normal curvature). This
+module only adapts FreeCAD to it and back:
+
+* :func:`face_target`: a ``Part.Face`` as the core's target protocol
+  (:class:`ght_cad.approximation.SurfaceTarget`: ``jet(u, v, order)`` = ``[S, S_u, S_v, S_uu,
+  S_vv, S_uv]`` and the face's parameter box ``face.ParameterRange``), through the workbench's
+  surface adapter :class:`.flat_pattern.FreeCADSurface`: a non-periodic B-spline/Bézier surface is
+  read into the core's NURBS evaluator, planes/cylinders/cones are evaluated in closed form; a
+  periodic B-spline surface is made non-periodic on a copy (same parameters, ``setUNotPeriodic``);
+  other surfaces (a ``Part.Sphere``, torus, surface of revolution, offset) go through
+  ``face.toNurbs()`` (OCCT's exact NURBS conversion of the face, its pcurves converted with it, so
+  the parameter box is the converted face's). Whatever cannot be read that way is evaluated point
+  by point by FreeCAD (``value``/``getDN``: correct, slow).
+* the panels (the core's :class:`~ght_cad.bspline.BSplineSurfaceData`, degree 1 across the
+  rulings, fitted to 1e-7 of the size) become ``Part.BSplineSurface`` faces
+  (:func:`.convert.face_from_data`) sewn into one shell at 1e-6 of the target size (adjacent
+  panels are lofted from the same seam curve).
+
+Per-panel outputs are listed in the order of the Shape's faces (``PanelDeviations[i]`` is
+``Face{i+1}``). :meth:`DevelopableApproximationFeature.surface` gives the panels' exact
+developables in that order, so the *Flat pattern* feature (Source = this feature) unrolls all
+panels onto one sheet with seam marks, as ``ght-cad approximate`` does, and the existing DXF/SVG
+export takes it. (The fitted B-spline faces are not unrolled: a loft's fan can be 1e-10 of the
+parameter range wide, and at its apex, where the rail's derivative vanishes, the development's
+θ check reads 90°.)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+import FreeCAD as App
+import Part
+
+from ght_cad.errors import GHTError
+
+from ._base import (BaseCommand, FeatureProxy, ViewProviderBase, failed, info_panel, new_feature, register_command, selected_links, set_read_only,
+                    tolerance_property)
+from .convert import face_from_data
+
+__all__ = ["DevelopableApproximationFeature", "face_target", "target_face",
+           "make_developable_approximation", "flat_patterns_of", "panel_shell", "DIRECTIONS", "OUTPUTS"]
+
+DIRECTIONS = ["auto", "u", "v"]
+OUTPUTS = ("PanelCount", "MaxDeviation", "PanelDeviations", "PanelMaxOut", "PanelMaxIn", "PanelThetaMax", "PanelAreas",
+           "DirectionUsed", "Report")
+
+
+def _readable(face: "Part.Face") -> Any:
+    """The :class:`.flat_pattern.FreeCADSurface` of ``face`` when it is evaluated in numpy (a
+    B-spline/Bézier read into the core, or a plane/cylinder/cone in closed form), else None; a
+    periodic B-spline surface is tried again on a non-periodic copy (same parameters)."""
+    from .flat_pattern import FreeCADSurface
+
+    surf = FreeCADSurface(face)
+    if surf.path != "freecad":
+        return surf
+    s = face.Surface
+    if type(s).__name__ == "BSplineSurface" and (s.isUPeriodic() or s.isVPeriodic()):
+        c = s.copy()
+        if c.isUPeriodic():
+            c.setUNotPeriodic()
+        if c.isVPeriodic():
+            c.setVNotPeriodic()
+        surf = FreeCADSurface(Part.Face(c))
+        if surf.path != "freecad":
+            return surf
+    return None
+
+
+def face_target(face: "Part.Face", name: str = "face") -> Any:
+    """A FreeCAD face as the core's approximation target (module doc).
+
+    Returns:
+        :class:`ght_cad.approximation.SurfaceTarget` on the face's parameter box, with
+        ``path`` set to how it is evaluated (``"nurbs"``, ``"analytic"``, ``"nurbs (toNurbs)"``
+        or ``"freecad"``).
+
+    Raises:
+        GHTError: a face without a parameter box (infinite).
+    """
+    from ght_cad.approximation import SurfaceTarget
+
+    from .flat_pattern import FreeCADSurface
+
+    src, how = face, ""
+    surf = _readable(face)
+    if surf is None:
+        try:
+            converted = face.toNurbs().Faces
+        except Exception:  # noqa: BLE001 - OCCT could not convert it: evaluate through FreeCAD
+            converted = []
+        if len(converted) == 1:
+            surf = _readable(converted[0])
+            if surf is not None:
+                src, how = converted[0], " (toNurbs)"
+    if surf is None:
+        surf = FreeCADSurface(face)
+    bounds = tuple(float(x) for x in src.ParameterRange)
+    if not all(np.isfinite(bounds)):
+        raise GHTError(f"{name} has the parameter range {bounds}; an approximation target must be a bounded face")
+    target = SurfaceTarget(lambda u, v, k: surf.jet(u, v, min(k, 2)), bounds, f"{name} ({surf.type_name})")
+    target.path = surf.path + how
+    return target
+
+
+def target_face(link: Any, what: str) -> "Part.Face":
+    """The face of a ``LinkSub`` ``(object, ["FaceN"])`` (or the object's only face).
+
+    Raises:
+        GHTError: no link, a sub-element that is not a face or no longer exists, an object with
+            several faces and none named.
+    """
+    obj, subs = link if link else (None, [])
+    if obj is None:
+        raise GHTError(f"{what} is not linked; select one face (of a Part feature, a Body or an imported STEP)")
+    faces = obj.Shape.Faces if hasattr(obj, "Shape") else []
+    names = f"Face1..Face{len(faces)}" if faces else "no faces"
+    subs = [s for s in (subs or []) if s]
+    if subs:
+        k = subs[0][4:] if subs[0].startswith("Face") else ""
+        if not k.isdigit() or not 1 <= int(k) <= len(faces):
+            raise GHTError(f"{what} = {obj.Label}.{subs[0]} is not a face of it ({names}); select the face again")
+        return faces[int(k) - 1]
+    if len(faces) != 1:
+        raise GHTError(f"{what} = {obj.Label} has {names}; link one face ({obj.Label}.FaceN)")
+    return faces[0]
+
+
+def _shell_order(shape: "Part.Shape", panels: list[Any], tol: float) -> list[int]:
+    """For every face of ``shape`` the index of the panel whose B-spline net it carries (sewing
+    keeps the surfaces but not necessarily the order)."""
+    nets = [np.asarray(p.surface.data.poles, dtype=float) for p in panels]
+    order = []
+    for i, f in enumerate(shape.Faces, 1):
+        poles = np.array([[tuple(p) for p in row] for row in f.Surface.getPoles()], dtype=float)
+        hits = [k for k, n in enumerate(nets) if n.shape == poles.shape and float(np.abs(n - poles).max()) <= tol]
+        if len(hits) != 1 or hits[0] in order:
+            raise GHTError(f"Face{i} of the sewn panel shell matches {len(hits)} panels; expected exactly one")
+        order.append(hits[0])
+    return order
+
+
+def panel_shell(faces: list, tol: float) -> "Part.Shape":
+    """The panel faces (in seam order) joined into one shell along their seams: OCCT's general fuse
+    with the fuzzy value ``tol`` (FreeCAD's ``generalFuse``), which merges the coincident seam
+    edges of neighbouring panels (they are lofted from the same seam curve and agree to the fit
+    tolerance, 1e-7 of the size). ``sewShape`` of FreeCAD 0.20 (OCCT 7.6) leaves such seams
+    open: none of the eight seams of the 1 m cap's nine panels was sewn, at any tolerance up to
+    1 mm. One face is returned as it is (a band closed around already carries its seam edge).
+
+    Raises:
+        GHTError: the fuse split a panel, or two neighbouring panels share no edge, or the shell
+            is not valid.
+    """
+    if len(faces) == 1:
+        return faces[0]
+    fused = faces[0].generalFuse(faces[1:], float(tol))[0]
+    if len(fused.Faces) != len(faces):
+        raise GHTError(f"joining the {len(faces)} panels at {tol:.3g} gave {len(fused.Faces)} faces; expected {len(faces)}")
+    shell = Part.Shell(fused.Faces)
+    if not shell.isValid():
+        raise GHTError(f"the shell of the {len(faces)} panels is not valid")
+    return shell
+
+
+def _check_seams(shell: "Part.Shape", order: list[int]) -> None:
+    """Every two panels that follow each other in seam order share an edge of the shell.
+
+    Raises:
+        GHTError: naming the first seam left open.
+    """
+    if len(order) < 2:
+        return
+    face_of = {k: i for i, k in enumerate(order)}
+    for k in range(len(order) - 1):
+        fa, fb = shell.Faces[face_of[k]], shell.Faces[face_of[k + 1]]
+        if not any(e.isSame(g) for e in fa.Edges for g in fb.Edges):
+            raise GHTError(f"the seam between panels {k + 1} and {k + 2} (Face{face_of[k] + 1}, Face{face_of[k + 1] + 1}) is open")
+
+
+class DevelopableApproximationFeature(FeatureProxy):
+    """Proxy of a developable approximation of a face (``Part::FeaturePython``)."""
+
+    Type = "GHT::DevelopableApproximation"
+
+    def setup(self, obj: Any) -> None:
+        obj.addProperty("App::PropertyLinkSub", "Target", "Input", "The double-curved face to cover: a face of a Part feature, a Body or an imported STEP")
+        obj.addProperty("App::PropertyFloat", "Tolerance", "Approximation", "Largest deviation of the panels from the target, both ways (model units, > 0)")
+        obj.Tolerance = 1.0
+        obj.addProperty("App::PropertyInteger", "MaxPanels", "Approximation", "Largest panel count accepted (>= 1); more needed: the feature fails naming the best deviation")
+        obj.MaxPanels = 64
+        obj.addProperty("App::PropertyEnumeration", "Direction", "Approximation", "Parameter of the target the rulings run along: auto (least normal curvature), u or v")
+        obj.Direction = DIRECTIONS
+        obj.Direction = "auto"
+        obj.addProperty("App::PropertyInteger", "PanelCount", "Result", "Number of developable panels (faces of the shell)")
+        obj.addProperty("App::PropertyFloat", "MaxDeviation", "Result", "Largest deviation of a panel from the target, both ways (the core's measure)")
+        obj.addProperty("App::PropertyFloatList", "PanelDeviations", "Result", "Per panel (FaceN order): max deviation both ways")
+        obj.addProperty("App::PropertyFloatList", "PanelMaxOut", "Result", "Per panel: largest deviation outside the target (along its normal)")
+        obj.addProperty("App::PropertyFloatList", "PanelMaxIn", "Result", "Per panel: largest deviation inside the target")
+        obj.addProperty("App::PropertyFloatList", "PanelThetaMax", "Result", "Per panel: developability θ_max in degrees (round-off expected)")
+        obj.addProperty("App::PropertyFloatList", "PanelAreas", "Result", "Per panel: 3-D area")
+        obj.addProperty("App::PropertyString", "DirectionUsed", "Result", "The parameter the rulings run along (u or v)")
+        obj.addProperty("App::PropertyString", "Report", "Result", "Summary of the approximation")
+        self.restored(obj)
+
+    def restored(self, obj: Any) -> None:
+        set_read_only(obj, OUTPUTS)
+
+    def surface(self, obj: Any) -> list[Any]:
+        """The panels' exact developables (:class:`ght_cad.loft.DevelopableLoft` or
+        :class:`ght_cad.approximation.ConeStrip`) in FaceN order: the *Flat pattern* feature
+        (Source = this feature) unrolls them all onto one sheet, as ``ght-cad approximate`` does.
+        They are kept from the last successful recompute (together with the Shape); after a
+        document is opened they are made again from the same inputs (the core is deterministic)
+        and matched to the saved Shape's faces.
+
+        Raises:
+            GHTError: no panels yet, or the saved faces are not those of the inputs (recompute).
+        """
+        panels = getattr(self, "_exact", None)
+        if panels is None:
+            if obj.Shape.isNull() or not obj.Shape.Faces:
+                raise GHTError(f"{obj.Label} has no panels yet; recompute it")
+            res, _ = self.run(obj)
+            try:
+                order = _shell_order(obj.Shape, res.panels, 1e-9 * res.size)
+            except GHTError:
+                raise GHTError(f"{obj.Label}: its saved panels are not those of its inputs; recompute it") from None
+            panels = self._exact = [_exact(res.panels[k]) for k in order]
+        return list(panels)
+
+    def run(self, obj: Any) -> tuple[Any, str]:
+        """``(the core's ApproximationResult, how the target is evaluated)`` for the inputs.
+
+        Raises:
+            GHTError: an unset or stale Target, a bad Tolerance or MaxPanels, no approximation
+                within Tolerance with at most MaxPanels panels (the best deviation reached).
+        """
+        from ght_cad.approximation import approximate
+
+        face = target_face(obj.Target, f"{obj.Label}.Target")
+        tol = tolerance_property(obj)
+        max_panels = int(obj.MaxPanels)
+        if max_panels < 1:
+            raise GHTError(f"{obj.Label}.MaxPanels={max_panels} is not allowed; it must be an integer >= 1")
+        target = face_target(face, f"{obj.Target[0].Label}.{(obj.Target[1] or ['Face1'])[0]}")
+        try:
+            res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels)
+        except GHTError as exc:  # name the feature's properties, not the core's arguments
+            raise GHTError(f"{exc} (properties Tolerance, MaxPanels)") from None
+        return res, target.path
+
+    def compute(self, obj: Any) -> None:
+        res, path = self.run(obj)
+        faces = [face_from_data(p.surface.data) for p in res.panels]
+        for i, f in enumerate(faces, 1):
+            if not f.isValid():
+                raise GHTError(f"the B-spline face of panel {i} is not valid")
+        shape = panel_shell(faces, 1e-6 * res.size)
+        order = _shell_order(shape, res.panels, 1e-9 * res.size)
+        _check_seams(shape, order)
+        panels = [res.panels[k] for k in order]
+        obj.PanelCount = len(panels)
+        obj.MaxDeviation = float(res.max_deviation)
+        obj.PanelDeviations = [float(p.max_deviation) for p in panels]
+        obj.PanelMaxOut = [float(p.max_out) for p in panels]
+        obj.PanelMaxIn = [float(p.max_in) for p in panels]
+        obj.PanelThetaMax = [float(p.theta_max_deg) for p in panels]
+        obj.PanelAreas = [float(p.area) for p in panels]
+        obj.DirectionUsed = res.direction
+        obj.Report = (f"{len(panels)} developable panel{'s' if len(panels) != 1 else ''} within {res.max_deviation:.4g} (Tolerance {res.tol:g}), rulings along "
+                      f"{res.direction}, target evaluated by {path}, {res.info.get('seconds', 0.0):.1f} s")
+        obj.Shape = shape
+        self._exact = [_exact(p) for p in panels]  # not saved (FeatureProxy.__getstate__): see surface
+
+
+def _exact(panel: Any) -> Any:
+    """A panel's exact developable (its fitted B-spline surface when the core kept none)."""
+    return panel.exact if panel.exact is not None else panel.surface
+
+
+class ViewProviderDevelopableApproximation(ViewProviderBase):
+    icon_name = "GHT_DevelopableApproximation"
+    shape_color = (0.62, 0.80, 0.62)
+    panel_factory = staticmethod(lambda obj: info_panel(obj, ("Target",), f"{obj.Report}\nEdit Tolerance, MaxPanels and "
+                                                        "Direction in the property editor; its Flat pattern holds every panel."))
+
+    def claimChildren(self) -> list:
+        """Its flat patterns (Flat pattern features whose Source is this feature) sit under it."""
+        obj = self.obj
+        if obj is None:
+            return []
+        return flat_patterns_of(obj)
+
+
+def flat_patterns_of(obj: Any) -> list[Any]:
+    """The Flat pattern features whose Source is ``obj``."""
+    return [o for o in obj.InList if getattr(getattr(o, "Proxy", None), "Type", "") == "GHT::FlatPattern"]
+
+
+def make_developable_approximation(
+    target: Any,
+    tolerance: float = 1.0,
+    *,
+    max_panels: int = 64,
+    direction: str = "auto",
+    flat_pattern: bool = False,
+    doc: Any = None,
+    name: str = "DevelopableApproximation",
+) -> Any:
+    """Create a developable approximation of a face.
+
+    Args:
+        target: ``(object, "FaceN")``, or an object whose shape is one face.
+        tolerance: largest deviation both ways (model units, > 0).
+        max_panels: largest panel count accepted.
+        direction: ``"auto"``, ``"u"`` or ``"v"``: the parameter the rulings run along.
+        flat_pattern: also make the *Flat pattern* of all panels (a child in the tree,
+            :func:`flat_patterns_of`).
+
+    Returns:
+        The recomputed feature (in the error state, with the reason in the Report view, when no
+        approximation within the tolerance and panel count exists).
+
+    Raises:
+        GHTError: a direction not in :data:`DIRECTIONS`.
+    """
+    if direction not in DIRECTIONS:
+        raise GHTError(f"direction={direction!r} is not allowed; use one of {DIRECTIONS}")
+    src, sub = target if isinstance(target, tuple) else (target, "")
+    obj = new_feature(doc or src.Document, name, DevelopableApproximationFeature, ViewProviderDevelopableApproximation)
+    obj.Target = (src, [sub] if sub else [])
+    obj.Tolerance = float(tolerance)
+    obj.MaxPanels = int(max_panels)
+    obj.Direction = direction
+    obj.Document.recompute()
+    if flat_pattern and not failed(obj):  # a failed approximation has no panels to unroll
+        from .flat_pattern import make_flat_pattern
+
+        make_flat_pattern(obj, doc=obj.Document, name=f"{obj.Name}Flat")
+    return obj
+
+
+class CommandDevelopableApproximation(BaseCommand):
+    name = "GHT_DevelopableApproximation"
+    icon_name = "GHT_DevelopableApproximation"
+    menu_text = "Developable approximation"
+    tooltip = (
+        "Cover the selected double-curved face (of a Part feature, a Body or an imported STEP) with exactly developable "
+        "panels within Tolerance: one shell of B-spline panels (degree 1 across the rulings) and the flat pattern of "
+        "all panels; per-panel deviations in the properties."
+    )
+
+    def IsActive(self) -> bool:
+        import FreeCADGui as Gui
+
+        return App.ActiveDocument is not None and bool(Gui.Selection.getSelection())
+
+    def Activated(self) -> None:
+        links = selected_links("Face")
+        if len(links) != 1:
+            App.Console.PrintError(f"Developable approximation: select exactly one face; {len(links)} selected\n")
+            return
+        doc = App.ActiveDocument
+        doc.openTransaction("Developable approximation")
+        make_developable_approximation(links[0], flat_pattern=True, doc=doc)  # a failure is reported by the feature itself
+        doc.commitTransaction()
+
+
+register_command(CommandDevelopableApproximation())

@@ -1,0 +1,45 @@
+"""The workbench's Developable approximation feature (issue 24) tested inside Debian's FreeCAD.
+
+``freecadcmd -t freecad.ght_workbench.tests.fc_approximation`` (about 1-4 min on 2 shared cores:
+the cap is approximated twice): a spherical cap (R 1000 mm, polar angle 0..60°) at Tolerance 1 mm
+in at most 14 panels, the deviation measured by FreeCAD's ``distToShape`` both ways within 1 mm
+(+1 % for OCCT's extrema accuracy); its flat pattern; save/reopen and a new Tolerance changing
+PanelCount; a cone face in one panel; refusals naming the property. Here: the printed figures, and
+the flat pattern's DXF read back with ezdxf (one closed outline per panel).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from freecad_launch import run_fc_unittest
+
+pytestmark = [pytest.mark.freecad, pytest.mark.slow]
+
+_NUM = r"([\deE.+-]+)"
+
+
+def test_developable_approximation_inside_freecadcmd(tmp_path: Path) -> None:
+    out = run_fc_unittest("freecad.ght_workbench.tests.fc_approximation", tmp_path, min_tests=3, timeout=900)
+    flat = out.replace("\t", "\n").replace("\r", "\n")
+    cap = re.search(rf"cap tol 1: (\d+) panels, MaxDeviation {_NUM}, measured target->shell {_NUM} shell->target {_NUM}", flat)
+    assert cap, out[-3000:]
+    panels, measured = int(cap.group(1)), max(float(cap.group(3)), float(cap.group(4)))
+    assert panels <= 14 and measured <= 1.01, cap.group(0)
+    again = re.search(r"cap reopened, tol 4: (\d+) -> (\d+) panels", flat)
+    assert again and int(again.group(2)) < int(again.group(1)) == panels, out[-3000:]
+    cone = re.search(rf"cone: 1 panel, MaxDeviation {_NUM}, measured {_NUM} \(size {_NUM}\)", flat)
+    assert cone and float(cone.group(2)) <= 1e-6 * float(cone.group(3)), out[-3000:]
+
+    pytest.importorskip("ezdxf")
+    from ezdxf import recover
+
+    count, area = (tmp_path / "cap_panels.txt").read_text().split()
+    assert int(count) == panels
+    dxf, auditor = recover.readfile(str(tmp_path / "cap_flat.dxf"))
+    assert not auditor.has_errors, [str(e) for e in auditor.errors]
+    outlines = dxf.modelspace().query('POLYLINE[layer=="OUTLINE"]')
+    assert len(outlines) == panels and all(o.is_closed for o in outlines), len(outlines)
