@@ -978,7 +978,8 @@ def classify_skin(sname: str, nums: Sequence[int], areas: Sequence[float],
 
     ``T`` is the distance of the largest face whose probes all leave the material at one distance
     through a face of opposite normal; a face is skin when most of its probes leave at ``T``
-    (relative :data:`DIST_TOL`) through an opposite face; a block (every face skin, or ``T`` more
+    (relative :data:`DIST_TOL`) through an opposite face; the skin faces must pair up one way only
+    (:func:`_check_pairing`); a block (every face skin, or ``T`` more
     than a quarter of the square root of the largest skin face's area) is no sheet; two skin faces
     sharing an edge must be tangent there (at most :data:`SHARP_DEG`); every skin face must be skin
     at all its probes; the skin faces form exactly two connected sets, each face's opposite face in

@@ -147,3 +147,18 @@ def test_surfaces_read_the_table_at_their_own_thickness() -> None:
     # a per-surface k_factor wins over the table
     c = pattern("thickness = 1.0\nk_factor = 0.33", "k_factor_table = [[0, 0.4], [100, 0.5]]")
     assert [p.info["sheet"]["k_factor"] for p in c.panels] == [0.4, 0.33]
+
+
+@pytest.mark.slow
+def test_optimize_checks_with_the_largest_k_and_the_result_with_its_own(tmp_path: Path) -> None:
+    """With ``[optimize]`` the candidates are checked with the table's largest K (|K T| = 0.45 x 10)
+    and the result's plate carries the K of its own R/T."""
+    from ght_cad.design import load_design, run_design
+
+    p = _design(tmp_path, "opt", "k_factor_table = [[0, 0.30], [22, 0.45]]")
+    p.write_text(p.read_text() + '\n[optimize]\nmethod = "pso"\npopulation = 4\niterations = 2\n\n'
+                 '[outputs]\nfiles = ["json"]\nfigures = []\n')
+    r = run_design(load_design(p), tmp_path / "out", progress=False)
+    assert r["optimization"]["sheet"]["k_t"] == pytest.approx(4.5, rel=1e-12)
+    ratio = r["plate"]["k_factor_ratio"]
+    assert r["plate"]["k_factor"] == (0.45 if ratio >= 22 else 0.30)

@@ -9,6 +9,9 @@ For every solid of a shape the faces are sorted into the sheet's two skins and i
   rays all leave at one distance through a face of opposite normal;
 * a face whose rays (most of them) leave at ``T`` through an opposite face is a skin face, others
   are walls (thickness walls, hole walls, cut faces);
+* the faces at T must pair up one way only (faces sharing an edge on one side, a face and the
+  faces its rays reach on opposite sides: :func:`ght_cad.blank.classify_skin`), else the skin is
+  ambiguous (a bar of square section T x T);
 * two skin faces sharing an edge (``TopExp.MapShapesAndAncestors``) must meet tangentially
   (else: a sharp edge, zero bend radius); every skin face must be skin at all its points (else
   the skin is ambiguous); the skin faces form exactly two connected sets (inside and outside),
