@@ -244,7 +244,18 @@ def test_cone_segment_bend() -> None:
     assert abs(res.pattern.area / area(K) - 1) < 1e-6, (res.pattern.area, area(K))
     row = res.blanks[0].bends[0]
     assert row["kind"] == "cone" and abs(row["angle_deg"] - 90.0) < 1e-9
-    assert res.pattern.panels[0].bend_lines.shape == (2, 2, 2)
+    bl = res.pattern.panels[0].bend_lines
+    assert bl.shape == (2, 2, 2)
+    # the tangent lines are the cone's end rulings: each of slant length W / cos α, and in the flat
+    # they meet at the developed sector angle (π/2) sin α (the cone turns π/2 about its axis,
+    # α = atan((8 - 3)/40) its semi-angle): both to 1e-9 relative
+    al = math.atan(5.0 / 40.0)
+    d = bl[:, 1] - bl[:, 0]
+    lengths = np.linalg.norm(d, axis=1)
+    assert np.all(np.abs(lengths / (40.0 / math.cos(al)) - 1) < 1e-9), lengths
+    cos = abs(float(d[0] @ d[1])) / (lengths[0] * lengths[1])
+    sector = math.pi / 2 * math.sin(al)
+    assert abs(math.acos(min(cos, 1.0)) / sector - 1) < 1e-9, (math.acos(min(cos, 1.0)), sector)
 
 
 def test_overlap_refusal_and_split(monkeypatch) -> None:
