@@ -52,12 +52,10 @@ ALLOWED_UPWARD = {
     ("ght_cad.patch", "ght_cad.cad.occ"),
     # surfaces -> kernel: to_face and the unroll dispatch of CAD faces (issue 27: a registry)
     ("ght_cad.developable", "ght_cad.cad.developable_faces"),
-    ("ght_cad.loft", "ght_cad.cad.developable_faces"),
+    ("ght_cad.loft.surface", "ght_cad.cad.developable_faces"),
     ("ght_cad.approximation", "ght_cad.cad.approximate"),
     ("ght_cad.unroll", "ght_cad.cad.unroll_faces"),
     ("ght_cad.flat_pattern", "ght_cad.cad.unroll_faces"),
-    # surfaces -> optimize: the loft's own optimization problem (issue 27: move it to optimize)
-    ("ght_cad.loft", "ght_cad.optimize.problems"),
     # optimize -> kernel: the pipeline's B-rep and STEP output
     ("ght_cad.optimize.pipeline", "ght_cad.cad.developable_faces"),
     ("ght_cad.optimize.pipeline", "ght_cad.cad.occ"),
