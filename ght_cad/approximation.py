@@ -146,9 +146,9 @@ def as_target(target: Any) -> SurfaceTarget:
         b = target.bounds() if callable(target.bounds) else target.bounds
         return SurfaceTarget(lambda u, v, k: target.jet(u, v, k), b, type(target).__name__)
     if hasattr(target, "wrapped") or type(target).__module__.startswith("OCP"):
-        from .cad.approximate import face_target  # lazy: the kernel adapter
+        from ._kernel import adapter  # the kernel adapter, through the core's dispatch
 
-        return face_target(target)
+        return adapter("face_target")(target)
     raise GHTError(
         f"target of type {type(target).__name__} is not allowed; give a GHTSurface, NurbsSurface, RuledSurface, "
         "a SurfaceTarget (jet + bounds) or a build123d/cadquery/OCP face"

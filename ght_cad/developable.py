@@ -437,9 +437,9 @@ class EnvelopeDevelopable(RuledSurface):
     # -- CAD ------------------------------------------------------------------------------------
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face (degree 1 across the rulings); see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .cad.developable_faces import developable_face
+        from ._kernel import adapter
 
-        return developable_face(self, tol=tol, **kwargs)
+        return adapter("developable_face")(self, tol=tol, **kwargs)
 
     def trimmed(self, t_range: tuple[float, float]) -> "EnvelopeDevelopable":
         """The same envelope restricted to the dual-curve parameters ``t_range``."""
@@ -589,9 +589,9 @@ class TangentDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .cad.developable_faces import developable_face
+        from ._kernel import adapter
 
-        return developable_face(self, tol=tol, **kwargs)
+        return adapter("developable_face")(self, tol=tol, **kwargs)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -654,9 +654,9 @@ class RectifyingDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .cad.developable_faces import developable_face
+        from ._kernel import adapter
 
-        return developable_face(self, tol=tol, **kwargs)
+        return adapter("developable_face")(self, tol=tol, **kwargs)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -898,6 +898,6 @@ class CompositeDevelopable:
     def to_shell(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A shell of one B-spline face per segment with shared joint edges; see
         :func:`ght_cad.cad.developable_faces.composite_shell`."""
-        from .cad.developable_faces import composite_shell
+        from ._kernel import adapter
 
-        return composite_shell(self, tol=tol, **kwargs)
+        return adapter("composite_shell")(self, tol=tol, **kwargs)

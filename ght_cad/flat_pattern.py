@@ -274,7 +274,7 @@ class FlatPattern:
 
     def to_face(self) -> Any:
         """Planar build123d Face(s) of the pattern (outline + holes); a list for composites."""
-        from .cad.unroll_faces import flat_faces
+        from ._kernel import adapter
 
-        faces = flat_faces(self)
+        faces = adapter("flat_faces")(self)
         return faces[0] if len(faces) == 1 else faces

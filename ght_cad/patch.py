@@ -376,11 +376,11 @@ class GHTSurface:
 
     def to_face(self, tol: float | None = None, degree: int = 5) -> Any:
         """build123d ``Face`` on :meth:`to_bspline` (imports the CAD adapter lazily)."""
-        from .cad.occ import make_face
+        from ._kernel import adapter
 
         if self.dim != 3:
             raise GHTError(f"a CAD face needs a 3-D patch; this patch has dim={self.dim}")
-        return make_face(self.to_bspline(tol, degree))
+        return adapter("make_face")(self.to_bspline(tol, degree))
 
 
 def patches_to_bspline(

@@ -662,16 +662,16 @@ def unroll(
             sheet=sheet,
         )
     if hasattr(surface_or_face, "wrapped") or type(surface_or_face).__module__.startswith("OCP"):
-        from .cad.unroll_faces import shape_faces, unroll_face
+        from ._kernel import adapter
 
-        faces = shape_faces(surface_or_face)
+        faces = adapter("shape_faces")(surface_or_face)
         if len(faces) > 1:  # a shell, solid or compound: one panel per face
             return unroll_composite(
                 faces, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings, samples=samples, units=units,
                 sheet=sheet,
             )
 
-        return unroll_face(
+        return adapter("unroll_face")(
             surface_or_face,
             best_effort=best_effort,
             tol_deg=tol_deg,

@@ -2,9 +2,14 @@
 
 Importing :mod:`ght_cad` never imports this package; importing this package itself imports no
 kernel (its modules import OCP). :func:`kernel_available` tells whether one can be imported.
+Importing it registers its adapters (:data:`ADAPTERS`, loaded on first call) with the core's
+kernel dispatch :mod:`ght_cad._kernel`, which is how the kernel-free core reaches them.
 """
 
 from __future__ import annotations
+
+import importlib
+from typing import Any, Callable
 
 #: The top-level modules of the CAD kernels the adapters use (a ``ModuleNotFoundError`` of one of
 #: these means "no kernel installed", not a bug)
@@ -30,3 +35,41 @@ def is_missing_kernel(exc: BaseException) -> bool:
     """Whether ``exc`` is the ``ModuleNotFoundError`` of a kernel module (OCP, build123d, cadquery)."""
     name = getattr(exc, "name", None) or ""
     return isinstance(exc, ModuleNotFoundError) and name.split(".")[0] in KERNEL_MODULES
+
+
+# -- the core's kernel dispatch (ght_cad._kernel) ---------------------------------------------------
+
+#: operation of :data:`ght_cad._kernel.OPERATIONS` -> (module of this package, function)
+ADAPTERS = {
+    "make_face": ("occ", "make_face"),
+    "make_edge": ("occ", "make_edge"),
+    "write_step": ("occ", "write_step"),
+    "developable_face": ("developable_faces", "developable_face"),
+    "composite_shell": ("developable_faces", "composite_shell"),
+    "face_target": ("approximate", "face_target"),
+    "shape_faces": ("unroll_faces", "shape_faces"),
+    "unroll_face": ("unroll_faces", "unroll_face"),
+    "flat_faces": ("unroll_faces", "flat_faces"),
+}
+
+
+def _on_first_call(module: str, name: str) -> Callable[..., Any]:
+    """``ght_cad.cad.<module>.<name>``, imported (and with it the kernel) when first called."""
+
+    def call(*args: Any, **kwargs: Any) -> Any:
+        return getattr(importlib.import_module(f"{__name__}.{module}"), name)(*args, **kwargs)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = f"Calls :func:`ght_cad.cad.{module}.{name}` (imports it, and the kernel, on first call)."
+    return call
+
+
+def _register_adapters() -> None:
+    """Fill the core's kernel registry with this package's adapters (imports no kernel)."""
+    from .. import _kernel
+
+    for operation, (module, name) in ADAPTERS.items():
+        _kernel.register_adapter(operation, _on_first_call(module, name))
+
+
+_register_adapters()

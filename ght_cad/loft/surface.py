@@ -400,9 +400,9 @@ class DevelopableLoft(RuledSurface):
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A build123d ``Shell`` of one B-spline face per segment sewn along the joint rulings
         (:func:`ght_cad.cad.developable_faces.composite_shell`; needs build123d)."""
-        from ..cad.developable_faces import composite_shell
+        from .._kernel import adapter
 
-        return composite_shell(self.segments, tol=tol, **kwargs)
+        return adapter("composite_shell")(self.segments, tol=tol, **kwargs)
 
     def joint_folds(self) -> list[dict[str, float]]:
         r"""Joint rulings where the surface folds back (a fan lying over the main part).

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-
+from .._kernel import adapter
 from ..errors import GHTError
 from ..io import write_text_atomic
 from ..progress import Progress
@@ -97,16 +97,13 @@ def _brep(obj: Any, notes: list[str]) -> Any:
         if isinstance(obj, RuledSurface):
             if hasattr(obj, "to_face"):
                 return obj.to_face()
-            from ..cad.developable_faces import developable_face
-
-            return developable_face(obj)
+            return adapter("developable_face")(obj)
         from ..bspline import curve_to_bspline
-        from ..cad.occ import make_edge
 
         if getattr(obj, "dim", 3) not in (2, 3):
             notes.append(f"no B-rep for a {obj.dim}-D curve")
             return None
-        return make_edge(curve_to_bspline(obj))
+        return adapter("make_edge")(curve_to_bspline(obj))
     except ImportError as exc:  # CAD kernel or adapter missing
         notes.append(f"B-rep skipped: {exc}")
         return None
@@ -188,9 +185,7 @@ def optimize_design(
     if cad:
         out.shape = _brep(obj, notes)
         if out.shape is not None and folder is not None:
-            from ..cad.occ import write_step
-
-            write_step(out.shape, folder / f"{stem}.step")
+            adapter("write_step")(out.shape, folder / f"{stem}.step")
             out.files["step"] = folder / f"{stem}.step"
     if flat and isinstance(obj, RuledSurface):
         try:
