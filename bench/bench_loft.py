@@ -70,7 +70,7 @@ def bench_optimization(iterations: int, pop: int, seed: int = 1) -> dict[str, fl
     import time
 
     from ght_cad import GHTCurve
-    from ght_cad.loft import LoftProblem
+    from ght_cad.optimize.problems import LoftProblem
     from ght_cad.optimize import minimize
 
     prob = LoftProblem(GHTCurve(CHINE), GHTCurve(SHEER), objective="fan_share")

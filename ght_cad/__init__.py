@@ -10,9 +10,7 @@ Stable names (spec section 9): :func:`basis`, :class:`GHTCurve`, :func:`developa
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from ._lazy import lazy_getattr
 from .basis import basis, bernstein
 from .curve import GHTCurve
 from .errors import (
@@ -80,11 +78,4 @@ _LAZY: dict[str, str] = {
     "approximate": "ght_cad.approximation",
 }
 
-
-def __getattr__(name: str) -> Any:
-    mod = _LAZY.get(name)
-    if mod is None:
-        raise AttributeError(f"module 'ght_cad' has no attribute {name!r}")
-    value = getattr(importlib.import_module(mod), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr(__name__, _LAZY, globals())

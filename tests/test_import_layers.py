@@ -35,7 +35,7 @@ WORKBENCH = ROOT / "freecad_workbench" / "freecad"
 LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
 
 _LAYER_OF = {
-    "core": ["errors", "_validate", "_vec", "_quadrature", "_cache", "io", "outdir", "progress", "step_guard", "_kernel"],
+    "core": ["errors", "_validate", "_vec", "_quadrature", "_cache", "io", "outdir", "progress", "step_guard", "_kernel", "_lazy"],
     "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
     "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "pattern", "faces", "developables", "join_panels",

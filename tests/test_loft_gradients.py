@@ -17,7 +17,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.loft import LoftGradientFallback, LoftProblem, developable_loft, loft_measures_and_gradients
+from ght_cad.loft import developable_loft
+from ght_cad.optimize.problems import LoftGradientFallback, LoftProblem, loft_measures_and_gradients
 from ght_cad.optimize import minimize
 
 CHINE = np.array([[0, -700, 300], [1500, -1050, 200], [3000, -1150, 250], [4500, -950, 450]], float)

@@ -286,7 +286,7 @@ def _rails_value_and_grad_fn(design: Design, curves: dict[str, Any], spec: Optim
     ``(+inf, 0)``. The forward-difference neighbours of a fallback are objective values only (no
     sheet check: they are gradient probes, not candidates).
     """
-    from ..loft import LOFT_OBJECTIVES, LoftGradientFallback, LoftProblem
+    from ..optimize.problems.loft import LOFT_OBJECTIVES, LoftGradientFallback, LoftProblem
 
     surf = design.surface
     assert surf is not None
@@ -362,7 +362,7 @@ def _rails_objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSp
     ``∫ max(0, 1 - c/margin)² dλ`` (c the distance of the edge-of-regression parameter ``v*`` from
     [0, 1]), or ``weighted`` = ``w0 fan_share + w1 fairness + w2 regression``. A candidate without a
     loft, or one ``accept`` refuses (the sheet rule), raises (``+inf`` in :func:`optimize_design`)."""
-    from ..loft import LOFT_OBJECTIVES, LoftProblem
+    from ..optimize.problems.loft import LOFT_OBJECTIVES, LoftProblem
 
     surf = design.surface
     assert surf is not None

@@ -39,9 +39,7 @@ exact gradients live in :mod:`ght_cad.optimize.problems.loft`; ``ght_cad.loft.Lo
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from .._lazy import lazy_getattr
 from .build import developable_loft
 from .equation import CORNER_RADIUS, CORNER_TOL, MIN_FAN, loft_function
 from .plot import plot_loft_sign
@@ -72,11 +70,4 @@ _MOVED = {
     "loft_measures_and_gradients": "ght_cad.optimize.problems.loft",
 }
 
-
-def __getattr__(name: str) -> Any:
-    mod = _MOVED.get(name)
-    if mod is None:
-        raise AttributeError(f"module 'ght_cad.loft' has no attribute {name!r}")
-    value = getattr(importlib.import_module(mod), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr(__name__, _MOVED, globals())

@@ -127,7 +127,7 @@ class OptimizationFeature(FeatureProxy):
 
     def loft_problem(self, obj: Any, targets: list, free: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
         """(:class:`ght_cad.loft.LoftProblem`, mapping to the rails' Mu/Nu/Gamma) of one loft target."""
-        from ght_cad.loft import LoftProblem
+        from ght_cad.optimize.problems import LoftProblem
 
         from .ght_curve import core_curve
 

@@ -20,7 +20,7 @@ from ...loft.rails import _det, _jet
 from ...loft.surface import DevelopableLoft, LoftSegment
 from ...loft.tracing import _at_corner
 from ...ruled import regression_v
-from .base import Problem
+from .base import CurveParameterJets, Problem
 
 
 # ----------------------------------------------------------------------------------------------
@@ -250,8 +250,6 @@ def _rail_parameter_jets(curve: GHTCurve, t: np.ndarray, k: int, reverse: bool) 
     r"""``∂r^(q)/∂(μ, ν, γ)`` at ``t`` for q = 0..k, each (3, N, 3) (closed form,
     :class:`ght_cad.optimize.problems.CurveParameterJets`); for the reversed rail ``r~(s) = r(1-s)``,
     ``∂r~^(q)(s) = (-1)^q ∂r^(q)(1-s)``."""
-    from .base import CurveParameterJets
-
     x = 1.0 - t if reverse else t
     J = CurveParameterJets(x, curve.control_points, k)(np.array([curve.mu]), np.array([curve.nu]),
                                                        np.array([curve.gamma]), tuple(range(k + 1)))

@@ -1,0 +1,65 @@
+"""The loft and the optimization problems as packages (issue 27): every name the old modules
+``ght_cad/loft.py`` and ``ght_cad/optimize/problems.py`` gave is still given, and is the same object
+as in its new home; the names that moved up to the optimize layer load only on first use."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: ``ght_cad.loft``'s ``__all__`` and public constants before the split (loft.py, 2,128 lines)
+OLD_LOFT = ["Rail", "CallableRail", "as_rail", "developable_loft", "DevelopableLoft", "LoftSegment", "LoftReport",
+            "loft_function", "plot_loft_sign", "LoftProblem", "LOFT_OBJECTIVES", "LoftGradientFallback",
+            "loft_measures_and_gradients", "CORNER_TOL", "CORNER_RADIUS", "MIN_FAN"]
+#: ``ght_cad.optimize.problems``' ``__all__`` before the split (problems.py, 1,049 lines), and the
+#: names other modules import from it
+OLD_PROBLEMS = ["ght_seed_jets", "population_basis", "PopulationBasis", "Problem", "StripProblem", "FairnessProblem",
+                "DualCurveFairnessProblem", "CurveFairnessProblem", "InterpolationFairnessProblem",
+                "FAIRNESS_MEASURES", "EnvelopeStrip", "default_strip_problem", "default_dual_problem",
+                "default_interpolation_problem", "wave_strip_problem", "cone_strip_problem", "CurveParameterJets",
+                "SHAPE_NAMES"]
+
+
+@pytest.mark.parametrize("name", OLD_LOFT)
+def test_ght_cad_loft_keeps_its_names(name: str) -> None:
+    import ght_cad.loft as loft
+
+    value = getattr(loft, name)
+    if callable(value):  # classes and functions: defined in the package or in the loft problem's module
+        assert value.__module__.startswith(("ght_cad.loft.", "ght_cad.optimize.problems.loft")), value.__module__
+
+
+@pytest.mark.parametrize("name", OLD_PROBLEMS)
+def test_ght_cad_optimize_problems_keeps_its_names(name: str) -> None:
+    import ght_cad.optimize.problems as problems
+
+    assert getattr(problems, name) is not None
+
+
+def test_moved_loft_names_are_the_optimize_ones_and_load_lazily() -> None:
+    code = (
+        "import sys, json, ght_cad.loft as L\n"
+        "before = 'ght_cad.optimize' in sys.modules\n"
+        "from ght_cad.loft import *\n"
+        "import ght_cad.optimize.problems as P\n"
+        "same = [getattr(L, n) is getattr(P, n) for n in "
+        "('LoftProblem', 'LOFT_OBJECTIVES', 'LoftGradientFallback', 'loft_measures_and_gradients')]\n"
+        "print(json.dumps([before, same, sorted(L.__all__) == sorted(set(L.__all__))]))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    before, same, unique = json.loads(out.stdout)
+    assert before is False, "importing ght_cad.loft must not import the optimize layer"
+    assert same == [True] * 4 and unique
+
+
+def test_unknown_name_is_an_attribute_error() -> None:
+    import ght_cad.loft as loft
+
+    with pytest.raises(AttributeError, match="module 'ght_cad.loft' has no attribute 'LoftSolver'"):
+        loft.LoftSolver  # noqa: B018
