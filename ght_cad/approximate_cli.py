@@ -155,7 +155,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     summary = {"command": "approximate", "target": str(path), "panels": report["panels"], "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}
     if getattr(args, "json", False):
-        from .cli import dumps
+        from .commands.common import dumps
 
         args._json_out = dumps({"ok": True, **summary})
     else:

@@ -537,7 +537,7 @@ def _write_summary(result: BatchResult, stage_cls: Any) -> None:
         for s in result.sweeps:
             plot_sweep(s, [r for r in result.rows if (r.get("sweep") or {}).get("base") == s.base],
                        stage.path(pngs[s.base]))
-        from .cli import dumps
+        from .commands.common import dumps
 
         stage.path(out / "batch.json").write_text(dumps(result.as_dict()) + "\n", encoding="utf-8")
         stage.path(out / "batch.md").write_text(batch_markdown(result), encoding="utf-8")

@@ -42,7 +42,7 @@ _LAYER_OF = {
                  "outline_arcs", "blank", "approximation"],
     "optimize": ["optimize"],
     "kernel": ["cad"],
-    "app": ["cli", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
+    "app": ["cli", "commands", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
 }
 
 #: The core's one way to the kernel layer: ``ght_cad._kernel.load_kernel`` imports ``ght_cad.cad``,
@@ -63,10 +63,8 @@ KNOWN_CYCLES = [
     {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.join_panels"},
     # FreeCAD workbench: the Flat pattern feature and the sheet-skin reader use each other
     {"ght_workbench.flat_pattern", "ght_workbench.sheet_skin"},
-    # the application: batch runs designs, design files read STEP through batch's helpers, the CLI
-    # runs both, and the demo (which the CLI runs) runs a design
-    {"ght_cad.batch", "ght_cad.cli", "ght_cad.demo", "ght_cad.design", "ght_cad.design.step_input",
-     "ght_cad.approximate_cli", "ght_cad.unfold_step"},
+    # the application: batch runs designs, design files read STEP through batch's helpers
+    {"ght_cad.batch", "ght_cad.design", "ght_cad.design.step_input"},
 ]
 
 
