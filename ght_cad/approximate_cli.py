@@ -16,15 +16,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
+from .design.approximate import (approximation_report, panel_pattern, panel_plates, plot_deviation,  # noqa: F401
+                                 report_markdown)
 from .errors import GHTError
 
-__all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown"]
+__all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
+           "panel_pattern", "panel_plates"]
 
 
 def add_parser(sub: Any, common: Callable[[argparse.ArgumentParser], None], epilog: str = "") -> None:
@@ -47,51 +49,15 @@ def add_parser(sub: Any, common: Callable[[argparse.ArgumentParser], None], epil
     sp.add_argument("--direction", choices=("auto", "u", "v"), default="auto",
                     help="parameter the rulings run along (default auto: least normal curvature)")
     sp.add_argument("--face", type=int, default=1, metavar="N", help="face number, 1-based in file order (default 1)")
+    sp.add_argument("--thickness", type=float, metavar="T",
+                    help="sheet thickness: panels.step holds one plate solid per panel and the flat patterns are "
+                         "the neutral surfaces at K*T from the panels (spec 6.1), as a design's [sheet]")
+    sp.add_argument("--k-factor", type=float, metavar="K", help="ANSI K-factor in [0, 1] (default 0.5; with --thickness)")
+    sp.add_argument("--din-k-factor", type=float, metavar="k", help="DIN k-factor k = 2K in [0, 2] (with --thickness)")
+    sp.add_argument("--side", choices=("normal", "reverse"),
+                    help="material along the panels' normal (normal, default) or against it (reverse)")
     common(sp)
     sp.set_defaults(func=cmd_approximate)
-
-
-def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
-    """PNG (900 × 700 px) of the signed deviation (panel minus target along the target normal)
-    over the target's (u, v), seams drawn as lines."""
-    from .plotting import _figure, _save
-
-    fig = _figure("surface")
-    ax = fig.add_subplot(1, 1, 1)
-    m = result.deviation_map
-    uv, d = m["uv"], m["d"]
-    lim = max(float(np.max(np.abs(d))), 1e-300)
-    sc = ax.scatter(uv[:, 0], uv[:, 1], c=d, s=6, cmap="coolwarm", vmin=-lim, vmax=lim)
-    fig.colorbar(sc, ax=ax, label="deviation (panel - target, along the normal)")
-    u0, u1, v0, v1 = result.info.get("bounds", (uv[:, 0].min(), uv[:, 0].max(), uv[:, 1].min(), uv[:, 1].max()))
-    for s in result.seams:
-        if result.direction == "v":
-            y = v0 + s["y"] * (v1 - v0)
-            ax.plot([u0, u1], [y, y], "k-", lw=0.6)
-        else:
-            x = u0 + s["y"] * (u1 - u0)
-            ax.plot([x, x], [v0, v1], "k-", lw=0.6)
-    ax.set_xlabel("u")
-    ax.set_ylabel("v")
-    ax.set_title(title or f"{len(result.panels)} panels, max deviation {result.max_deviation:.4g} (tol {result.tol:g})")
-    return _save(fig, path)
-
-
-def report_markdown(report: dict[str, Any]) -> str:
-    """The report as a Markdown table."""
-    lines = [f"# Developable approximation: {report.get('name', 'target')}", "",
-             f"- panels: {report['panels']} (rulings along {report['direction']})",
-             f"- tolerance: {report['tol']:g}; largest deviation: {report['max_deviation']:.6g}",
-             f"- total area: {report['total_area']:.6g}", "",
-             "| panel | max out | max in | theta_max (deg) | area | flat area |",
-             "|---|---|---|---|---|---|"]
-    for p in report["panel_report"]:
-        lines.append(f"| P{p['index']} | {p['max_out']:.4g} | {p['max_in']:.4g} | {p['theta_max_deg']:.2e} | "
-                     f"{p['area']:.8g} | {p.get('flat_area', float('nan')):.8g} |")
-    files = report.get("files")
-    if files:
-        lines += ["", "Files: " + ", ".join(files)]
-    return "\n".join(lines) + "\n"
 
 
 def _json_default(o: Any) -> Any:
@@ -102,24 +68,32 @@ def _json_default(o: Any) -> Any:
     raise TypeError(type(o).__name__)
 
 
-def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str = "mm") -> dict[str, Any]:
+def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str = "mm",
+                  sheet: Any = None) -> dict[str, Any]:
     """Write panels.step, flat.dxf, flat.svg, deviation.png, report.json and report.md into the
-    open :class:`ght_cad.outdir.OutputFolder` ``folder``; returns the report dict."""
+    open :class:`ght_cad.outdir.OutputFolder` ``folder``; returns the report dict. With a sheet of
+    T > 0 the STEP file holds one plate solid per panel and the flat patterns are the neutral
+    surfaces (:func:`panel_plates`, :func:`panel_pattern`)."""
     from .cad.approximate import panels_shell
     from .cad.occ import write_step
     from .io import atomic_write
 
-    shell = panels_shell(result)
-    write_step(shell, folder.path("panels.step"), units=units)
-    pattern = result.flat_pattern(units=units)
+    if sheet is not None and not sheet.is_zero:
+        from .cad.sheet_solid import write_plate_step
+
+        plates = panel_plates(result, sheet, name)
+        write_plate_step(plates, folder.path("panels.step"), units=units, product=name)
+    else:
+        write_step(panels_shell(result), folder.path("panels.step"), units=units)
+    pattern = panel_pattern(result, sheet, units=units)
     pattern.export_dxf(folder.path("flat.dxf"))
     pattern.export_svg(folder.path("flat.svg"))
     plot_deviation(result, folder.path("deviation.png"), title=None)
-    report = result.as_dict()
-    report["name"] = name
-    for p, fp in zip(report["panel_report"], pattern.panels):
-        p["flat_area"] = float(fp.area_flat)
-        p["label"] = fp.label
+    report = approximation_report(result, pattern, name=name)
+    if sheet is not None:
+        report["sheet"] = sheet.as_dict()
+        if not sheet.is_zero:
+            report["plate"] = {"solids": len(plates), "volume": float(sum(p.volume for p in plates))}
     names = ["panels.step", "flat.dxf", "flat.svg", "deviation.png", "report.json", "report.md"]
     report["files"] = names
     report["tool"] = "ght-cad"
@@ -132,9 +106,10 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
 
 def cmd_approximate(args: argparse.Namespace) -> int:
     """``ght-cad approximate TARGET.step --tol T --out DIR``."""
-    from .cad.approximate import approximate_face
-    from .cad.occ import read_step
+    from .approximation import approximate
+    from .cad.approximate import step_target
     from .outdir import OutputFolder
+    from .sheet import make_sheet
 
     path = Path(args.target)
     if path.suffix.lower() not in (".step", ".stp"):
@@ -143,14 +118,14 @@ def cmd_approximate(args: argparse.Namespace) -> int:
         raise FileNotFoundError(2, "No such file", str(path))
     if not (isinstance(args.tol, float) and np.isfinite(args.tol) and args.tol > 0):
         raise GHTError(f"{path}: --tol={args.tol!r} is not allowed; it must be a length > 0")
-    shape = read_step(path)
     try:
-        result = approximate_face(shape, args.tol, face=args.face - 1, max_panels=args.max_panels,
-                                  direction=args.direction)
+        sheet = make_sheet(args.thickness, args.k_factor, din_k_factor=args.din_k_factor, side=args.side or "normal")
+        result = approximate(step_target(path, args.face - 1), args.tol, max_panels=args.max_panels,
+                             direction=args.direction)
     except GHTError as exc:
         raise GHTError(f"{path}: {exc}") from None
     with OutputFolder(args.out) as folder:
-        report = write_outputs(result, folder, name=path.stem)
+        report = write_outputs(result, folder, name=path.stem, sheet=sheet)
         folder.commit()
     summary = {"command": "approximate", "target": str(path), "panels": report["panels"], "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}

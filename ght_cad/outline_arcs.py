@@ -156,6 +156,14 @@ def _fit_pieces(evaluate: Callable[[np.ndarray], np.ndarray], t0: np.ndarray, t1
         pm, pq = pts[:n], pts[n:].reshape(n, _CHECK.size, 2)
         b = three_point_bulge(p0, pm, p1)
         dev = bulge_deviation(p0, p1, b, pq).max(axis=1)
+        # a piece on which the edge stands still (a fan's apex inside an edge: its points are rounding
+        # noise, their 3-point arc any bulge at all): every point within tol/10 of p0 -> a line, which
+        # then lies within tol/10 of every point
+        still = np.max(np.abs(np.concatenate([pm[:, None], pq, p1[:, None]], axis=1) - p0[:, None]), axis=(1, 2)) \
+            <= 0.05 * tol
+        if still.any():
+            b = np.where(still, 0.0, b)
+            dev = np.where(still, bulge_deviation(p0, p1, b, pq).max(axis=1), dev)
         ok = (dev <= _SAFETY * tol) & (np.abs(b) <= _MAX_BULGE)
         ok |= h <= 1e-15  # nothing left to split (a stationary or singular spot): keep as is
         if ok.any():

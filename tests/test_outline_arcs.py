@@ -169,3 +169,25 @@ def test_bad_chord_tolerance_is_refused() -> None:
     for bad in (0.0, -1e-3, math.inf, math.nan):
         with pytest.raises(GHTError, match="chord_tol"):
             arc_chain(lambda t: np.stack([t, t], axis=1), bad, 1.0)
+
+
+def test_edge_standing_still_over_a_parameter_range() -> None:
+    """An edge that stands still on part of its range (a loft's fan apex inside the edge of an
+    approximation panel: the development's points there are rounding noise, ~1e-13): the still part
+    becomes straight segments, the rest arcs, all within the chord tolerance (before: 131072
+    pieces and a refusal, 'chord_tol cannot be met')."""
+    rng = np.random.default_rng(3)
+
+    def fn(t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        s = np.clip((t - 0.3) / 0.7, 0.0, 1.0)
+        p = np.stack([300.0 * np.sin(1.2 * s) + 40 * s * s, 300.0 * (1 - np.cos(1.2 * s))], 1)
+        return p + 1e-13 * rng.standard_normal(p.shape)
+
+    tol = 1e-3
+    ch = arc_chain(fn, tol, 400.0, [0.3])
+    assert ch.kind == "curve"
+    q = fn(np.linspace(0, 1, 4001))
+    assert chain_distance(q, ch.points, ch.bulges).max() <= tol
+    assert np.allclose(ch.points[0], fn(np.array([0.0]))[0], atol=1e-9)
+    assert np.allclose(ch.points[-1], fn(np.array([1.0]))[0], atol=1e-9)

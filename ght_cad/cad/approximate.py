@@ -24,7 +24,7 @@ from ..errors import ConversionError, GHTError
 from .occ import is_valid, make_face
 from .unroll_faces import _open_face, shape_faces
 
-__all__ = ["face_target", "approximate_face", "panel_faces", "panels_shell"]
+__all__ = ["face_target", "shape_target", "step_target", "approximate_face", "panel_faces", "panels_shell"]
 
 
 def face_target(face: Any) -> SurfaceTarget:
@@ -62,16 +62,36 @@ def _unperiodic(ad: Any, bounds: tuple[float, float, float, float]) -> Any:
     return ev if getattr(ev, "_nurbs", None) is not None else None
 
 
+def shape_target(shape: Any, face: int = 0) -> SurfaceTarget:
+    """:func:`face_target` of face number ``face`` (0-based, in ``TopExp`` order) of a shape.
+
+    Raises:
+        GHTError: ``face`` out of range (the message starts ``face=``).
+    """
+    faces = shape_faces(shape)
+    if isinstance(face, bool) or not isinstance(face, int) or not 0 <= face < len(faces):
+        raise GHTError(f"face={face!r} is not allowed; the shape has {len(faces)} face(s): use 0..{len(faces) - 1}")
+    return face_target(faces[face])
+
+
+def step_target(path: Any, face: int = 0) -> SurfaceTarget:
+    """:func:`shape_target` of a STEP file (``ght-cad approximate`` and the design files' STEP targets).
+
+    Raises:
+        GHTError: an unreadable file, or ``face`` out of range.
+    """
+    from .occ import read_step
+
+    return shape_target(read_step(path), face)
+
+
 def approximate_face(shape: Any, tol: float, *, face: int = 0, **options: Any) -> ApproximationResult:
     """:func:`ght_cad.approximate` of face number ``face`` (0-based, in ``TopExp`` order) of a shape.
 
     Raises:
         GHTError: ``face`` out of range, or as :func:`ght_cad.approximate`.
     """
-    faces = shape_faces(shape)
-    if isinstance(face, bool) or not isinstance(face, int) or not 0 <= face < len(faces):
-        raise GHTError(f"face={face!r} is not allowed; the shape has {len(faces)} face(s): use 0..{len(faces) - 1}")
-    return approximate(face_target(faces[face]), tol, **options)
+    return approximate(shape_target(shape, face), tol, **options)
 
 
 def panel_faces(result: ApproximationResult) -> list[Any]:

@@ -109,6 +109,8 @@ def _initial_shape(design: Design, curves: dict[str, Any]) -> dict[str, float]:
     assert spec is not None
     if spec.type == "planes":
         return {"mu": spec.mu, "nu": spec.nu, "gamma": spec.gamma}
+    if spec.type == "approximate":  # no shape parameters of its own (ght_cad.approximate fits them)
+        return {}
     if spec.type == "composite":
         return {f"{g.name}.{k}": float(getattr(g, k)) for g in spec.segments or [] for k in SHAPE_NAMES}
     out = {}
@@ -129,6 +131,10 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
         )
     if spec.type == "composite":
         return _make_composite(design, shape)
+    if spec.type == "approximate":
+        from .approximate import build_approximation
+
+        return build_approximation(spec, design.source)
     ca = curves[spec.curve_a].with_shape(shape["a.mu"], shape["a.nu"], shape["a.gamma"])
     cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
     if spec.type == "rails":
@@ -194,8 +200,17 @@ def _is_composite(surface: Any) -> bool:
 
 def sheet_parts(surface: Any) -> list[Any]:
     """The ruled surfaces a ``[sheet]`` is checked on and thickened: every strip of a composite,
-    else the surface itself (a developable loft as a whole, fans included)."""
+    every panel of an approximation (its exact developable), else the surface itself (a
+    developable loft as a whole, fans included)."""
+    if _is_approximation(surface):
+        return list(surface.parts)
     return list(surface.segments) if _is_composite(surface) else [surface]
+
+
+def _is_approximation(surface: Any) -> bool:
+    from .approximate import is_approximation
+
+    return is_approximation(surface)
 
 
 def sheet_part_label(design: Design, i: int) -> str:
@@ -289,7 +304,10 @@ def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int
 
 def _developability_dict(surface: Any) -> dict[str, float]:
     """Developability degree of a surface; for a composite the worst strip per quantity
-    (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed)."""
+    (θ_max and residual max, θ_rms as the root mean square over strips, DD min, R summed); for an
+    approximation the worst panel likewise."""
+    if _is_approximation(surface):
+        return _worst([p.developability().as_dict() for p in surface.parts])
     if not _is_composite(surface):
         return surface.developability().as_dict()
     return _worst([d.as_dict() for d in surface.developability()])
@@ -361,6 +379,8 @@ def surface_view(built: "BuiltSurface | Sequence[BuiltSurface]") -> Any:
         if len(built) == 1:
             return surface_view(built[0])
         return _StackedView([surface_view(b) for b in built])
+    if _is_approximation(built.surface):  # panels side by side across the rulings, sharing their seams
+        return _StackedView(built.surface.parts)
     return _CompositeView(built.surface) if _is_composite(built.surface) else built.surface
 
 
@@ -435,6 +455,8 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
     s = built.surface
     if _is_composite(s):
         return _composite_summary(built)
+    if _is_approximation(s):
+        return _approximation_summary(built)
     dev = s.developability()
     out: dict[str, Any] = {
         "surface": {
@@ -458,6 +480,31 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
         loft["curve_a"], loft["curve_b"] = spec.curve_a, spec.curve_b
         out["surface"]["loft"] = loft
     return out
+
+
+def _approximation_summary(built: BuiltSurface) -> dict[str, Any]:
+    """``report["surface"]`` and ``report["developability"]`` of an ``approximate`` surface: area,
+    ruling lengths, the worst panel's developability and ``surface.approximation``
+    (:func:`ght_cad.design.approximate.approximation_report`: per panel max deviation out/in,
+    θ_max, area; the panel count and largest deviation)."""
+    from .approximate import approximation_report
+
+    s = built.surface
+    u = np.linspace(0, 1, 257)
+    lengths = np.concatenate([np.asarray(p.ruling_lengths(u), dtype=float) for p in s.parts])
+    res = approximation_report(s.result, name=built.design.name)
+    res.pop("info", None)
+    return {
+        "surface": {
+            "type": "approximate",
+            "shape_parameters": {},
+            "area_3d": float(res["total_area"]),
+            "ruling_length_min": float(lengths.min()),
+            "ruling_length_max": float(lengths.max()),
+            "approximation": res,
+        },
+        "developability": _developability_dict(s),
+    }
 
 
 def surfaces_summary(builts: Sequence[BuiltSurface]) -> dict[str, Any]:

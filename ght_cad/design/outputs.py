@@ -11,7 +11,7 @@ from typing import Any, Iterable, Sequence
 
 import numpy as np
 
-from .build import (BuiltSurface, _is_composite, build_curves, build_surfaces, sheet_part_label, sheet_parts, surfaces_summary,
+from .build import (BuiltSurface, _is_approximation, _is_composite, build_curves, build_surfaces, sheet_part_label, sheet_parts, surfaces_summary,
                     surface_view)
 from .schema import Design, DesignError
 
@@ -54,6 +54,10 @@ def brep_shape(built: BuiltSurface, tol: float | None = None) -> Any:
         from ..cad.developable_faces import composite_shell
 
         return composite_shell(built.surface, tol=tol)
+    if _is_approximation(built.surface):  # the shell ght-cad approximate writes
+        from ..cad.approximate import panels_shell
+
+        return panels_shell(built.surface.result)
     return brep_face(built, tol)
 
 
@@ -159,6 +163,11 @@ def unroll_surface(built: BuiltSurface) -> Any:
 
     d = built.design
     sheet = d.sheet.to_sheet() if d.sheet is not None else None  # [sheet]: the neutral surface (spec 6.1)
+    if _is_approximation(built.surface):  # the panels of ght-cad approximate, seams marked
+        from .approximate import panel_pattern
+
+        return panel_pattern(built.surface.result, sheet, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
+                             samples=d.unroll.samples, units=d.units)
     if _is_composite(built.surface):
         from ..unroll import unroll_composite
 
@@ -180,7 +189,11 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
 
     sheet = d.sheet.to_sheet()
     # the parts and labels of check_sheet (the optimizer's sheet rule is the same check on the same parts)
-    return [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
+    plates = [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
+    if _is_approximation(built.surface):  # named as the panels of the flat pattern: P1.inside, ...
+        for i, p in enumerate(plates):
+            p.name = f"P{i + 1}"
+    return plates
 
 
 def design_plates(builts: Sequence[BuiltSurface]) -> tuple[list[Any], Any]:

@@ -124,8 +124,8 @@ def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: 
                      final: dict[str, Any] | None) -> list[str]:
     """Type, shape parameters, area, ruling lengths and the developability table of one surface;
     for a ``rails`` loft also its segments, fan share and edge of regression."""
-    L = [f"## {title}", "", f"Type: `{s['type']}` · shape parameters: "
-         + ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
+    shape = ", ".join(f"{k} = {v:.6g}" for k, v in s["shape_parameters"].items())
+    L = [f"## {title}", "", f"Type: `{s['type']}`" + (f" · shape parameters: {shape}" if shape else "")
          + f" · area {s['area_3d']:.9g} {r['units']}² · ruling length {s['ruling_length_min']:.6g}–"
          f"{s['ruling_length_max']:.6g} {r['units']}", ""]
     L += ["### Developability degree (spec section 5)", "", "| | θ_max [deg] | θ_rms [deg] | DD | R |", "|---|---|---|---|---|"]
@@ -151,8 +151,13 @@ def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: 
 
 
 def _strips_section(s: dict[str, Any]) -> list[str]:
-    """The strips and joints tables of a composite surface (nothing for other types)."""
+    """The strips and joints tables of a composite surface, the panel table of an approximation
+    (:func:`ght_cad.design.approximate.report_markdown`); nothing for other types."""
     L: list[str] = []
+    if s.get("approximation"):
+        from .approximate import report_markdown as approximation_markdown
+
+        L += approximation_markdown(s["approximation"], heading="###").splitlines() + [""]
     if s.get("strips"):
         L += ["### Strips", "", "| strip | μ | ν | γ | area | θ_max [deg] | DD |", "|---|---|---|---|---|---|---|"]
         for x in s["strips"]:

@@ -18,7 +18,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..errors import GHTError
-from .build import (GHT_DEFINITION, _developability_dict, _is_composite, build_curves, build_surface, build_surfaces,
+from .build import (GHT_DEFINITION, _developability_dict, _is_approximation, _is_composite, build_curves, build_surface, build_surfaces,
                     check_sheet, surface_summary, surface_view, surfaces_summary)
 from .optimize import optimize_design
 from .outputs import (_jsonable, brep_shapes, curve_edges, pattern_report, plate_solids, plot_pattern, shared_edge_count,
@@ -303,6 +303,12 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             step("flat pattern")
             pattern = unroll_surfaces(builts)
             report["flat_pattern"] = pattern_report(pattern)
+            if built is not None and _is_approximation(built.surface):  # every panel's flat area and label
+                from .approximate import approximation_report
+
+                report["surface"]["approximation"] = approximation_report(built.surface.result, pattern,
+                                                                          name=design.name)
+                report["surface"]["approximation"].pop("info", None)
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]), chord_tol=chord_tol)
             if "svg" in want_files:
@@ -350,6 +356,10 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
             plot_pattern(pattern, stage.path(FIGURE_NAMES["flat_pattern"]), title=design.name)
             if pattern.sheet is not None:  # roll-bending chart of the sheet's bend lines
                 pattern.plot_roll_chart(stage.path("forming.png"), title=f"{design.name}: roll bending")
+        if "deviation" in want_figs and built is not None and _is_approximation(built.surface):
+            from .approximate import plot_deviation  # the map ght-cad approximate draws
+
+            plot_deviation(built.surface.result, stage.path(FIGURE_NAMES["deviation"]))
         if "convergence" in want_figs and opt is not None:
             P.plot_convergence({f"{opt.method} ({opt.objective})": opt.history},
                                stage.path(FIGURE_NAMES["convergence"]), title=f"{design.name}: optimizer convergence")

@@ -21,7 +21,7 @@ FILE_OUTPUTS = ("step", "dxf", "svg", "json", "md")
 
 
 #: figures a design may request (PNG)
-FIGURE_OUTPUTS = ("basis", "curve", "curvature", "surface", "flat_pattern", "convergence")
+FIGURE_OUTPUTS = ("basis", "curve", "curvature", "surface", "flat_pattern", "convergence", "deviation")
 
 
 #: optimizers
@@ -38,7 +38,13 @@ STRIP_OBJECTIVES = ("R",)
 #: objectives of a ``rails`` surface (the developable loft, :data:`ght_cad.loft.LOFT_OBJECTIVES`) and their
 #: weighted sum ``w0 fan_share + w1 fairness + w2 regression``
 RAILS_OBJECTIVES = ("fan_share", "fairness", "regression", "weighted")
-SURFACE_TYPES = ("planes", "curves", "rails", "composite")
+SURFACE_TYPES = ("planes", "curves", "rails", "composite", "approximate")
+#: the parameter the rulings of an ``approximate`` surface run along (:func:`ght_cad.approximate`)
+APPROX_DIRECTIONS = ("auto", "u", "v")
+#: largest ``max_panels`` of an ``approximate`` surface (each panel is a developable loft)
+MAX_APPROX_PANELS = 256
+#: largest degree of an inline NURBS target (and rows/columns of a target net: :data:`MAX_ROWS`)
+MAX_TARGET_DEGREE = 25
 #: orientations of the second rail of a ``rails`` surface (:func:`ght_cad.developable_loft`)
 RAIL_ORIENTATIONS = ("auto", "same", "reversed")
 
@@ -154,6 +160,31 @@ class SurfaceSpec:
     #: ``[surfaces.sheet]``: this surface's overrides of the design's ``[sheet]`` (any of
     #: ``thickness``, ``k_factor``, ``side``; None: the design's sheet as it is)
     sheet: dict[str, Any] | None = None
+    #: ``type = "approximate"``: the target (:class:`TargetSpec`), the tolerance (both ways, in the
+    #: design's unit), the largest panel count and the parameter the rulings run along
+    target: "TargetSpec | None" = None
+    tol: float = 0.0
+    max_panels: int = 64
+    direction: str = "auto"
+
+
+@dataclass
+class TargetSpec:
+    """The target of an ``approximate`` surface (``[surfaces.target]``): a face of a STEP file
+    (``step``: path relative to the design file, ``face``: 1-based), a GHT patch (``control_points``
+    net (m+1) x (n+1) x 3 and ``mu_u`` ... ``gamma_v``) or a NURBS patch (``poles`` net, ``knots_u``,
+    ``knots_v``, ``degree_u``, ``degree_v``, optional ``weights``)."""
+
+    kind: str  # "step", "ght" or "nurbs"
+    step: str | None = None
+    face: int = 1
+    control_points: list[list[list[float]]] | None = None
+    shape: dict[str, float] = field(default_factory=dict)
+    knots_u: list[float] | None = None
+    knots_v: list[float] | None = None
+    degree_u: int = 3
+    degree_v: int = 3
+    weights: list[list[float]] | None = None
 
 
 @dataclass
@@ -258,6 +289,9 @@ class Design:
         d.pop("source")
         for sd in [d["surface"] or {}] + d["surfaces"]:
             sd.pop("key", None)
+            if sd.get("type") != "approximate":  # the keys of an approximate surface only
+                for k in ("target", "tol", "max_panels", "direction"):
+                    sd.pop(k, None)
             if sd.get("sheet", 0) is None:  # no per-surface sheet overrides: as before
                 sd.pop("sheet")
         if d["sheet"] is not None:
@@ -522,6 +556,11 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     # surface(s)
     surfaces = _parse_surfaces(ck, data, curves)
     surface = surfaces[0] if len(surfaces) == 1 else None
+    approx = [s for s in surfaces if s.type == "approximate"]
+    if approx and len(surfaces) > 1:
+        raise ck.fail(f"{approx[0].key}.type", f"\"approximate\" covers its target with panels of its own and must be "
+                      f"the design's only surface (this design has {len(surfaces)}); allowed: one [[surfaces]] entry "
+                      "(or [surface]) of type \"approximate\", or other surface types together")
 
     # optimize
     optimize = None
@@ -531,6 +570,9 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
             raise ck.fail("optimize", ("needs a [surface] table to optimize" if not surfaces else
                                        f"optimizes one surface; this design has {len(surfaces)} [[surfaces]]; "
                                        "allowed: [optimize] with a single [surface] or [[surfaces]] entry"))
+        if surface.type == "approximate":
+            raise ck.fail("optimize", "an approximate surface is fitted and optimized by ght_cad.approximate itself; "
+                          "allowed: [optimize] with a planes, curves, rails or composite surface")
         ck.keys(ot, "optimize", ("method", "objective", "weights", "parameters", "population", "iterations", "seed"))
         method = ck.string(ot, "method", "optimize", "hybrid", choices=METHODS)
         objs = _objectives_for(surface.type)
@@ -625,6 +667,11 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
             raise ck.fail("outputs.figures", "'convergence' needs an [optimize] table; allowed without one: "
                           + ", ".join(f for f in FIGURE_OUTPUTS if f != "convergence"))
         outputs.figures = [f for f in outputs.figures if f != "convergence"]
+    if not approx:
+        if explicit_figs and "deviation" in outputs.figures:
+            raise ck.fail("outputs.figures", "'deviation' needs a surface of type \"approximate\"; allowed without one: "
+                          + ", ".join(f for f in FIGURE_OUTPUTS if f != "deviation"))
+        outputs.figures = [f for f in outputs.figures if f != "deviation"]
     if not curves:
         if explicit_figs and any(f in ("curve", "curvature") for f in outputs.figures):
             raise ck.fail("outputs.figures", "'curve' and 'curvature' need at least one [[curves]] entry; allowed without: "
@@ -754,6 +801,8 @@ def _parse_surface(ck: _Checker, st: dict, path: str, curves: list[CurveSpec]) -
         return SurfaceSpec("planes", planes, bplanes, **shape, normalize=normalize)  # type: ignore[arg-type]
     if stype == "composite":
         return _parse_composite(ck, st, path, extra)
+    if stype == "approximate":
+        return _parse_approximate(ck, st, path, extra)
     rails = stype == "rails"
     ck.keys(st, path, ("type", "curve_a", "curve_b") + (("orientation",) if rails else ()) + extra)
     names = sorted(c.name for c in curves)
@@ -769,6 +818,101 @@ def _parse_surface(ck: _Checker, st: dict, path: str, curves: list[CurveSpec]) -
         raise ck.fail(f"{path}.curve_b", f"{cb!r} equals curve_a; allowed: another 3-D curve")
     orientation = ck.string(st, "orientation", path, "auto", choices=RAIL_ORIENTATIONS) if rails else "auto"
     return SurfaceSpec(stype, curve_a=ca, curve_b=cb, orientation=orientation)
+
+
+_APPROX_KEYS = ("type", "target", "tol", "max_panels", "direction")
+#: the keys of ``[surfaces.target]`` by kind of target (the kind is told by its first key)
+TARGET_KEYS = {
+    "step": ("step", "face"),
+    "ght": ("control_points", "mu_u", "nu_u", "gamma_u", "mu_v", "nu_v", "gamma_v"),
+    "nurbs": ("poles", "weights", "knots_u", "knots_v", "degree_u", "degree_v"),
+}
+_TARGET_FIRST = {"step": "step", "ght": "control_points", "nurbs": "poles"}
+
+
+def _parse_approximate(ck: _Checker, st: dict, path: str, extra: tuple[str, ...] = ()) -> SurfaceSpec:
+    """``type = "approximate"`` at ``path``: ``tol`` (> 0), ``max_panels`` (1..256), ``direction``
+    (auto|u|v) and the ``[<path>.target]`` table (:func:`_parse_target`)."""
+    ck.keys(st, path, _APPROX_KEYS + extra)
+    tol = ck.number(st, "tol", path, required=True, lo=0.0, lo_open=True,
+                    allowed="a length > 0 (largest deviation both ways, in the design's unit)")
+    max_panels = ck.integer(st, "max_panels", path, 64, lo=1, hi=MAX_APPROX_PANELS)
+    direction = ck.string(st, "direction", path, "auto", choices=APPROX_DIRECTIONS)
+    target = _parse_target(ck, st, f"{path}.target")
+    return SurfaceSpec("approximate", target=target, tol=tol, max_panels=max_panels, direction=direction)
+
+
+def _parse_target(ck: _Checker, st: dict, tpath: str) -> TargetSpec:
+    """``[<surface>.target]``: ``step`` + ``face``, or a GHT patch (``control_points``), or a NURBS
+    patch (``poles``); exactly one of the three."""
+    forms = "step = \"FILE.step\" (+ face = N), control_points = [[[x, y, z], ...], ...] (a GHT patch) or " \
+            "poles = [[[x, y, z], ...], ...] with knots_u, knots_v, degree_u, degree_v (a NURBS patch)"
+    t = st.get("target")
+    if t is None:
+        raise ck.fail(tpath, f"missing; required: a table [{tpath.rsplit('[', 1)[0]}.target] with {forms}")
+    if not isinstance(t, dict):
+        raise ck.fail(tpath, f"expected a table with {forms}; got {_tname(t)} {_short(t)}")
+    kinds = [k for k, first in _TARGET_FIRST.items() if first in t]
+    if len(kinds) != 1:
+        what = "none of step, control_points, poles" if not kinds else " and ".join(_TARGET_FIRST[k] for k in kinds)
+        raise ck.fail(tpath, f"gives {what}; allowed: exactly one of {forms}")
+    kind = kinds[0]
+    ck.keys(t, tpath, TARGET_KEYS[kind])
+    if kind == "step":
+        step = ck.string(t, "step", tpath, required=True)
+        if Path(step).suffix.lower() not in (".step", ".stp"):
+            raise ck.fail(f"{tpath}.step", f"{step!r} is not allowed; allowed: a STEP file (.step/.stp), "
+                          "its path relative to the design file")
+        return TargetSpec("step", step=step, face=ck.integer(t, "face", tpath, 1, lo=1, hi=1_000_000))
+    if kind == "ght":
+        net = _net(ck, t, "control_points", tpath, 3, MAX_TARGET_DEGREE + 1)
+        shape = {k: ck.number(t, k, tpath, 0.0, lo=-1.0, hi=1.0) for k in TARGET_KEYS["ght"][1:]}
+        return TargetSpec("ght", control_points=net, shape=shape)
+    pu = ck.integer(t, "degree_u", tpath, 3, lo=1, hi=MAX_TARGET_DEGREE)
+    pv = ck.integer(t, "degree_v", tpath, 3, lo=1, hi=MAX_TARGET_DEGREE)
+    net = _net(ck, t, "poles", tpath, 2, MAX_ROWS)
+    nu, nv = len(net), len(net[0])
+    knots = []
+    for key, p, n in (("knots_u", pu, nu), ("knots_v", pv, nv)):
+        full = f"{tpath}.{key}"
+        v = ck.required(t, key, tpath, f"an array of {n + p + 1} non-decreasing numbers")
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                              and math.isfinite(x) for x in v):
+            raise ck.fail(full, f"expected an array of {n + p + 1} finite non-decreasing numbers, got {_tname(v)} {_short(v)}")
+        k = [float(x) for x in v]
+        if len(k) != n + p + 1 or any(b < a for a, b in zip(k, k[1:])) or not k[-p - 1] > k[p]:
+            raise ck.fail(full, f"{_short(k)} is not allowed; allowed: {n + p + 1} non-decreasing numbers ({n} poles "
+                          f"+ degree {p} + 1) with {key}[{p}] < {key}[{n}]")
+        knots.append(k)
+    weights = None
+    if "weights" in t:
+        weights = ck.matrix(t, "weights", tpath, cols=(nv,), min_rows=nu, max_rows=nu)
+        for i, row in enumerate(weights or []):
+            for j, w in enumerate(row):
+                if not w > 0:
+                    raise ck.fail(f"{tpath}.weights[{i}][{j}]", f"{w:g} is not allowed; allowed: a weight > 0")
+    return TargetSpec("nurbs", control_points=net, knots_u=knots[0], knots_v=knots[1], degree_u=pu, degree_v=pv,
+                      weights=weights)
+
+
+def _net(ck: _Checker, t: dict, key: str, tpath: str, least: int, most: int) -> list[list[list[float]]]:
+    """A net of points ``t[key]``: at least ``least`` and at most ``most`` rows of as many
+    ``[x, y, z]`` points each (the same count in every row)."""
+    full = f"{tpath}.{key}"
+    what = f"an array of {least}..{most} rows, each an array of {least}..{most} points [x, y, z] (the same count in every row)"
+    v = ck.required(t, key, tpath, what)
+    if not isinstance(v, list) or not all(isinstance(r, list) for r in v):
+        raise ck.fail(full, f"expected {what}, got {_tname(v)} {_short(v)}")
+    if not least <= len(v) <= most:
+        raise ck.fail(full, f"has {len(v)} rows; allowed: {what}")
+    net = []
+    for i, row in enumerate(v):
+        rows = ck.matrix({f"{key}[{i}]": row}, f"{key}[{i}]", tpath, cols=(3,), min_rows=least, max_rows=None)
+        assert rows is not None
+        if len(rows) > most or (net and len(rows) != len(net[0])):
+            raise ck.fail(f"{full}[{i}]", f"has {len(rows)} points; allowed: {what}")
+        net.append(rows)
+    return net
 
 
 def _composite_parameters(ck: _Checker, ot: dict, surface: SurfaceSpec) -> list[str]:
