@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._quadrature import leggauss
 from ..errors import NotDevelopableError
 from .rails import _det, _jet, as_rail
 
@@ -18,7 +19,7 @@ _EPS = np.finfo(float).eps
 CORNER_TOL = 1e-12
 #: parameter distance from a meeting corner within which ``g = b - a`` is integrated (no cancellation)
 CORNER_RADIUS = 1.0 / 32
-_CORNER_GL = np.polynomial.legendre.leggauss(16)
+_CORNER_GL = leggauss(16)
 #: relative size of a fan (in the rail parameter) below which the branch is taken to start or end
 #: at the corner (no fan)
 MIN_FAN = 1e-12
