@@ -10,7 +10,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .._validate import as_parameter_array
-from ..curve import gauss_legendre
+from .._quadrature import gauss_legendre
 from ..errors import GHTError
 from ..ruled import Developability, RuledSurface, regression_v
 from .equation import MIN_FAN, _EPS, _Pair

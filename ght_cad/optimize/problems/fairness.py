@@ -9,7 +9,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..._vec import cross as _cross
-from ...curve import GHTCurve, gauss_legendre
+from ..._quadrature import gauss_legendre
+from ...curve import GHTCurve
 from ...errors import GHTError
 from ...ruled import RuledSurface
 from .base import CurveParameterJets, FAIRNESS_MEASURES, PopulationBasis, Problem, SHAPE_NAMES, _split, population_basis

@@ -12,7 +12,8 @@ import numpy as np
 
 from ..._validate import is_real
 from ..._vec import cross as _cross3
-from ...curve import GHTCurve, gauss_legendre
+from ..._quadrature import gauss_legendre
+from ...curve import GHTCurve
 from ...errors import GHTError
 from ...loft.build import developable_loft
 from ...loft.equation import MIN_FAN

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..._vec import cross as _cross
 from ...basis import bernstein
-from ...curve import GHTCurve, gauss_legendre
+from ..._quadrature import gauss_legendre
+from ...curve import GHTCurve
 from ...errors import GHTError
 from ...ruled import CurvePairRuledSurface
 from .base import CurveParameterJets, PopulationBasis, Problem, SHAPE_NAMES, _split
