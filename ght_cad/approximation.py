@@ -34,6 +34,16 @@ Algorithm (all kernel-free, numpy/scipy):
    ``tol``, the march is repeated with a smaller ``f``; a result needing more than ``max_panels``
    panels raises :class:`ght_cad.errors.GHTError` naming the best deviation reached.
 
+4. **Loft or dual fit per strip** (``method="auto"``, spec 10.1): every strip also gets the dual
+   fit of the target's tangent planes along its middle curve (:mod:`ght_cad.approximation_dual`:
+   a GHT dual curve, spec 5.2, fitted by least squares, its μ, ν, γ optimized by
+   :func:`ght_cad.optimize.minimize`), trimmed to the strip: its boundary on the seam rows is a
+   seam ``S(x, y_j) + δ(x) n`` of the same family. Strips turn dual greedily where the dual seams
+   give a smaller sampled deviation and the strip and its neighbours get closer; a seam next to a
+   dual strip is that strip's trimmed boundary. Every panel is the loft between its two seams, so
+   neighbours share the seam curve exactly whatever their methods; if the mix misses ``tol`` the
+   all-loft set is built too and the better kept.
+
 Inputs that are developable already (a cone, a ght_cad loft) give one panel: the first march step
 tries the whole box.
 """
@@ -503,6 +513,11 @@ class Panel:
         theta_max_deg: the developability measure θ_max of the panel (degrees).
         area: 3-D area.
         exact: the exact developable (a :class:`ght_cad.loft.DevelopableLoft` or :class:`ConeStrip`).
+        method: ``"loft"`` (seams centred by the offsets of step 2) or ``"dual"`` (seams = the
+            trimmed boundary of the strip's dual fit, :mod:`ght_cad.approximation_dual`).
+        choice: how the method was chosen: the sampled deviations of both candidates
+            (``deviation_loft``, ``deviation_dual``), the dual fit's μ, ν, γ and its deviation at
+            ``μ = ν = γ = 0`` and after optimization (``dual_start``, ``dual_optimized``).
     """
 
     surface: Any
@@ -514,9 +529,14 @@ class Panel:
     theta_max_deg: float = math.nan
     area: float = math.nan
     exact: Any = None
+    method: str = "loft"
+    choice: dict[str, Any] = field(default_factory=dict)
 
-    def as_dict(self) -> dict[str, float]:
-        return {k: float(getattr(self, k)) for k in ("y0", "y1", "max_out", "max_in", "max_deviation", "theta_max_deg", "area")}
+    def as_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {k: float(getattr(self, k)) for k in ("y0", "y1", "max_out", "max_in", "max_deviation", "theta_max_deg", "area")}
+        d["method"] = self.method
+        d.update(self.choice)
+        return d
 
 
 @dataclass
@@ -680,6 +700,77 @@ def _offsets(frame: _Frame, ys: list[float], degree: int, iters: int) -> list[_S
     return seams
 
 
+def _strip_dev(frame: _Frame, A: _Seam, B: _Seam) -> float:
+    """Sampled one-way deviation ``max |d|`` of the loft between two seams (the march's ruling
+    samples); ``inf`` where the rulings cannot be found."""
+    try:
+        lo, hi = _strip_range(frame, A, B)
+    except (GHTError, FloatingPointError, ValueError):
+        return math.inf
+    v = max(-lo, hi)
+    return v if math.isfinite(v) else math.inf
+
+
+def _dual_seams(frame: _Frame, loft: list[_Seam], duals: list[Any], chosen: list[bool]) -> list[_Seam]:
+    r"""Seams of a method mix: seam j is the trimmed boundary ``δ_j = h(x, y_j)`` of the dual fit of
+    the chosen neighbouring strip (the mean of the two Chebyshev series when both neighbours are
+    dual), else the loft seam of step 2. Every panel is then the loft between its two seams, so
+    neighbours share the seam curve exactly whatever their methods."""
+    out = []
+    for j, sm in enumerate(loft):
+        props = []
+        if j - 1 >= 0 and chosen[j - 1]:
+            props.append(duals[j - 1].delta_hi)
+        if j < len(chosen) and chosen[j]:
+            props.append(duals[j].delta_lo)
+        if not props or sm.point:
+            out.append(sm)
+            continue
+        c = np.zeros(max(p.size for p in props))
+        for p in props:
+            c[: p.size] += p / len(props)
+        out.append(_Seam(frame, sm.y, c))
+    return out
+
+
+def _choose_methods(frame: _Frame, loft: list[_Seam], duals: list[Any], method: str) -> tuple[list[bool], list[dict[str, float]]]:
+    r"""Per strip: loft or dual (module doc, step 4). ``method="dual"``: every strip whose dual fit
+    is usable. ``"auto"``: greedy by gain ``e_loft - e_dual`` (sampled deviations of the loft
+    between the loft seams and between the dual fit's own trimmed seams); a strip turns dual only if
+    the largest deviation of it and its two neighbours (whose shared seams change) goes down, and
+    never beside a strip that is dual already (its seams would be averaged)."""
+    n = len(duals)
+    e_loft = [_strip_dev(frame, A, B) for A, B in zip(loft[:-1], loft[1:])]
+    e_dual = []
+    for i, d in enumerate(duals):
+        if d is None or not d.ok:
+            e_dual.append(math.inf)
+            continue
+        A = loft[i] if loft[i].point else _Seam(frame, loft[i].y, d.delta_lo)
+        B = loft[i + 1] if loft[i + 1].point else _Seam(frame, loft[i + 1].y, d.delta_hi)
+        e_dual.append(_strip_dev(frame, A, B))
+    info = [{"deviation_loft": e_loft[i], "deviation_dual": e_dual[i]} for i in range(n)]
+    if method == "dual":
+        return [bool(d is not None and d.ok and math.isfinite(e_dual[i])) for i, d in enumerate(duals)], info
+    chosen = [False] * n
+    cur = list(e_loft)
+    for i in sorted(range(n), key=lambda k: e_dual[k] - e_loft[k]):
+        if not e_dual[i] < e_loft[i]:
+            break
+        if (i > 0 and chosen[i - 1]) or (i + 1 < n and chosen[i + 1]):
+            continue
+        trial = chosen.copy()
+        trial[i] = True
+        seams = _dual_seams(frame, loft, duals, trial)
+        near = [k for k in (i - 1, i, i + 1) if 0 <= k < n]
+        new = {k: (e_dual[i] if k == i else _strip_dev(frame, seams[k], seams[k + 1])) for k in near}
+        if max(new.values()) < max(cur[k] for k in near):
+            chosen = trial
+            for k, v in new.items():
+                cur[k] = v
+    return chosen, info
+
+
 def _build_panel(frame: _Frame, A: _Seam, B: _Seam) -> Any:
     if B.point:
         return ConeStrip(A.rail(), B.eval(np.array([0.5]), 0)[0][0])
@@ -797,6 +888,10 @@ def approximate(
     offset_degree: int = 4,
     offset_iterations: int = 2,
     safety: float = 0.9,
+    method: str = "auto",
+    optimizer: str | None = "igwo",
+    optimizer_budget: int = 60,
+    dual_degree: int = 10,
     progress: Callable[[str], None] | None = None,
 ) -> ApproximationResult:
     r"""Cover ``target`` with exactly developable panels within ``tol`` (module doc).
@@ -817,6 +912,12 @@ def approximate(
         offset_degree: Chebyshev degree of the seam offsets δ_j(t) (0: constant).
         offset_iterations: fixed-point iterations of the offsets.
         safety: the march's share ``f`` of the deviation budget (lowered by 7 % per retry).
+        method: ``"auto"`` (per strip the closer of the loft and the dual fit of the tangent
+            planes, step 4), ``"loft"`` or ``"dual"`` (the dual fit wherever it is usable).
+        optimizer: :func:`ght_cad.optimize.minimize` method for each dual fit's μ, ν, γ
+            (``"igwo"``, ``"pso"``, ``"hybrid"``, ...), or None to keep ``μ = ν = γ = 0``.
+        optimizer_budget: objective evaluations per strip for that optimizer.
+        dual_degree: degree m of the fitted dual curves.
         progress: called with a line of text per step (e.g. ``print``).
 
     Returns:
@@ -835,6 +936,14 @@ def approximate(
     _check_number("safety", safety, 0.05)
     if direction not in ("auto", "u", "v"):
         raise GHTError(f"direction={direction!r} is not allowed; use 'auto', 'u' or 'v'")
+    if method not in ("auto", "loft", "dual"):
+        raise GHTError(f"method={method!r} is not allowed; use 'auto', 'loft' or 'dual'")
+    _check_number("optimizer_budget", optimizer_budget, 1, integer=True)
+    _check_number("dual_degree", dual_degree, 3, integer=True)
+    if optimizer is not None:
+        from .approximation_dual import check_optimizer
+
+        check_optimizer(optimizer)
     from .developable import developable_bspline
 
     say = progress or (lambda s: None)
@@ -859,18 +968,56 @@ def approximate(
         if n > max_panels:
             history.append({"f": f, "panels": n, "max_deviation": None})
             break
-        seams = _offsets(frame, ys, offset_degree, offset_iterations)
-        panels = []
-        maps = []
-        for A, B in zip(seams[:-1], seams[1:]):
-            exact = _build_panel(frame, A, B)
-            data = developable_bspline(exact, tol=1e-7 * frame.size, degree=5)
-            surf = BSplineRuled(data)
-            out, inn, mp = _measure_panel(frame, surf, A, B)
-            th = data.info.get("theta_max_deg", math.nan)
-            panels.append(Panel(surf, A.y, B.y, out, inn, max(out, inn), float(th) if math.isfinite(th) else 0.0,
-                                exact=exact))
-            maps.append(mp)
+        loft_seams = _offsets(frame, ys, offset_degree, offset_iterations)
+        chosen = [False] * n
+        duals: list[Any] = []
+        choice = [{} for _ in range(n)]
+        if method != "loft":
+            from .approximation_dual import fit_strip
+
+            for A, B in zip(loft_seams[:-1], loft_seams[1:]):
+                try:
+                    duals.append(fit_strip(frame, A.y, B.y, degree=dual_degree, optimizer=optimizer,
+                                           max_nfev=optimizer_budget, closed=frame.closed_x))
+                except (GHTError, FloatingPointError, ValueError, np.linalg.LinAlgError):
+                    duals.append(None)
+            chosen, choice = _choose_methods(frame, loft_seams, duals, method)
+            for c, d in zip(choice, duals):
+                if d is not None:
+                    c.update({"dual_ok": d.ok, "dual_reason": d.reason, "mu": d.params[0], "nu": d.params[1],
+                              "gamma": d.params[2], "dual_start": d.half_range_start, "dual_optimized": d.half_range})
+            say(f"  dual fits usable: {sum(1 for d in duals if d is not None and d.ok)}/{n}; chosen: {sum(chosen)}")
+        mixes = [(_dual_seams(frame, loft_seams, duals, chosen), chosen)] if any(chosen) else []
+        mixes.append((loft_seams, [False] * n))
+        best_mix = None
+        for seams, ch in mixes:
+            panels, maps = [], []
+            try:
+                for i, (A, B) in enumerate(zip(seams[:-1], seams[1:])):
+                    exact = _build_panel(frame, A, B)
+                    if ch[i] and getattr(getattr(exact, "report", None), "regression", None):
+                        raise GHTError(f"the dual panel {i + 1} contains its edge of regression")
+                    data = developable_bspline(exact, tol=1e-7 * frame.size, degree=5)
+                    surf = BSplineRuled(data)
+                    out, inn, mp = _measure_panel(frame, surf, A, B)
+                    th = data.info.get("theta_max_deg", math.nan)
+                    panels.append(Panel(surf, A.y, B.y, out, inn, max(out, inn), float(th) if math.isfinite(th) else 0.0,
+                                        exact=exact, method="dual" if ch[i] else "loft", choice=dict(choice[i])))
+                    maps.append(mp)
+            except GHTError as exc:
+                say(f"  mix refused: {exc}")
+                continue
+            w = max(p.max_deviation for p in panels)
+            if best_mix is None or w < best_mix[0]:
+                best_mix = (w, panels, maps, seams)
+            if w <= tol:
+                break
+        if best_mix is None:  # no developable between some seams: a finer march
+            history.append({"f": f, "panels": n, "max_deviation": None, "error": "no developable between the seams"})
+            panels = []
+            f *= 0.93
+            continue
+        _, panels, maps, seams = best_mix
         worst = max(p.max_deviation for p in panels)
         history.append({"f": f, "panels": n, "max_deviation": worst})
         say(f"  {n} panels, max deviation {worst:.4g} (tol {tol:.4g})")
@@ -895,6 +1042,7 @@ def approximate(
     for p in panels:
         p.area = p.surface.area()
     dmap = {k: np.concatenate([m[k] for m in maps]) for k in maps[0]}
+    info["methods"] = [p.method for p in panels]
     info["seconds"] = time.perf_counter() - t0
     seam_info = [{"y": s.y, "delta": [float(c) for c in s.coef], "point": s.point} for s in seams]
     return ApproximationResult(panels, tol, direction, frame.size, max(p.max_deviation for p in panels), dmap, seam_info, info)

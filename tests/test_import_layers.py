@@ -39,8 +39,9 @@ _LAYER_OF = {
     "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
     "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "pattern", "faces", "developables", "join_panels",
-                 "outline_arcs", "blank", "approximation"],
-    "optimize": ["optimize"],
+                 "outline_arcs", "blank"],
+    # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
+    "optimize": ["optimize", "approximation", "approximation_dual"],
     "kernel": ["cad"],
     "app": ["cli", "commands", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
 }
