@@ -50,7 +50,7 @@ def bump_target(amp: float, width: float = 0.1, R1: float = 800.0, R2: float = 4
 def test_dual_fit_chosen_where_closer():
     # a sharp bump of cross curvature (4x at mid-length): the loft between the centred seams
     # (offsets of Chebyshev degree 4) deviates 6.36 > tol; the dual fit's trimmed seams give 5.61
-    res = approximate(bump_target(3.0), 6.0, max_panels=4)
+    res = approximate(bump_target(3.0), 6.0, max_panels=4, optimizer=None)
     assert len(res.panels) == 1
     p = res.panels[0]
     assert p.method == "dual"
@@ -125,11 +125,13 @@ def test_mixed_panels_are_watertight_and_within_tol_by_occt():
     from test_approximate import bspline_face, free_wires, twist_deg, two_way
 
     t = bump_target(1.0)
-    face = bspline_face(lambda s, r: t.jet(np.array([s]), np.array([r]), 0)[0][0], 25, 9)
+    face = bspline_face(lambda s, r: t.jet(np.array([s]), np.array([r]), 0)[0][0], 41, 9)
     tol = 2.0
     res = approximate(face, tol, max_panels=6)
     methods = [p.method for p in res.panels]
-    assert "dual" in methods and "loft" in methods  # measured: ['loft', 'dual'], 0.686 and 0.605
+    # measured: loft 0.706 and dual 0.647 (the all-loft set: 0.753, 0.755)
+    assert "dual" in methods and "loft" in methods
+    assert res.max_deviation <= 0.72
     shell = panels_shell(res)
     sh = shell.wrapped
     assert two_way(face, sh) <= tol * 1.001
