@@ -284,7 +284,7 @@ def fit_strip(frame: Any, y_lo: float, y_hi: float, *, degree: int = 6, optimize
             seams stay closed.
         delta_degree: Chebyshev degree of the trimmed seam offsets.
     """
-    from .optimize.optimizers import _one_blas_thread  # tiny least squares: no BLAS thread waits
+    from .optimize.hybrid import _one_blas_thread  # tiny least squares: no BLAS thread waits
 
     with _one_blas_thread():
         return _fit_strip(frame, y_lo, y_hi, degree, optimizer, max_nfev, seed, closed, delta_degree)
