@@ -18,8 +18,8 @@ module only adapts FreeCAD to it and back:
   by point by FreeCAD (``value``/``getDN``: correct, slow).
 * the panels (the core's :class:`~ght_cad.bspline.BSplineSurfaceData`, degree 1 across the
   rulings, fitted to 1e-7 of the size) become ``Part.BSplineSurface`` faces
-  (:func:`.convert.face_from_data`) sewn into one shell at 1e-6 of the target size (adjacent
-  panels are lofted from the same seam curve).
+  (:func:`.convert.face_from_data`) joined into one shell along their seams at 1e-6 of the target
+  size (:func:`panel_shell`: adjacent panels are lofted from the same seam curve).
 
 Per-panel outputs are listed in the order of the Shape's faces (``PanelDeviations[i]`` is
 ``Face{i+1}``). :meth:`DevelopableApproximationFeature.surface` gives the panels' exact
@@ -134,56 +134,79 @@ def target_face(link: Any, what: str) -> "Part.Face":
     return faces[0]
 
 
-def _shell_order(shape: "Part.Shape", panels: list[Any], tol: float) -> list[int]:
-    """For every face of ``shape`` the index of the panel whose B-spline net it carries (sewing
-    keeps the surfaces but not necessarily the order)."""
-    nets = [np.asarray(p.surface.data.poles, dtype=float) for p in panels]
+def _shell_order(shape: "Part.Shape", nets: list[np.ndarray], tol: float) -> list[int]:
+    """For every face of ``shape`` the index of the panel whose B-spline net (poles, (n, 2, 3)) it
+    carries: joining keeps the surfaces, not necessarily the order.
+
+    Raises:
+        GHTError: a face that matches no net or several, or two faces the same net.
+    """
     order = []
     for i, f in enumerate(shape.Faces, 1):
         poles = np.array([[tuple(p) for p in row] for row in f.Surface.getPoles()], dtype=float)
         hits = [k for k, n in enumerate(nets) if n.shape == poles.shape and float(np.abs(n - poles).max()) <= tol]
         if len(hits) != 1 or hits[0] in order:
-            raise GHTError(f"Face{i} of the sewn panel shell matches {len(hits)} panels; expected exactly one")
+            raise GHTError(f"Face{i} of the panel shell matches {len(hits)} panels; expected exactly one")
         order.append(hits[0])
     return order
 
 
-def panel_shell(faces: list, tol: float) -> "Part.Shape":
-    """The panel faces (in seam order) joined into one shell along their seams: OCCT's general fuse
-    with the fuzzy value ``tol`` (FreeCAD's ``generalFuse``), which merges the coincident seam
-    edges of neighbouring panels (they are lofted from the same seam curve and agree to the fit
-    tolerance, 1e-7 of the size). ``sewShape`` of FreeCAD 0.20 (OCCT 7.6) leaves such seams
-    open: none of the eight seams of the 1 m cap's nine panels was sewn, at any tolerance up to
-    1 mm. One face is returned as it is (a band closed around already carries its seam edge).
-
-    Raises:
-        GHTError: the fuse split a panel, or two neighbouring panels share no edge, or the shell
-            is not valid.
-    """
-    if len(faces) == 1:
-        return faces[0]
-    fused = faces[0].generalFuse(faces[1:], float(tol))[0]
-    if len(fused.Faces) != len(faces):
-        raise GHTError(f"joining the {len(faces)} panels at {tol:.3g} gave {len(fused.Faces)} faces; expected {len(faces)}")
-    shell = Part.Shell(fused.Faces)
-    if not shell.isValid():
-        raise GHTError(f"the shell of the {len(faces)} panels is not valid")
-    return shell
-
-
-def _check_seams(shell: "Part.Shape", order: list[int]) -> None:
-    """Every two panels that follow each other in seam order share an edge of the shell.
-
-    Raises:
-        GHTError: naming the first seam left open.
-    """
-    if len(order) < 2:
-        return
+def _open_seam(shell: "Part.Shape", order: list[int]) -> str | None:
+    """The first seam (two panels that follow each other in seam order) whose faces share no edge
+    of ``shell``, as text; None when every seam is joined."""
     face_of = {k: i for i, k in enumerate(order)}
     for k in range(len(order) - 1):
         fa, fb = shell.Faces[face_of[k]], shell.Faces[face_of[k + 1]]
         if not any(e.isSame(g) for e in fa.Edges for g in fb.Edges):
-            raise GHTError(f"the seam between panels {k + 1} and {k + 2} (Face{face_of[k] + 1}, Face{face_of[k + 1] + 1}) is open")
+            return f"the seam between panels {k + 1} and {k + 2} (Face{face_of[k] + 1}, Face{face_of[k + 1] + 1}) is open"
+    return None
+
+
+def _joined(faces: list, tol: float, how: str) -> "Part.Shape | None":
+    """The faces joined by ``sewShape`` (``how="sew"``) or by the general fuse (``"fuse"``), as one
+    shell; None when sewing gave several."""
+    if how == "sew":
+        comp = Part.makeCompound([f.copy() for f in faces])
+        comp.sewShape(tol)
+        shells = [comp] if comp.ShapeType == "Shell" else comp.Shells
+        return shells[0] if len(shells) == 1 else None
+    return Part.Shell(faces[0].generalFuse(faces[1:], tol)[0].Faces)
+
+
+def panel_shell(faces: list, nets: list[np.ndarray], tol: float) -> tuple["Part.Shape", list[int]]:
+    """The panel faces (in seam order, with their B-spline nets) joined into one shell along their
+    seams, and for every face of it the index of its panel (:func:`_shell_order`).
+
+    Adjacent panels are lofted from the same seam curve; their faces agree along it to the fit
+    tolerance (1e-7 of the size). First ``sewShape(tol)``; where that does not give one valid shell
+    with every seam a shared edge, OCCT's general fuse with the fuzzy value ``tol`` (FreeCAD's
+    ``generalFuse``), which merges the coincident seam edges. FreeCAD 0.20's sewing (OCCT 7.6)
+    joined the five open strips of a 1 m dome but none of the eight seams of the spherical cap's
+    nine bands closed around (at any tolerance up to 1 mm); the fuse joined all eight there but
+    left a self-intersecting wire in one of the dome's strips. One face is returned as it is (a
+    band closed around carries its own seam edge).
+
+    Raises:
+        GHTError: neither way gave one valid shell of the panels with every seam joined (the
+            reasons of both).
+    """
+    if len(faces) == 1:
+        return faces[0], [0]
+    why = []
+    for how in ("sew", "fuse"):
+        shell = _joined(faces, float(tol), how)
+        if shell is None or len(shell.Faces) != len(faces):
+            why.append(f"{how}: {0 if shell is None else len(shell.Faces)} faces in one shell")
+            continue
+        if not shell.isValid():
+            why.append(f"{how}: not a valid shell")
+            continue
+        order = _shell_order(shell, nets, 1e-3 * tol)
+        open_seam = _open_seam(shell, order)
+        if open_seam is None:
+            return shell, order
+        why.append(f"{how}: {open_seam}")
+    raise GHTError(f"the {len(faces)} panels could not be joined into one shell at {tol:.3g} ({'; '.join(why)})")
 
 
 class DevelopableApproximationFeature(FeatureProxy):
@@ -231,7 +254,7 @@ class DevelopableApproximationFeature(FeatureProxy):
                 raise GHTError(f"{obj.Label} has no panels yet; recompute it")
             res, _ = self.run(obj)
             try:
-                order = _shell_order(obj.Shape, res.panels, 1e-9 * res.size)
+                order = _shell_order(obj.Shape, [p.surface.data.poles for p in res.panels], 1e-9 * res.size)
             except GHTError:
                 raise GHTError(f"{obj.Label}: its saved panels are not those of its inputs; recompute it") from None
             panels = self._exact = [_exact(res.panels[k]) for k in order]
@@ -264,9 +287,7 @@ class DevelopableApproximationFeature(FeatureProxy):
         for i, f in enumerate(faces, 1):
             if not f.isValid():
                 raise GHTError(f"the B-spline face of panel {i} is not valid")
-        shape = panel_shell(faces, 1e-6 * res.size)
-        order = _shell_order(shape, res.panels, 1e-9 * res.size)
-        _check_seams(shape, order)
+        shape, order = panel_shell(faces, [p.surface.data.poles for p in res.panels], 1e-6 * res.size)
         panels = [res.panels[k] for k in order]
         obj.PanelCount = len(panels)
         obj.MaxDeviation = float(res.max_deviation)

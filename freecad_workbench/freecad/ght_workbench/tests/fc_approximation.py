@@ -7,7 +7,8 @@ rulings whose seams are shared edges; the deviation measured independently by Fr
 Tolerance (1 + 1 %: the margin covers only OCCT's extrema accuracy, the core reports 0.855 mm); its
 Flat pattern child holds one face per panel with the shell's area; the document recomputes clean
 (not Touched, nothing in the Report view); save/reopen keeps it working, and a new Tolerance (4 mm)
-changes PanelCount. The lateral face of a ``Part::Cone`` gives one panel within 1e-6 of its size.
+changes PanelCount. The lateral face of a cone (a PartDesign Body's face) gives one panel within
+1e-6 of its size; a B-spline dome imported from STEP is covered within Tolerance (open strips).
 Refusals (bad Tolerance, MaxPanels, unset Target, a tolerance the panel count cannot meet) are one
 line each naming the property.
 
@@ -138,13 +139,16 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assertEqual(len(fp.Shape.Faces), obj.PanelCount)
         print(f"cap reopened, tol 4: {count} -> {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}, {seconds:.1f} s")
 
-    def test_cone_gives_one_panel(self):
-        cone = self.doc.addObject("Part::Cone", "Cone")
+    def test_cone_of_a_body_gives_one_panel(self):
+        body = self.doc.addObject("PartDesign::Body", "Body")
+        cone = self.doc.addObject("PartDesign::AdditiveCone", "Cone")
+        body.addObject(cone)
         cone.Radius1, cone.Radius2, cone.Height = 50.0, 20.0, 80.0
         self.doc.recompute()
-        face = cone.Shape.Faces[0]
+        face = body.Shape.Faces[0]  # a face of the Body (its tip's shape), as a click selects it
         self.assertEqual(type(face.Surface).__name__, "Cone")
-        obj = da.make_developable_approximation((cone, "Face1"), 0.1, flat_pattern=True, doc=self.doc)
+        self.assertEqual(da.face_target(face).path, "analytic")
+        obj = da.make_developable_approximation((body, "Face1"), 0.1, flat_pattern=True, doc=self.doc)
         self.assertFalse(_base.failed(obj), obj.getStatusString())
         self.assertEqual(obj.PanelCount, 1)
         self.assert_panels(obj)
@@ -157,6 +161,32 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assert_recompute_clean(self.doc, obj, fp)
         print(f"cone: 1 panel, MaxDeviation {obj.MaxDeviation:.3g}, measured {max(out, back):.3g} (size {size:.1f}), "
               f"AreaFlat {fp.AreaFlat:.6f} cone face {face.Area:.6f}")
+
+    def test_bspline_dome_imported_from_step(self):
+        # a shallow dome, 1 m square (z = (x² + y²) / 8000), as an interpolated B-spline face written
+        # to STEP and read back into a Part feature, as an imported design surface arrives
+        pts = [[App.Vector(x, y, (x * x + y * y) / 8000) for y in range(-500, 501, 125)] for x in range(-500, 501, 125)]
+        srf = Part.BSplineSurface()
+        srf.interpolate(pts)
+        path = os.path.join(OUT, "dome.step")
+        srf.toShape().exportStep(path)
+        imported = self.doc.addObject("Part::Feature", "Dome")
+        imported.Shape = Part.read(path)
+        self.doc.recompute()
+        face = imported.Shape.Faces[0]
+        self.assertEqual(da.face_target(face).path, "nurbs")
+        obj = da.make_developable_approximation((imported, "Face1"), 1.0, flat_pattern=True, doc=self.doc)
+        self.assertFalse(_base.failed(obj), obj.getStatusString())
+        self.assertNotIn("Touched", obj.State)
+        self.assert_panels(obj)
+        out, back = two_way(face, obj.Shape, (25, 25), (24, 5))
+        self.assertLessEqual(max(out, back), 1.0 * (1 + MARGIN), (out, back))
+        fp = da.flat_patterns_of(obj)[0]
+        self.assertEqual(len(fp.Shape.Faces), obj.PanelCount)
+        self.assertLess(abs(fp.AreaFlat - obj.Shape.Area), 1e-6 * obj.Shape.Area)
+        self.assert_recompute_clean(self.doc, obj, fp)
+        print(f"dome tol 1: {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}, measured target->shell {out:.4f} "
+              f"shell->target {back:.4f}")
 
     def test_refusals_name_the_property(self):
         cone = self.doc.addObject("Part::Cone", "Cone")
