@@ -46,11 +46,13 @@ from ._base import (BaseCommand, FeatureProxy, ViewProviderBase, failed, info_pa
 from .convert import face_from_data
 
 __all__ = ["DevelopableApproximationFeature", "face_target", "target_face",
-           "make_developable_approximation", "flat_patterns_of", "panel_shell", "DIRECTIONS", "OUTPUTS"]
+           "make_developable_approximation", "flat_patterns_of", "panel_shell", "DIRECTIONS", "METHODS", "OUTPUTS"]
 
 DIRECTIONS = ["auto", "u", "v"]
+#: how each strip is fitted (ght_cad.approximate's ``method``): the closer of both, the rails loft, the dual fit
+METHODS = ["auto", "loft", "dual"]
 OUTPUTS = ("PanelCount", "MaxDeviation", "PanelDeviations", "PanelMaxOut", "PanelMaxIn", "PanelThetaMax", "PanelAreas",
-           "DirectionUsed", "Report")
+           "PanelMethods", "DirectionUsed", "Report")
 
 
 def _readable(face: "Part.Face") -> Any:
@@ -223,6 +225,7 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.addProperty("App::PropertyEnumeration", "Direction", "Approximation", "Parameter of the target the rulings run along: auto (least normal curvature), u or v")
         obj.Direction = DIRECTIONS
         obj.Direction = "auto"
+        self._method_properties(obj)
         obj.addProperty("App::PropertyInteger", "PanelCount", "Result", "Number of developable panels (faces of the shell)")
         obj.addProperty("App::PropertyFloat", "MaxDeviation", "Result", "Largest deviation of a panel from the target, both ways (the core's measure)")
         obj.addProperty("App::PropertyFloatList", "PanelDeviations", "Result", "Per panel (FaceN order): max deviation both ways")
@@ -234,7 +237,20 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.addProperty("App::PropertyString", "Report", "Result", "Summary of the approximation")
         self.restored(obj)
 
+    @staticmethod
+    def _method_properties(obj: Any) -> None:
+        """Method and PanelMethods (added to documents saved before they existed: Method "loft",
+        what those documents were computed with)."""
+        if "Method" not in obj.PropertiesList:
+            obj.addProperty("App::PropertyEnumeration", "Method", "Approximation", "Per strip: auto (the closer of the rails loft "
+                            "and the dual fit of the target's tangent planes, spec 10.1), loft or dual")
+            obj.Method = METHODS
+            obj.Method = "auto" if "PanelCount" not in obj.PropertiesList else "loft"
+        if "PanelMethods" not in obj.PropertiesList:
+            obj.addProperty("App::PropertyStringList", "PanelMethods", "Result", "Per panel: loft or dual (how its seams were found)")
+
     def restored(self, obj: Any) -> None:
+        self._method_properties(obj)
         set_read_only(obj, OUTPUTS)
 
     def surface(self, obj: Any) -> list[Any]:
@@ -276,7 +292,7 @@ class DevelopableApproximationFeature(FeatureProxy):
             raise GHTError(f"{obj.Label}.MaxPanels={max_panels} is not allowed; it must be an integer >= 1")
         target = face_target(face, f"{obj.Target[0].Label}.{(obj.Target[1] or ['Face1'])[0]}")
         try:
-            res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels)
+            res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels, method=str(obj.Method))
         except GHTError as exc:  # name the feature's properties, not the core's arguments
             raise GHTError(f"{exc} (properties Tolerance, MaxPanels)") from None
         return res, target.path
@@ -296,9 +312,11 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.PanelMaxIn = [float(p.max_in) for p in panels]
         obj.PanelThetaMax = [float(p.theta_max_deg) for p in panels]
         obj.PanelAreas = [float(p.area) for p in panels]
+        obj.PanelMethods = [str(getattr(p, "method", "loft")) for p in panels]
         obj.DirectionUsed = res.direction
         obj.Report = (f"{len(panels)} developable panel{'s' if len(panels) != 1 else ''} within {res.max_deviation:.4g} (Tolerance {res.tol:g}), rulings along "
-                      f"{res.direction}, target evaluated by {path}, {res.info.get('seconds', 0.0):.1f} s")
+                      f"{res.direction} ({obj.PanelMethods.count('loft')} loft, {obj.PanelMethods.count('dual')} dual), target "
+                      f"evaluated by {path}, {res.info.get('seconds', 0.0):.1f} s")
         obj.Shape = shape
         self._exact = [_exact(p) for p in panels]  # not saved (FeatureProxy.__getstate__): see surface
 
@@ -311,8 +329,8 @@ def _exact(panel: Any) -> Any:
 class ViewProviderDevelopableApproximation(ViewProviderBase):
     icon_name = "GHT_DevelopableApproximation"
     shape_color = (0.62, 0.80, 0.62)
-    panel_factory = staticmethod(lambda obj: info_panel(obj, ("Target",), f"{obj.Report}\nEdit Tolerance, MaxPanels and "
-                                                        "Direction in the property editor; its Flat pattern holds every panel."))
+    panel_factory = staticmethod(lambda obj: info_panel(obj, ("Target",), f"{obj.Report}\nEdit Tolerance, MaxPanels, "
+                                                        "Direction and Method in the property editor; its Flat pattern holds every panel."))
 
     def claimChildren(self) -> list:
         """Its flat patterns (Flat pattern features whose Source is this feature) sit under it."""
@@ -333,6 +351,7 @@ def make_developable_approximation(
     *,
     max_panels: int = 64,
     direction: str = "auto",
+    method: str = "auto",
     flat_pattern: bool = False,
     doc: Any = None,
     name: str = "DevelopableApproximation",
@@ -344,6 +363,7 @@ def make_developable_approximation(
         tolerance: largest deviation both ways (model units, > 0).
         max_panels: largest panel count accepted.
         direction: ``"auto"``, ``"u"`` or ``"v"``: the parameter the rulings run along.
+        method: ``"auto"``, ``"loft"`` or ``"dual"`` (:data:`METHODS`): how each strip is fitted.
         flat_pattern: also make the *Flat pattern* of all panels (a child in the tree,
             :func:`flat_patterns_of`).
 
@@ -356,12 +376,15 @@ def make_developable_approximation(
     """
     if direction not in DIRECTIONS:
         raise GHTError(f"direction={direction!r} is not allowed; use one of {DIRECTIONS}")
+    if method not in METHODS:
+        raise GHTError(f"method={method!r} is not allowed; use one of {METHODS}")
     src, sub = target if isinstance(target, tuple) else (target, "")
     obj = new_feature(doc or src.Document, name, DevelopableApproximationFeature, ViewProviderDevelopableApproximation)
     obj.Target = (src, [sub] if sub else [])
     obj.Tolerance = float(tolerance)
     obj.MaxPanels = int(max_panels)
     obj.Direction = direction
+    obj.Method = method
     obj.Document.recompute()
     if flat_pattern and not failed(obj):  # a failed approximation has no panels to unroll
         from .flat_pattern import make_flat_pattern

@@ -80,6 +80,8 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
             self.assertEqual(shape.ShapeType, "Shell")
             self.assertEqual(shared_edges(shape), obj.PanelCount - 1)
         self.assertEqual(len(obj.PanelDeviations), obj.PanelCount)
+        self.assertEqual(len(obj.PanelMethods), obj.PanelCount)
+        self.assertLessEqual(set(obj.PanelMethods), {"loft", "dual"})
         self.assertAlmostEqual(max(obj.PanelDeviations), obj.MaxDeviation, delta=1e-12 * max(obj.MaxDeviation, 1.0))
         self.assertLess(max(obj.PanelThetaMax), 0.01)
 
@@ -99,8 +101,9 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assert_panels(obj)
         out, back = two_way(face, obj.Shape)
         self.assertLessEqual(max(out, back), 1.0 * (1 + MARGIN), (out, back))
+        self.assertEqual(obj.Method, "auto")
         print(f"cap tol 1: {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}, measured target->shell {out:.4f} "
-              f"shell->target {back:.4f}, {seconds:.1f} s")
+              f"shell->target {back:.4f}, {seconds:.1f} s, methods {list(obj.PanelMethods)}")
         # the flat pattern child: one face per panel, the shell's area
         flats = da.flat_patterns_of(obj)
         self.assertEqual(len(flats), 1)
@@ -129,12 +132,14 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assert_recompute_clean(self.doc, obj, fp)
         self.assertEqual(len(fp.Shape.Faces), count)
         obj.Tolerance = 4.0
+        obj.Method = "loft"  # the rails loft on every strip (no dual fits: faster)
         t0 = time.perf_counter()
         self.assert_recompute_clean(self.doc, obj, fp)
         seconds = time.perf_counter() - t0
         self.assertNotIn("Touched", obj.State)
         self.assertLess(obj.PanelCount, count)
         self.assertLessEqual(obj.MaxDeviation, 4.0)
+        self.assertEqual(set(obj.PanelMethods), {"loft"})
         self.assert_panels(obj)
         self.assertEqual(len(fp.Shape.Faces), obj.PanelCount)
         print(f"cap reopened, tol 4: {count} -> {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}, {seconds:.1f} s")
