@@ -21,8 +21,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .design.approximate import (approximation_report, panel_pattern, panel_plates, plot_deviation,  # noqa: F401
-                                 report_markdown)
+from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
+                                 plot_deviation, report_markdown)
 from .errors import GHTError
 
 __all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
@@ -69,23 +69,25 @@ def _json_default(o: Any) -> Any:
 
 
 def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str = "mm",
-                  sheet: Any = None) -> dict[str, Any]:
+                  sheet: Any = None, target: Any = None) -> dict[str, Any]:
     """Write panels.step, flat.dxf, flat.svg, deviation.png, report.json and report.md into the
     open :class:`ght_cad.outdir.OutputFolder` ``folder``; returns the report dict. With a sheet of
     T > 0 the STEP file holds one plate solid per panel and the flat patterns are the neutral
-    surfaces (:func:`panel_plates`, :func:`panel_pattern`)."""
+    surfaces (:func:`panel_plates`, :func:`panel_pattern`), ``side`` measured on the normal of the
+    ``target`` (:func:`panel_sheets`; needed with a sheet)."""
     from .cad.approximate import panels_shell
     from .cad.occ import write_step
     from .io import atomic_write
 
-    if sheet is not None and not sheet.is_zero:
+    sheets = panel_sheets(result, target, sheet)
+    if sheets is not None:
         from .cad.sheet_solid import write_plate_step
 
-        plates = panel_plates(result, sheet, name)
+        plates = panel_plates(result, sheets, name)
         write_plate_step(plates, folder.path("panels.step"), units=units, product=name)
     else:
         write_step(panels_shell(result), folder.path("panels.step"), units=units)
-    pattern = panel_pattern(result, sheet, units=units)
+    pattern = panel_pattern(result, sheets, units=units)
     pattern.export_dxf(folder.path("flat.dxf"))
     pattern.export_svg(folder.path("flat.svg"))
     plot_deviation(result, folder.path("deviation.png"), title=None)
@@ -120,12 +122,12 @@ def cmd_approximate(args: argparse.Namespace) -> int:
         raise GHTError(f"{path}: --tol={args.tol!r} is not allowed; it must be a length > 0")
     try:
         sheet = make_sheet(args.thickness, args.k_factor, din_k_factor=args.din_k_factor, side=args.side or "normal")
-        result = approximate(step_target(path, args.face - 1), args.tol, max_panels=args.max_panels,
-                             direction=args.direction)
+        target = step_target(path, args.face - 1)
+        result = approximate(target, args.tol, max_panels=args.max_panels, direction=args.direction)
     except GHTError as exc:
         raise GHTError(f"{path}: {exc}") from None
     with OutputFolder(args.out) as folder:
-        report = write_outputs(result, folder, name=path.stem, sheet=sheet)
+        report = write_outputs(result, folder, name=path.stem, sheet=sheet, target=target)
         folder.commit()
     summary = {"command": "approximate", "target": str(path), "panels": report["panels"], "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}

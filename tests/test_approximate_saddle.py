@@ -39,7 +39,6 @@ def saddle_face():
     return bspline_face(lambda s, t: (1000 * s - 500, 1000 * t - 500, (1000 * s - 500) * (1000 * t - 500) / L), 9, 9)
 
 
-@pytest.mark.slow
 @pytest.mark.xfail(strict=True, raises=NotDevelopableError,
                    reason="seams along the saddle's asymptotic (straight) parameter lines: no rails loft joins two "
                           "skew lines; the strips must follow the principal directions (issue 24, fit owned by approxfit)")

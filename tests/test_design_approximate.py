@@ -296,3 +296,69 @@ def test_cli_approximate_thickness(tmp_path: Path) -> None:
     # flat areas differ from the panels' (the neutral surface at K T = 1.2 mm)
     assert all(abs(p["flat_area"] - p["area"]) > 1e-5 * p["area"] for p in rep["panel_report"])
     assert main(["approximate", str(step), "--tol", "2", "--k-factor", "0.4", "--out", str(tmp_path / "o2")]) == 2
+
+
+@pytest.mark.slow
+def test_ght_patch_target_through_surface_export_and_unroll(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """A GHT patch target (the net of a general cylinder z = z(y): developable) through the other
+    design commands: one panel within 1e-6 of the size (issue 24: developable inputs give one panel);
+    ``ght-cad surface --json`` reports it, ``export`` writes STEP/DXF/JSON, ``unroll`` the pattern."""
+    pytest.importorskip("OCP")
+    net = [[[600.0 * i, 400.0 * j, [0.0, 80.0, 0.0][j]] for j in range(3)] for i in range(3)]
+    d = _target(poles=None, knots_u=None, knots_v=None, degree_u=None, degree_v=None, control_points=net)
+    path = tmp_path / "cyl.toml"
+    path.write_text(_toml(d))
+    assert main(["surface", str(path), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    ap = res["surface"]["approximation"]
+    assert ap["panels"] == 1 and ap["max_deviation"] <= 1e-6 * ap["size"]
+    assert res["developability"]["theta_max"] <= 1e-3
+    files = [tmp_path / "x.step", tmp_path / "x.dxf", tmp_path / "x.json"]
+    assert main(["export", str(path), *map(str, files)]) == 0
+    assert all(f.stat().st_size > 0 for f in files)
+    rep = json.loads(files[2].read_text())
+    assert abs(rep["flat_pattern"]["area"] - ap["total_area"]) <= 1e-6 * ap["total_area"]
+    capsys.readouterr()
+    assert main(["unroll", str(path), "--svg", str(tmp_path / "u.svg")]) == 0
+    assert (tmp_path / "u.svg").stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_sheet_side_is_measured_on_the_target_normal() -> None:
+    """``side = "normal"`` puts every panel's material on the TARGET's normal side ``S_u × S_v``,
+    whichever way the panel's own normal points (the strips of this cylinder run along u: the
+    panel's ``X_u × X_v`` is ``-(S_u × S_v)``): the plate's outside face lies ``T`` along the target
+    normal (to 1e-3 of T, the point's nearest target point found on a 401 × 401 grid and refined),
+    and with ``side = "reverse"`` ``T`` against it."""
+    pytest.importorskip("OCP")
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.BRepTools import BRepTools
+    from scipy.optimize import minimize
+
+    from ght_cad.design import build_surface, plate_solids
+    from ght_cad.patch import GHTSurface
+
+    net = [[[600.0 * i, 400.0 * j, [0.0, 80.0, 0.0][j]] for j in range(3)] for i in range(3)]
+    g = GHTSurface(np.array(net))
+    T = 3.0
+    for side, sign in (("normal", 1.0), ("reverse", -1.0)):
+        d = _target(poles=None, knots_u=None, knots_v=None, degree_u=None, degree_v=None, control_points=net)
+        d["sheet"] = {"thickness": T, "side": side}
+        built = build_surface(parse_design(d, "d.toml"))
+        plates = plate_solids(built)
+        assert len(plates) == 1
+        out = plates[0].outside
+        ad = BRepAdaptor_Surface(out)
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(out)
+        for fu, fv in ((0.5, 0.5), (0.3, 0.7), (0.8, 0.2)):
+            P = np.array(ad.Value(u0 + fu * (u1 - u0), v0 + fv * (v1 - v0)).Coord())
+            x = np.linspace(0, 1, 401)
+            X, Y = np.meshgrid(x, x, indexing="ij")
+            G = g.evaluate(X.ravel(), Y.ravel())
+            k = int(np.argmin(np.linalg.norm(G - P, axis=1)))
+            r = minimize(lambda w: float(np.sum((g.evaluate([w[0]], [w[1]])[0] - P) ** 2)), [X.ravel()[k], Y.ravel()[k]],
+                         method="Nelder-Mead", options={"xatol": 1e-12, "fatol": 1e-14})
+            uu, vv = r.x
+            n = np.cross(g.derivative([uu], [vv], 1, 0)[0], g.derivative([uu], [vv], 0, 1)[0])
+            n /= np.linalg.norm(n)
+            assert abs(float((P - g.evaluate([uu], [vv])[0]) @ n) - sign * T) <= 1e-3 * T, (side, fu, fv)

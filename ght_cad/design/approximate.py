@@ -29,7 +29,7 @@ from ..errors import GHTError
 from .schema import DesignError, SurfaceSpec
 
 __all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "is_approximation", "plot_deviation",
-           "report_markdown", "approximation_report", "panel_pattern", "panel_plates"]
+           "report_markdown", "approximation_report", "panel_sheets", "panel_pattern", "panel_plates"]
 
 
 class ApproximatedSurface:
@@ -41,6 +41,10 @@ class ApproximatedSurface:
         self.result = result
         self.target = target
         self.parts = [p.exact if p.exact is not None else p.surface for p in result.panels]
+
+    def part_sheets(self, sheet: Any) -> list[Any] | None:
+        """Per panel the sheet with ``side`` on the target's normal (:func:`panel_sheets`)."""
+        return panel_sheets(self.result, self.target, sheet)
 
     def __repr__(self) -> str:
         return f"ApproximatedSurface({len(self.parts)} panels, max deviation {self.result.max_deviation:.4g})"
@@ -204,23 +208,50 @@ def approximation_report(result: Any, pattern: Any = None, *, name: str = "targe
     return report
 
 
-def panel_pattern(result: Any, sheet: Any = None, **kwargs: Any) -> Any:
-    """All panels' flat patterns on one sheet with seam marks; with a :class:`ght_cad.sheet.Sheet`
-    of T > 0 each panel's neutral surface (at ``K T`` from the panel), the seam marks matched on the
-    panels' own seams (the neutral surfaces of two panels meeting at an angle part along their seam)."""
-    if sheet is not None and not sheet.is_zero:
-        kwargs.update(sheet=sheet, marks_on="design")
+def panel_sheets(result: Any, target: Any, sheet: Any) -> list[Any] | None:
+    r"""Per panel the sheet whose ``side`` is measured on the TARGET's normal ``n = S_u × S_v / |..|``
+    (None without a sheet or with T = 0). A panel's own normal ``X_u × X_v`` (``X = a + v (b - a)``)
+    can point the other way: the strips run along the target's u or v (``direction``), and a cone
+    panel with its apex on the strip's first seam has its rail as ``a``; where
+    ``n · (X_u × X_v) < 0`` at the panel's middle (``u = v = 1/2``, the target at the middle of its
+    strip) the panel gets :meth:`ght_cad.sheet.Sheet.flipped`, so ``side = "normal"`` puts the
+    material of every panel on the target's normal side."""
+    if sheet is None or sheet.is_zero:
+        return None
+    u0, u1, v0, v1 = target.bounds
+    out = []
+    for p in result.panels:
+        part = p.exact if p.exact is not None else p.surface
+        y = 0.5 * (p.y0 + p.y1)
+        u, v = (u0 + (u1 - u0) * y, v0 + 0.5 * (v1 - v0)) if result.direction == "u" else \
+            (u0 + 0.5 * (u1 - u0), v0 + (v1 - v0) * y)
+        _, Su, Sv = target.jet(np.array([u]), np.array([v]), 1)
+        a, b = part.a(np.array([0.5])), part.b(np.array([0.5]))
+        xu = 0.5 * (part.a(np.array([0.5]), 1) + part.b(np.array([0.5]), 1))
+        sign = float(np.dot(np.cross(Su[0] * (u1 - u0), Sv[0] * (v1 - v0)), np.cross(xu[0], b[0] - a[0])))
+        out.append(sheet if sign >= 0 else sheet.flipped())
+    return out
+
+
+def panel_pattern(result: Any, sheets: Any = None, **kwargs: Any) -> Any:
+    """All panels' flat patterns on one sheet with seam marks; with the panels' sheets
+    (:func:`panel_sheets`) each panel's neutral surface (at ``K T`` from the panel on its material
+    side), the seam marks matched on the panels' own seams (the neutral surfaces of two panels
+    meeting at an angle part along their seam)."""
+    if sheets is not None:
+        kwargs.update(sheet=list(sheets), marks_on="design")
     return result.flat_pattern(**kwargs)
 
 
-def panel_plates(result: Any, sheet: Any, name: str = "panel") -> list[Any]:
+def panel_plates(result: Any, sheets: Any, name: str = "panel") -> list[Any]:
     """One plate solid of thickness T per panel (:func:`ght_cad.cad.sheet_solid.plate_solid` of its
-    exact developable), labelled ``<name> part <i>`` in messages and named ``P<i>`` (faces
-    ``P<i>.inside``, ``P<i>.outside``, ``P<i>.edgeN`` in STEP), as the panels of the flat pattern."""
+    exact developable with its sheet of :func:`panel_sheets`), labelled ``<name> part <i>`` in
+    messages and named ``P<i>`` (faces ``P<i>.inside``, ``P<i>.outside``, ``P<i>.edgeN`` in STEP), as
+    the panels of the flat pattern."""
     from ..cad.sheet_solid import plate_solid
 
     parts = [p.exact if p.exact is not None else p.surface for p in result.panels]
-    plates = [plate_solid(s, sheet, label=f"{name} part {i + 1}") for i, s in enumerate(parts)]
+    plates = [plate_solid(s, sh, label=f"{name} part {i + 1}") for i, (s, sh) in enumerate(zip(parts, sheets))]
     for i, p in enumerate(plates):
         p.name = f"P{i + 1}"
     return plates

@@ -298,8 +298,11 @@ def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int
         sheet = design.sheet.to_sheet()
     if sheet.is_zero:
         return math.inf
-    return min(check_offset(part, sheet, f"surface {sheet_part_label(design, i)!r}", samples=samples)
-               for i, part in enumerate(sheet_parts(surface)))
+    parts = sheet_parts(surface)
+    # an approximation's panels: each with its side on the target's normal (ApproximatedSurface.part_sheets)
+    sheets = surface.part_sheets(sheet) if _is_approximation(surface) else [sheet] * len(parts)
+    return min(check_offset(part, sh, f"surface {sheet_part_label(design, i)!r}", samples=samples)
+               for i, (part, sh) in enumerate(zip(parts, sheets)))
 
 
 def _developability_dict(surface: Any) -> dict[str, float]:

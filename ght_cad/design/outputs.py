@@ -166,8 +166,8 @@ def unroll_surface(built: BuiltSurface) -> Any:
     if _is_approximation(built.surface):  # the panels of ght-cad approximate, seams marked
         from .approximate import panel_pattern
 
-        return panel_pattern(built.surface.result, sheet, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
-                             samples=d.unroll.samples, units=d.units)
+        return panel_pattern(built.surface.result, built.surface.part_sheets(sheet), tol_deg=d.unroll.tol_deg,
+                             rulings=d.unroll.rulings, samples=d.unroll.samples, units=d.units)
     if _is_composite(built.surface):
         from ..unroll import unroll_composite
 
@@ -188,12 +188,12 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
     from ..cad.sheet_solid import plate_solid
 
     sheet = d.sheet.to_sheet()
+    if _is_approximation(built.surface):  # the plates of ght-cad approximate --thickness (P1.inside, ...)
+        from .approximate import panel_plates
+
+        return panel_plates(built.surface.result, built.surface.part_sheets(sheet), d.name)
     # the parts and labels of check_sheet (the optimizer's sheet rule is the same check on the same parts)
-    plates = [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
-    if _is_approximation(built.surface):  # named as the panels of the flat pattern: P1.inside, ...
-        for i, p in enumerate(plates):
-            p.name = f"P{i + 1}"
-    return plates
+    return [plate_solid(s, sheet, label=sheet_part_label(d, i)) for i, s in enumerate(sheet_parts(built.surface))]
 
 
 def design_plates(builts: Sequence[BuiltSurface]) -> tuple[list[Any], Any]:
