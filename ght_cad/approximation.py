@@ -912,8 +912,9 @@ def approximate(
         offset_degree: Chebyshev degree of the seam offsets δ_j(t) (0: constant).
         offset_iterations: fixed-point iterations of the offsets.
         safety: the march's share ``f`` of the deviation budget (lowered by 7 % per retry).
-        method: ``"auto"`` (per strip the closer of the loft and the dual fit of the tangent
-            planes, step 4), ``"loft"`` or ``"dual"`` (the dual fit wherever it is usable).
+        method: ``"auto"`` (spec 10.1: per strip the closer of the loft and the dual fit of the tangent
+            planes, step 4), ``"loft"`` or ``"dual"`` (the dual fit wherever it is usable, the loft
+            only where it is not; no all-loft fallback: a finer march instead).
         optimizer: :func:`ght_cad.optimize.minimize` method for each dual fit's μ, ν, γ
             (``"igwo"``, ``"pso"``, ``"hybrid"``, ...), or None to keep ``μ = ν = γ = 0``.
         optimizer_budget: objective evaluations per strip for that optimizer.
@@ -988,7 +989,8 @@ def approximate(
                               "gamma": d.params[2], "dual_start": d.half_range_start, "dual_optimized": d.half_range})
             say(f"  dual fits usable: {sum(1 for d in duals if d is not None and d.ok)}/{n}; chosen: {sum(chosen)}")
         mixes = [(_dual_seams(frame, loft_seams, duals, chosen), chosen)] if any(chosen) else []
-        mixes.append((loft_seams, [False] * n))
+        if method != "dual" or not mixes:  # "dual": no all-loft fallback (a finer march instead)
+            mixes.append((loft_seams, [False] * n))
         best_mix = None
         for seams, ch in mixes:
             panels, maps = [], []

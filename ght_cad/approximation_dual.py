@@ -1,4 +1,4 @@
-r"""Dual fit of a strip's tangent planes (issue 24; spec sections 3, 5.2 and 10).
+r"""Dual fit of a strip's tangent planes (issue 24; spec sections 3, 5.2, 10 and 10.1).
 
 Along the middle curve ``c(x) = S(x, y_m)`` of a strip ``y_lo <= y <= y_hi`` of the target, the
 tangent planes ``T(x) = (-n·c, n)`` and their derivatives ``T'(x) = (-n_x·c, n_x)`` (``n·c_x = 0``)

@@ -61,7 +61,7 @@ def test_dual_fit_chosen_where_closer():
 
 def test_loft_chosen_where_closer():
     # constant cross curvature: the loft is closer (1.408 against the dual fit's 1.421) and is kept
-    res = approximate(bump_target(0.0), 2.0, max_panels=4)
+    res = approximate(bump_target(0.0), 2.0, max_panels=4, optimizer=None)
     assert [p.method for p in res.panels] == ["loft"]
     c = res.panels[0].choice
     assert c["deviation_loft"] < c["deviation_dual"]
@@ -69,6 +69,10 @@ def test_loft_chosen_where_closer():
     # method="loft" skips the dual fits, and gives the same panel
     res2 = approximate(bump_target(0.0), 2.0, max_panels=4, method="loft")
     assert res2.panels[0].choice == {} and abs(res2.max_deviation - res.max_deviation) <= 1e-9 * res.size
+    # method="dual" keeps the (farther) dual panel: no fallback to the loft while within tol
+    res3 = approximate(bump_target(0.0), 2.0, max_panels=4, method="dual", optimizer=None)
+    assert [p.method for p in res3.panels] == ["dual"]
+    assert res.max_deviation < res3.max_deviation <= 2.0
 
 
 def test_shape_parameter_optimization_lowers_the_deviation():
