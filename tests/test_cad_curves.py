@@ -230,29 +230,20 @@ def test_face_from_patch_area_and_step(tmp_path):
     assert _valid(back) and _area(back) == pytest.approx(_area(face), rel=1e-9)
 
 
-def test_cadquery_plugin_and_shared_wrapped_objects(tmp_path):
-    cq = pytest.importorskip("cadquery")  # the [cadquery] world (OCP 7.9); build123d-only worlds skip
-    import ght_cad.cad.cq_plugin  # noqa: F401  (registers Workplane.ghtBezier / ghtCurve)
+def test_cadquery_and_build123d_share_wrapped_objects():
+    """Needs build123d and cadquery in one environment (no CI venv has both: this skips there); the
+    cadquery half of the old test runs in the [cadquery] world (tests/test_cq_world.py)."""
+    cq = pytest.importorskip("cadquery")
+    import ght_cad.cad.cq_plugin  # noqa: F401
 
-    pts = [(1, 1.5), (2.5, 1.0), (3, 0)]
-    wp = cq.Workplane("XY").moveTo(0, 0).ghtBezier(pts, mu=0.3, includeCurrent=True).close()
-    solid = wp.extrude(2.0, clean=False).val()
-    assert solid.isValid()
-    curve = GHTCurve([(0, 0)] + pts, 0.3)
-    exact_area = _green_area([curve, GHTCurve([(3, 0), (1.5, 0), (0, 0)])])
-    assert solid.Volume() == pytest.approx(2.0 * exact_area, rel=1e-6)
-    # local coordinates are mapped exactly to the workplane (XZ: local y -> world Z)
+    curve = GHTCurve([(0, 0), (1, 1.5), (2.5, 1.0), (3, 0)], 0.3)
     e = cq.Workplane("XZ").ghtCurve(curve).val()
-    mid = e.positionAt(0.5, mode="parameter")
-    assert np.allclose(mid.toTuple(), [curve.evaluate(0.5)[0], 0.0, curve.evaluate(0.5)[1]], atol=1e-6)
     # no copies between build123d and cadquery
     b3d = ght_edge(curve)
     assert cq.Edge(b3d.wrapped).wrapped is b3d.wrapped
     from build123d import Edge
 
     assert Edge(e.wrapped).wrapped is e.wrapped
-    write_step(solid, tmp_path / "cq.step")
-    assert _valid(read_step(tmp_path / "cq.step"))
 
 
 def test_exact_edges_restores_build123d_behaviour():
@@ -331,20 +322,6 @@ def test_adapter_errors():
         ght_face(a)
     with pytest.raises(GHTError, match="GHTCurve"):
         ght_wire([a, "not a curve"])
-
-
-def test_cadquery_plugin_refuses_curves_of_more_than_three_dimensions():
-    # a 4-D curve (e.g. a dual curve of planes) handed to Workplane.ghtCurve raised numpy's
-    # "could not broadcast input array from shape (4,) into shape (3,)" (a bare ValueError)
-    cq = pytest.importorskip("cadquery")
-
-    import ght_cad.cad.cq_plugin  # noqa: F401
-
-    four = GHTCurve(np.zeros((3, 4)) + np.arange(3)[:, None])
-    with pytest.raises(GHTError, match=r"curve has dimension 4; .*2-D or 3-D"):
-        cq.Workplane("XY").ghtCurve(four)
-    with pytest.raises(GHTError, match=r"2-D or 3-D; got 4 coordinates"):
-        cq.Workplane("XY").ghtBezier([(0, 0, 0, 0), (1, 1, 1, 1), (2, 0, 0, 0)])
 
 
 def test_write_step_refuses_what_is_not_a_shape(tmp_path):

@@ -1,5 +1,5 @@
 """build123d / cadquery front ends of the exact developable loft (spec 5.7): OCP edge rails, the
-sewn B-spline shell, STEP round trip, builder/algebra mode, the cadquery Workplane method."""
+sewn B-spline shell, STEP round trip, builder/algebra mode (the cadquery Workplane method: tests/test_cq_world.py)."""
 
 from __future__ import annotations
 
@@ -333,32 +333,6 @@ def test_builder_thicken_gives_a_valid_solid() -> None:
     assert part.part.is_valid
     area = ght_cad.unroll(shape.ght_loft).area
     assert abs(part.part.volume - 0.2 * area) <= (0.2 * 0.25) * 0.2 * area
-
-
-# -- cadquery -----------------------------------------------------------------------------------
-def test_cadquery_workplane_and_function(dory_shape) -> None:
-    cq = pytest.importorskip("cadquery")
-    import ght_cad.cad.cq_plugin  # noqa: F401  (registers Workplane.developableLoft)
-    from ght_cad.cad.cq_plugin import developable_loft_cq
-
-    ea, eb = cq.Edge(ght_edge(CHINE).wrapped), cq.Edge(ght_edge(SHEER).wrapped)
-    wp = cq.Workplane("XY").add(ea).add(eb).developableLoft()
-    shell = wp.val()
-    assert isinstance(shell, cq.Shell) and shell.isValid()
-    assert len(shell.Faces()) == 3
-    # same B-rep as the build123d front end: same poles
-    ours = [np.asarray(d.poles) for d in shell.ght_bspline]
-    ref = [np.asarray(d.poles) for d in dory_shape.ght_bspline]
-    assert all(a.shape == b.shape and np.max(np.abs(a - b)) <= 1e-9 * _size(dory_shape) for a, b in zip(ours, ref))
-    face = developable_loft_cq(cq.Edge.makeCircle(5.0), cq.Edge.makeCircle(2.0, cq.Vector(0, 0, 6)))
-    assert isinstance(face, cq.Face) and face.isValid()
-    assert cq.Workplane().developableLoft(ea, eb).val().isValid()
-    with pytest.raises(GHTError, match="exactly two edges"):
-        cq.Workplane().add(ea).developableLoft()
-    with pytest.raises(GHTError, match="two rails"):
-        cq.Workplane().developableLoft(ea)
-    with pytest.raises(NotDevelopableError):
-        developable_loft_cq(cq.Edge.makeLine(cq.Vector(0, 0, 0), cq.Vector(10, 0, 0)), cq.Edge.makeLine(cq.Vector(0, 5, 3), cq.Vector(0, 8, 10)))
 
 
 # -- the example --------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-pytest.importorskip("build123d")  # the cadquery tests skip by themselves where cadquery is not installed
+pytest.importorskip("build123d")  # the cadquery papercuts are in tests/test_cq_world.py (the [cadquery] world)
 
 from build123d import BuildLine  # noqa: E402
 
@@ -44,16 +44,6 @@ def test_bezier_line_refuses_what_is_not_points():
         GHTBezierLine((0, 0), "ab", (1, 0))
     with pytest.raises(GHTError, match="2 or 3 coordinates"):
         GHTBezierLine((0, 0, 0, 0), (1, 1, 1, 1), (2, 0, 0, 0))
-
-
-@pytest.mark.parametrize("dtype", [np.int64, np.float32], ids=lambda d: np.dtype(d).name)
-def test_cadquery_bezier_takes_numpy_points(dtype):
-    cq = pytest.importorskip("cadquery")
-    import ght_cad.cad.cq_plugin  # noqa: F401
-
-    exact = GHTCurve(POINTS, mu=0.25).arc_length()
-    edge = cq.Workplane("XY").ghtBezier(np.array(POINTS, dtype=dtype), mu=np.float32(0.25)).val()
-    assert edge.Length() == pytest.approx(exact, rel=1e-7)
 
 
 # -- transformed shapes carry transformed (or no) ght metadata -------------------------------
@@ -144,22 +134,6 @@ def test_nonuniform_scale_drops_the_metadata_and_loft_drops_its_core_object():
     P = np.vstack([d.poles.reshape(-1, 3) for d in turned.ght_bspline])
     P0 = np.vstack([d.poles.reshape(-1, 3) for d in half.ght_bspline])
     np.testing.assert_allclose(P[:, :2], np.c_[-P0[:, 1], P0[:, 0]], atol=1e-9 * 200)
-
-
-def test_cadquery_loft_metadata_follows_in_place_moves():
-    cadquery = pytest.importorskip("cadquery")
-
-    from ght_cad.cad.cq_plugin import developable_loft_cq
-
-    a = cadquery.Edge.makeCircle(100, angle1=0, angle2=180)
-    b = cadquery.Edge.makeCircle(60, pnt=cadquery.Vector(0, 0, 150), angle1=0, angle2=180)
-    shell = developable_loft_cq(a, b)
-    dev = shell.ght_max_deviation
-    shell.move(cadquery.Location(cadquery.Vector(0, 0, 10)))        # in place: the attributes stay on it
-    assert shell.ght_max_deviation == dev
-    assert getattr(shell, "ght_loft", None) is None
-    z = np.vstack([d.poles.reshape(-1, 3) for d in shell.ght_bspline])[:, 2]
-    assert z.min() == pytest.approx(10.0, abs=1e-9) and z.max() == pytest.approx(160.0, abs=1e-6)
 
 
 # -- exact_edges keeps build123d's clean: history, warnings, nested SkipClean ----------------

@@ -78,19 +78,30 @@ def test_bad_plates_are_refused(tmp_path) -> None:
     assert plate_faces(read_step(write_plate_step(plate_solid(cylinder(10.0), Sheet(1.0)), tmp_path / "x.step"))) is not None
 
 
-def test_build123d_and_cadquery_faces_and_solids() -> None:
-    """The same sheet options on a build123d face and a cadquery face; the plate as both kinds of solid."""
-    cq = pytest.importorskip("cadquery")
+def test_build123d_faces_and_solids() -> None:
+    """The sheet options on a build123d face; the plate as a build123d solid (the cadquery
+    half is the next test, which runs in the [cadquery] world: tests/test_install.py)."""
+    pytest.importorskip("build123d")
     from build123d import Solid
 
     r, h, T, K = 30.0, 12.0, 1.5, 0.3
     b_face = next(f for f in Solid.make_cylinder(r, h, angle=90).faces() if f.geom_type.name == "CYLINDER")
-    c_face = next(f for f in cq.Workplane().cylinder(h, r, angle=90).faces().vals() if f.geomType() == "CYLINDER")
-    for face in (b_face, c_face):
-        pat = unroll(face, thickness=T, k_factor=K)  # face normal away from the axis
-        assert pat.area == pytest.approx(0.5 * math.pi * (r + K * T) * h, rel=1e-9)
+    pat = unroll(b_face, thickness=T, k_factor=K)  # face normal away from the axis
+    assert pat.area == pytest.approx(0.5 * math.pi * (r + K * T) * h, rel=1e-9)
     plate = plate_solid(b_face, Sheet(T, K))
     exact = 0.25 * math.pi * ((r + T) ** 2 - r**2) * h
     assert plate.to_build123d().volume == pytest.approx(exact, rel=1e-9)
+
+
+def test_cadquery_faces_and_solids() -> None:
+    """The same sheet options on a cadquery face; the plate as a cadquery solid."""
+    cq = pytest.importorskip("cadquery")
+
+    r, h, T, K = 30.0, 12.0, 1.5, 0.3
+    c_face = next(f for f in cq.Workplane().cylinder(h, r, angle=90).faces().vals() if f.geomType() == "CYLINDER")
+    pat = unroll(c_face, thickness=T, k_factor=K)  # face normal away from the axis
+    assert pat.area == pytest.approx(0.5 * math.pi * (r + K * T) * h, rel=1e-9)
+    plate = plate_solid(c_face, Sheet(T, K))
+    exact = 0.25 * math.pi * ((r + T) ** 2 - r**2) * h
     assert plate.to_cadquery().Volume() == pytest.approx(exact, rel=1e-9)
     assert plate_solid(c_face, thickness=T, side="reverse").volume == pytest.approx(0.25 * math.pi * (r**2 - (r - T) ** 2) * h, rel=1e-9)

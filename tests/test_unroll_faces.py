@@ -387,14 +387,6 @@ def test_bezier_and_rational_bezier_faces() -> None:
         assert pat.errors["max"] < 1e-10
 
 
-def test_cadquery_face() -> None:
-    cq = pytest.importorskip("cadquery")
-
-    face = next(f for f in cq.Workplane().cylinder(5.0, 2.0).val().Faces() if f.geomType() == "CYLINDER")
-    pat = unroll(face)
-    assert pat.area == pytest.approx(2 * math.pi * 2.0 * 5.0, rel=RTOL)
-
-
 def _torus_face(major_angle: float = 360.0):
     return _face(bd.Torus(10.0, 2.0, major_angle=major_angle), bd.GeomType.TORUS)
 
