@@ -45,6 +45,7 @@ def saddle_face():
                    reason="seams along the saddle's asymptotic (straight) parameter lines: no rails loft joins two skew "
                           "lines, the march needs more than 30 strips; the strips must follow the principal directions "
                           "(issue 24, fit owned by approxfit)")
+@pytest.mark.slow
 def test_saddle_in_its_own_parametrization():
     face = saddle_face()
     res = ght_cad.approximate(face, TOL, max_panels=30)

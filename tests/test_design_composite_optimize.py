@@ -217,6 +217,7 @@ def test_other_objectives_never_worse_and_recomputed(objective: str, weights) ->
     assert [(j["requested"], j["achieved_G"]) for j in o.joints] == [("G2", 2)]
 
 
+@pytest.mark.slow
 def test_reproducible_for_a_fixed_seed_and_subset_of_parameters() -> None:
     """Same seed, same result (parameters, value, history); only the listed parameters move."""
     text = TEXT.replace('parameters = ["quarter.mu", "quarter.nu", "quarter.gamma",\n              ',

@@ -404,6 +404,7 @@ def test_hopper_outline_within_chord_tolerance(hopper_pattern: FlatPattern, chor
         assert bulges.size < len(panel.loop_arcs(1e-3)[0][1])
 
 
+@pytest.mark.slow
 def test_cli_chord_tol(hopper_pattern: FlatPattern, tmp_path, capsys) -> None:
     """``ght-cad unroll DESIGN --dxf --svg --chord-tol 0.1`` (and ``export``) writes the outline of that tolerance
     (the vertices of :meth:`FlatPattern.outline_arcs`); ``--chord-tol 0`` is refused (exit 2, one

@@ -267,6 +267,7 @@ def _classify(name: str, rc: int, err: str) -> str:
     return "exit 2: refused, key named"
 
 
+@pytest.mark.slow
 @_settings(N_DESIGN)
 @given(case=mutated_design(sorted(EXAMPLES)))
 def test_mutated_design(case: tuple[str, bytes, str], tmp_path_factory: pytest.TempPathFactory) -> None:
@@ -374,6 +375,7 @@ def step_mutation(draw: Any, data: bytes) -> tuple[bytes, str]:
     return data[:m.start()] + v + data[m.end():], f"{m.group(0)!r} -> {v!r}"
 
 
+@pytest.mark.slow
 @_settings(N_STEP)
 @given(data=st.data())
 def test_mutated_step(data: Any, step_bytes: bytes, tmp_path_factory: pytest.TempPathFactory) -> None:

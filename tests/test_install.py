@@ -51,6 +51,7 @@ def test_blocker_really_blocks(tmp_path: Path) -> None:
                                    "blocked OCP.gp", "kernel False"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("blocked", ["OCP,build123d,cadquery", "OCP,build123d,cadquery,ezdxf"])
 def test_core_only_run_writes_dxf_svg_json(tmp_path: Path, blocked: str) -> None:
     design = tmp_path / "cone.toml"

@@ -193,6 +193,7 @@ rulings = 6
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sheet", ["", "\n[sheet]\nthickness = 2.0\nk_factor = 0.4\n"])
 def test_design_surfaces_meeting_g1_along_a_rail_are_one_blank(sheet: str) -> None:
     """Two `rails` lofts over one planar profile (every rail has the same x, y control points: one

@@ -153,6 +153,7 @@ def _design_fns(text: str):
     return _objective_fn(d, curves, d.optimize), _value_and_grad_fn(d, curves, d.optimize, names, shape_of), shape_of
 
 
+@pytest.mark.slow
 def test_design_rails_objective_gradient_matches_fd() -> None:
     """examples/design_hull_plate.toml's objective (fan share of the candidate loft, the sheer being
     the first curve of a G1 join, so not re-solved): the value_and_grad given to hybrid has the

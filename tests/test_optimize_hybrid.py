@@ -92,6 +92,7 @@ def test_user_jacobian():
     (wave_strip_problem, {"a.mu": -1.0, "a.nu": 1.0, "a.gamma": -1.0, "b.nu": 1.0}),
     (cone_strip_problem, {"a.nu": -1.0, "a.gamma": -1.0, "b.nu": 1.0}),
 ])
+@pytest.mark.slow
 def test_optimum_on_the_box_boundary_is_reached_exactly(make, bound_params):
     p = make()
     de = differential_evolution(p, p.bounds, pop_size=30, max_iter=150, seed=0)

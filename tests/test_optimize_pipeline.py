@@ -18,6 +18,7 @@ from ght_cad.optimize.problems import default_dual_problem, default_interpolatio
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_dual_problem_to_step_and_flat_pattern(tmp_path):
     p = default_dual_problem("CVEn")
     d = optimize_design(p, pop_size=10, max_iter=20, seed=0, out_dir=tmp_path, stem="duct")
@@ -105,6 +106,7 @@ def test_budget_sweep_takes_the_best_grid_point():
         budget_sweep(sphere, b, "pso", 0.0, pop_sizes=())
 
 
+@pytest.mark.slow
 def test_plots_are_png(tmp_path):
     f = lambda X: np.sum(X**2, axis=1)  # noqa: E731
     runs = [igwo(f, (-np.ones(2), np.ones(2)), pop_size=6, max_iter=10, seed=s) for s in range(3)]

@@ -12,6 +12,7 @@ PLANES = [(-400, 1, 0, 0.5), (-400, 1, 1, 0.5), (-400, 0, 1, 0.5)]
 CUTS = [(0, 0, 0, 1), (-400, 0, 0, 1)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dtype", [np.int32, np.int64, np.float32], ids=lambda d: np.dtype(d).name)
 def test_core_constructors_take_numpy_numbers(dtype):
     """Points, planes and options given as numpy arrays/scalars of any dtype give what the same

@@ -92,6 +92,7 @@ def test_exact_cylinder_patch():
     assert np.abs(np.hypot(q[:, 0], q[:, 1]) - 2.0).max() <= face_data.info["tol"]
 
 
+@pytest.mark.slow
 @settings(max_examples=12)
 @given(m=st.integers(2, 10), n=st.integers(2, 10), params=params6, seed=st.integers(0, 2**31 - 1))
 def test_to_bspline_certified_deviation(m, n, params, seed):

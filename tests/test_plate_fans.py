@@ -258,6 +258,7 @@ def test_exact_and_offset_plates_of_smooth_strips() -> None:
     assert plate_volume(cylinder(r, h), Sheet(T, 0.4, "reverse")) == pytest.approx(0.25 * math.pi * (r**2 - (r - T) ** 2) * h, rel=1e-13)
 
 
+@pytest.mark.slow
 def test_plate_step_names_readers_and_unroll(tmp_path) -> None:
     """The plate of the hull loft in STEP: one inside and one outside face (C0 at the joint rulings),
     found by names and by geometry, thickness T, unrolled as one panel equal to the loft's own

@@ -238,6 +238,7 @@ def test_run_plated_skiff_with_a_pointed_side_panel(tmp_path, capsys) -> None:
     assert all(math.isfinite(joint[k]) for k in ("outside_edge_distance_max", "fold_angle_deg_max"))
 
 
+@pytest.mark.slow
 def test_unroll_step_of_a_plain_pointed_loft(tmp_path, capsys) -> None:
     """The skiff without its sheet written to STEP and read back (``ght-cad unroll model.step``):
     its side face comes to a point at the bow, where the B-spline's end poles differ by rounding

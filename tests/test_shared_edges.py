@@ -189,6 +189,7 @@ def test_candidates_grow_linearly():
     assert per_edge[-1] <= 2.0 and per_edge[-1] <= 1.5 * per_edge[0] + 0.5, per_edge
 
 
+@pytest.mark.slow
 def test_step_faces_same_marks_as_all_pairs(tmp_path, monkeypatch):
     import importlib.util
 
@@ -211,6 +212,7 @@ def test_step_faces_same_marks_as_all_pairs(tmp_path, monkeypatch):
     assert len(res.pattern.panels) >= 60 and seen and seen[0] > 0
 
 
+@pytest.mark.slow
 def test_dory_surfaces_same_marks_as_all_pairs(monkeypatch):
     from ght_cad.design import build_surfaces, load_design, unroll_surfaces
 

@@ -42,6 +42,7 @@ def edge(pattern, name: str) -> dict:
     return next(e for e in pattern.sheet["edges"] if e["edge"] == name)
 
 
+@pytest.mark.slow
 @settings(max_examples=20, deadline=None)
 @given(r=st.floats(5.0, 500.0), t_rel=st.floats(0.001, 0.2), K=st.floats(0.0, 1.0), h=st.floats(1.0, 200.0))
 def test_cylinder_flat_width_is_phi_r_plus_KT(r: float, t_rel: float, K: float, h: float) -> None:

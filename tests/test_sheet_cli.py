@@ -104,6 +104,7 @@ def test_sheet_flags_on_a_design_file_are_refused(capsys, tmp_path) -> None:
     assert rc == EXIT_USAGE and "--forming-png needs a sheet thickness" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("side", ["normal", "reverse"])
 def test_plate_step_of_a_run_unrolls_to_the_runs_neutral_pattern(tmp_path, capsys, side) -> None:
     """`ght-cad run` with a [sheet] writes its plate to model.step with named faces; `ght-cad unroll

@@ -65,6 +65,7 @@ def test_thickness_zero_is_the_plain_pattern(tmp_path) -> None:
     assert plain.dxf_r12_text() == zero.dxf_r12_text()
 
 
+@pytest.mark.slow
 def test_run_writes_the_plate_solid_and_forming_chart(tmp_path, capsys) -> None:
     from ght_cad.cad.occ import is_valid, volume
     from ght_cad.cad.sheet_solid import read_step_face_names

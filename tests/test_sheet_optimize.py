@@ -226,6 +226,7 @@ def test_without_a_sheet_the_optimization_is_bit_identical(method: str, pop: int
 # ---------------------------------------------------------------------------------------------
 # the constraint at work
 # ---------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_a_boundary_optimum_is_held_inside_by_the_margin() -> None:
     # CVEn falls monotonically with gamma while the radius falls from 240 to 120: with K T = 180 the
     # constrained optimum lies on the boundary radius = K T; hybrid's finishes converge onto it
@@ -294,6 +295,7 @@ def test_an_infeasible_start_is_said_and_a_feasible_design_found(tmp_path, capsy
     assert "is refused by the sheet check" in (out / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_a_thickness_no_candidate_can_carry_exit_2_nothing_written(tmp_path, capsys) -> None:
     text = bracket(_sheet(200.0, 0.5), method="pso", pop=4, it=2)
     rc, err, out = run_cli(tmp_path, text, capsys)
@@ -311,6 +313,7 @@ def test_a_thickness_no_candidate_can_carry_exit_2_nothing_written(tmp_path, cap
     assert f"allowed: a sheet with |K*T| < {closest:.6g}" in str(e.value)
 
 
+@pytest.mark.slow
 def test_apexes_everywhere_exit_2_naming_the_apex(tmp_path, capsys) -> None:
     rc, err, out = run_cli(tmp_path, TRANSITION, capsys)
     assert rc == EXIT_USAGE and len(err.strip().splitlines()) == 1, err
@@ -356,6 +359,7 @@ def test_every_candidate_surface_goes_through_accept(kind: str) -> None:
     assert seen and seen[0] == sh
 
 
+@pytest.mark.slow
 def test_exact_gradient_path_refuses_like_the_values() -> None:
     free = optimize_design(design(bracket(method="hybrid", pop=6, it=6)), progress=False)
     d = design(bracket(_sheet(6.0, 0.5)))

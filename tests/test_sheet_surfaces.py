@@ -74,6 +74,7 @@ def plated_run(tmp_path_factory):
     return out, json.loads((out / "report.json").read_text())
 
 
+@pytest.mark.slow
 def test_plated_dory_runs_two_named_valid_solids(plated_run) -> None:
     from ght_cad.cad.occ import is_valid
     from ght_cad.cad.sheet_solid import read_step_face_names
@@ -110,6 +111,7 @@ def test_plated_dory_runs_two_named_valid_solids(plated_run) -> None:
     assert "FORMING" in dxf
 
 
+@pytest.mark.slow
 def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
     out, rep = plated_run
     rc = main(["unroll", str(out / "model.step"), "--k-factor", "0.44", "--json"])
@@ -175,6 +177,7 @@ k_factor = 0.4
 """
 
 
+@pytest.mark.slow
 def test_neutral_patterns_exact_without_fans() -> None:
     from ght_cad.design import unroll_surfaces
     from ght_cad.sheet import OffsetRuledSurface
@@ -190,6 +193,7 @@ def test_neutral_patterns_exact_without_fans() -> None:
     assert any(t[2] == "E1" for t in pat.labels)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", ["side rails swapped", "keel reversed", "sheer reversed"])
 def test_material_on_the_same_side_of_the_shell(variant) -> None:
     """Flipping a rail's direction or the rail order of one surface flips that surface's own
@@ -242,6 +246,7 @@ def test_bad_overrides_refused(tmp_path, capsys, text, key) -> None:
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_refusal_names_the_surface(tmp_path, capsys) -> None:
     # the bottom bends down to a radius of 183 mm, the side to 3844 mm: |K T| = 220 only fails the bottom
     p = tmp_path / "thick.toml"
@@ -258,6 +263,7 @@ def test_refusal_names_the_surface(tmp_path, capsys) -> None:
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_thickness_zero_and_no_sheet_are_the_plain_run() -> None:
     """T = 0 on every surface: the patterns of the design without [sheet], bit for bit, and the
     design dict of a [[surfaces]] design without [sheet] has no new keys."""
