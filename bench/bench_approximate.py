@@ -78,7 +78,7 @@ def main() -> None:
     ap.add_argument("--png", default=os.path.join(os.path.dirname(__file__), "..", "docs", "img", "approximate_panels.png"))
     args = ap.parse_args()
     from ght_cad.approximation import approximate
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     tols = [float(x) for x in args.tols.split(",")]
     tg = targets()

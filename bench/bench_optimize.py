@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ght_cad.io import write_text_atomic
+from ght_cad.core.io import write_text_atomic
 from ght_cad.optimize import METHODS, differential_evolution, hybrid
 from ght_cad.optimize.compare import budget_sweep, compare, format_table, set_target
 from ght_cad.optimize.pareto import pareto_front
@@ -56,7 +56,7 @@ from ght_cad.optimize.problems import (
     default_strip_problem,
     wave_strip_problem,
 )
-from ght_cad.progress import Progress
+from ght_cad.core.progress import Progress
 
 
 SWEEP_POPS = (8, 10, 15, 20, 30)

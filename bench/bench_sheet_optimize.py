@@ -57,7 +57,7 @@ def _candidates(design, n: int):
     """(shape, surface, plain time) of n random candidates that build."""
     from ght_cad.design.build import _initial_shape, build_curves
     from ght_cad.design.optimize import _objective_fn
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     curves, _ = build_curves(design)
     base = _initial_shape(design, curves)

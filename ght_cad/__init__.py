@@ -10,10 +10,13 @@ Stable names (spec section 9): :func:`basis`, :class:`GHTCurve`, :func:`developa
 
 from __future__ import annotations
 
-from ._lazy import lazy_getattr
+import importlib
+from typing import Any
+
+from .core._lazy import lazy_getattr
 from .basis import basis, bernstein
 from .curve import GHTCurve
-from .errors import (
+from .core.errors import (
     ConversionError,
     DegenerateGeometryError,
     EdgeOfRegressionError,
@@ -78,4 +81,19 @@ _LAZY: dict[str, str] = {
     "approximate": "ght_cad.approximation",
 }
 
-__getattr__ = lazy_getattr(__name__, _LAZY, globals())
+#: Modules moved into the layer packages (issue 27): old name -> new module path. The old path
+#: ``ght_cad.<name>`` stays importable (a shim at the old file makes it the same module object);
+#: as an attribute of this package it is imported on first use, like the names of :data:`_LAZY`.
+_MOVED: dict[str, str] = {
+    **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
+                                        "progress", "step_guard", "_kernel")},
+}
+
+_lazy_name = lazy_getattr(__name__, _LAZY, globals())
+
+
+def __getattr__(name: str) -> Any:
+    """A name of :data:`_LAZY` or an old module path of :data:`_MOVED`, imported on first use."""
+    if name in _MOVED:
+        return importlib.import_module(f"{__name__}.{name}")  # the shim, which also sets the attribute
+    return _lazy_name(name)

@@ -1,28 +1,6 @@
-"""Names a module gives without importing them up front (PEP 562 module ``__getattr__``)."""
+"""Moved to :mod:`ght_cad.core._lazy` (issue 27); this path stays importable."""
+import sys
 
-from __future__ import annotations
+from .core import _lazy as _module
 
-import importlib
-from typing import Any, Callable, Mapping
-
-
-def lazy_getattr(module: str, table: Mapping[str, str], namespace: dict[str, Any]) -> Callable[[str], Any]:
-    """A module ``__getattr__`` that imports ``table[name]`` (a dotted module path) on first use,
-    takes ``name`` from it and keeps the value in ``namespace`` (the module's ``globals()``).
-
-    Used by the facade ``ght_cad`` (heavier modules, and the CAD adapter ``unfold``) and by
-    ``ght_cad.loft`` (names that moved to ``ght_cad.optimize.problems.loft``, a higher layer).
-
-    Raises:
-        AttributeError: ``name`` is not in ``table`` (as for any missing module attribute).
-    """
-
-    def __getattr__(name: str) -> Any:
-        source = table.get(name)
-        if source is None:
-            raise AttributeError(f"module {module!r} has no attribute {name!r}")
-        value = getattr(importlib.import_module(source), name)
-        namespace[name] = value
-        return value
-
-    return __getattr__
+sys.modules[__name__] = _module

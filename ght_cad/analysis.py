@@ -28,10 +28,10 @@ import numpy as np
 
 from .composite import CompositeCurve
 from .curve import GHTCurve, curvature_from_derivatives
-from .errors import GHTError
-from ._quadrature import leggauss
-from ._validate import is_real
-from .io import atomic_path
+from .core.errors import GHTError
+from .core._quadrature import leggauss
+from .core._validate import is_real
+from .core.io import atomic_path
 
 __all__ = [
     "curvature",

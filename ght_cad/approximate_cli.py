@@ -23,7 +23,7 @@ import numpy as np
 
 from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
                                  plot_deviation, report_markdown)
-from .errors import GHTError
+from .core.errors import GHTError
 
 __all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
            "panel_pattern", "panel_plates"]
@@ -77,7 +77,7 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     ``target`` (:func:`panel_sheets`; needed with a sheet)."""
     from .cad.approximate import panels_shell
     from .cad.occ import write_step
-    from .io import atomic_write
+    from .core.io import atomic_write
 
     sheets = panel_sheets(result, target, sheet)
     if sheets is not None:

@@ -50,8 +50,8 @@ __all__ = ["DualFit", "PlaneSamples", "tangent_planes", "fit_dual_planes", "norm
 
 
 def check_optimizer(name: Any) -> None:
-    """Raise :class:`ght_cad.errors.GHTError` unless ``name`` is a :func:`ght_cad.optimize.minimize` method."""
-    from .errors import GHTError
+    """Raise :class:`ght_cad.core.errors.GHTError` unless ``name`` is a :func:`ght_cad.optimize.minimize` method."""
+    from .core.errors import GHTError
     from .optimize import METHODS
 
     key = str(name).lower().replace("-", "").replace("_", "")

@@ -16,9 +16,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._cache import readonly_cache
-from ._validate import as_parameter_array, check_degree, check_unit_interval
-from .errors import GHTError
+from .core._cache import readonly_cache
+from .core._validate import as_parameter_array, check_degree, check_unit_interval
+from .core.errors import GHTError
 from .seeds import MAX_DERIVATIVE, Seed, ght_seed_parameter_derivatives, make_seed
 
 __all__ = [

@@ -12,7 +12,7 @@ the local folder. ``DIR/batch.json`` and ``DIR/batch.md`` (plus one ``sweep-<nam
 sweep, :mod:`ght_cad.sweep`) hold one row per design:
 
 * ``status``: ``ok``, ``bad input`` (an invalid design file or geometry the pipeline refuses: a
-  :class:`~ght_cad.errors.GHTError`) or ``failed`` (an internal failure, or the worker died);
+  :class:`~ght_cad.core.errors.GHTError`) or ``failed`` (an internal failure, or the worker died);
 * ``error``: the one-line message for the last two;
 * key figures: ``area`` (flat pattern area), ``theta_max`` (degrees, spec section 5),
   ``pattern_error`` (largest relative error of the flat pattern), ``optimization``
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from .errors import GHTError
+from .core.errors import GHTError
 
 __all__ = ["BatchJob", "BatchResult", "collect_jobs", "run_batch", "run_task", "MAX_ATTEMPTS", "batch_markdown",
            "map_step_faces", "preload_run_modules"]
@@ -471,7 +471,7 @@ def run_batch(
             unreachable scheduler.
     """
     from .outdir import StagedFiles
-    from .progress import Progress
+    from .core.progress import Progress
 
     t0 = time.perf_counter()
     if not paths:

@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
-from ._cache import readonly_cache
-from ._quadrature import leggauss
-from .errors import ConversionError, GHTError
+from .core._cache import readonly_cache
+from .core._quadrature import leggauss
+from .core.errors import ConversionError, GHTError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .curve import GHTCurve

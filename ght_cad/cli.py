@@ -411,7 +411,7 @@ def _watch_sigint() -> Any:
 def _dispatch(args: argparse.Namespace) -> int:
     """Run ``args.func`` and map exceptions to exit codes (one line on stderr each)."""
     try:
-        from .errors import GHTError
+        from .core.errors import GHTError
     except Exception:  # pragma: no cover
         GHTError = ValueError  # type: ignore[assignment,misc]
     try:

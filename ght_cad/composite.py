@@ -29,11 +29,11 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_points
+from .core._validate import as_parameter_array, check_points
 from .basis import _check_order
 from .continuity import Continuity, JointReport, join, measure_continuity, reverse_g_parameters
 from .curve import GHTCurve, curvature_from_derivatives
-from .errors import GHTError, SingularJoinError
+from .core.errors import GHTError, SingularJoinError
 from .seeds import make_seed, seed_names
 
 __all__ = ["CompositeCurve"]
@@ -496,7 +496,7 @@ class CompositeCurve:
         Raises:
             GHTError: too few points, repeated consecutive points, too low a degree.
         """
-        from ._validate import check_degree
+        from .core._validate import check_degree
 
         Q = check_points("points", points, min_count=3 if closed else 2)
         m = check_degree(degree)

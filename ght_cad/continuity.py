@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from .curve import GHTCurve
-from .errors import GHTError, SingularJoinError
+from .core.errors import GHTError, SingularJoinError
 from .seeds import MAX_DERIVATIVE, BernsteinSeed, GBTSeed, GHTSeed, make_seed, seed_names
 
 __all__ = [
@@ -364,7 +364,7 @@ def join(
         known = row[:r] @ pts[:r]
         with np.errstate(over="ignore", invalid="ignore"):
             pts[r] = (targets[r] - known) / c
-    from ._validate import MAX_COORDINATE
+    from .core._validate import MAX_COORDINATE
 
     if not np.all(np.abs(pts) <= MAX_COORDINATE):  # NaN/inf included
         raise SingularJoinError(

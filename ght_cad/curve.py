@@ -13,11 +13,11 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from ._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
+from .core._validate import affine_parts, as_parameter_array, check_points, check_unit_interval
 from .basis import MAX_DIRECT_DEGREE, _check_order, bernstein, bernstein_log, seed_basis
-from ._quadrature import gauss_legendre  # noqa: F401  (public here: ght_cad.curve.gauss_legendre)
-from ._quadrature import leggauss as _leggauss
-from .errors import DegenerateGeometryError, GHTError
+from .core._quadrature import gauss_legendre  # noqa: F401  (public here: ght_cad.curve.gauss_legendre)
+from .core._quadrature import leggauss as _leggauss
+from .core.errors import DegenerateGeometryError, GHTError
 from .seeds import Seed, make_seed
 
 __all__ = ["GHTCurve", "gauss_legendre", "integrate"]

@@ -31,10 +31,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validate import as_parameter_array, check_finite_array, check_unit_interval
+from .core._validate import as_parameter_array, check_finite_array, check_unit_interval
 from .basis import evaluate_derivatives
 from .curve import GHTCurve
-from .errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
+from .core.errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
 from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
 from .ruled import Developability, RuledSurface
 # Moved to ght_cad.developables (issue 27); every name stays importable from here.
@@ -437,7 +437,7 @@ class EnvelopeDevelopable(RuledSurface):
     # -- CAD ------------------------------------------------------------------------------------
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face (degree 1 across the rulings); see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -589,7 +589,7 @@ class TangentDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -654,7 +654,7 @@ class RectifyingDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -898,6 +898,6 @@ class CompositeDevelopable:
     def to_shell(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A shell of one B-spline face per segment with shared joint edges; see
         :func:`ght_cad.cad.developable_faces.composite_shell`."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         return adapter("composite_shell")(self, tol=tol, **kwargs)

@@ -12,7 +12,7 @@ checked against its 3-D original (spec section 6) in a :class:`DistortionReport`
 * angle: ``|angle(Y_u, Y_v) - angle(X_u, X_v)|`` in degrees on a parameter grid (first
   fundamental form), flat partials by 5-point central differences of the development map.
 
-Exports write atomically through :mod:`ght_cad.io`; ezdxf and matplotlib are imported inside the
+Exports write atomically through :mod:`ght_cad.core.io`; ezdxf and matplotlib are imported inside the
 exporting methods only.
 """
 
@@ -25,8 +25,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .errors import GHTError
-from .io import write_text_atomic
+from .core.errors import GHTError
+from .core.io import write_text_atomic
 # The model, layout and writers live in ght_cad.pattern (issue 27); their names stay importable here.
 from .pattern.io import dxf as _dxf_io
 from .pattern.io import png as _png_io
@@ -274,7 +274,7 @@ class FlatPattern:
 
     def to_face(self) -> Any:
         """Planar build123d Face(s) of the pattern (outline + holes); a list for composites."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         faces = adapter("flat_faces")(self)
         return faces[0] if len(faces) == 1 else faces

@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from ._cache import readonly_cache
-from .errors import GHTError
-from ._vec import einsum as _einsum
-from ._vec import stack as _stack
+from .core._cache import readonly_cache
+from .core.errors import GHTError
+from .core._vec import einsum as _einsum
+from .core._vec import stack as _stack
 
 __all__ = ["NurbsSurface", "NurbsCurve", "expand_knots"]
 

@@ -3,12 +3,12 @@
 Every ght_cad writer that puts results on disk goes through this module (``ght-cad run``/``demo``/
 ``batch`` folders, the single-file outputs of ``curve``/``surface``/``unroll``/``export``, the
 FreeCAD workbench's exports). Three mechanisms, all plain ``os`` with ``fcntl`` locks (``msvcrt``
-on Windows; a platform with neither is refused with a :class:`~ght_cad.errors.GHTError`):
+on Windows; a platform with neither is refused with a :class:`~ght_cad.core.errors.GHTError`):
 
 **Locks.** A run that writes a folder (or a file) first takes an exclusive ``fcntl.flock`` on a
 lock file beside it, ``.<name>.ght-cad-lock``, which holds the owner's pid and command line. A
 second process on the same target either waits for it (``wait=True``, optional ``timeout``) or
-is refused with :class:`FolderBusy` (a :class:`~ght_cad.errors.GHTError`: exit code 2 on the
+is refused with :class:`FolderBusy` (a :class:`~ght_cad.core.errors.GHTError`: exit code 2 on the
 command line) naming the target and the other process. The kernel drops a flock when its
 process dies, so a killed run (SIGKILL, OOM) never leaves a stuck lock; the lock file itself is
 removed on release (a waiter that locked the removed file notices the changed inode and retries).
@@ -58,7 +58,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
-from .errors import GHTError
+from .core.errors import GHTError
 
 try:  # POSIX
     import fcntl
@@ -527,7 +527,7 @@ def read_manifest(folder: str | os.PathLike) -> list[str]:
 
 def write_manifest(folder: str | os.PathLike, files: Iterable[str], *, pending: bool = False) -> Path:
     """Write ``.ght-cad-manifest.json`` (``{"tool", "files", "pending"}``) into ``folder`` atomically."""
-    from .io import write_text_atomic
+    from .core.io import write_text_atomic
 
     body = {"tool": "ght-cad", "files": sorted(set(_safe_names(files))), "pending": bool(pending)}
     return write_text_atomic(Path(folder) / MANIFEST_NAME, json.dumps(body, indent=1) + "\n")
@@ -541,7 +541,7 @@ def _listed_by_report(folder: Path, names: Sequence[str]) -> bool:
 
 def _remove_part_leftovers(folder: Path) -> None:
     """Remove half-written manifests (``..ght-cad-manifest.*.json.part``, named by
-    :func:`ght_cad.io.atomic_path`) a killed run left in ``folder``."""
+    :func:`ght_cad.core.io.atomic_path`) a killed run left in ``folder``."""
     stem = Path(MANIFEST_NAME).stem
     try:
         for p in folder.glob(f".{stem}.*.part"):
@@ -764,7 +764,7 @@ def _restore_file(path: Path, content: bytes | None) -> None:
             if path.is_file() and not path.is_symlink():
                 path.unlink()
         else:
-            from .io import write_bytes_atomic
+            from .core.io import write_bytes_atomic
 
             write_bytes_atomic(path, content)
     except OSError:  # pragma: no cover - the folder just failed us; the manifest still covers our files

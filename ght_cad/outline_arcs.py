@@ -38,7 +38,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .errors import GHTError
+from .core.errors import GHTError
 
 __all__ = ["EXACT_REL", "ArcChain", "arc_chain", "bulge_deviation", "bulge_polygon_area", "three_point_bulge"]
 

@@ -21,11 +21,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validate import affine_parts, as_parameter_array, check_unit_interval
+from .core._validate import affine_parts, as_parameter_array, check_unit_interval
 from .basis import _check_order, seed_basis
 from .bspline import BSplineSurfaceData, fit_function
 from .curve import GHTCurve
-from .errors import GHTError
+from .core.errors import GHTError
 from .seeds import Seed, make_seed
 
 __all__ = ["GHTSurface", "join_patches", "measure_patch_continuity", "basis_bspline", "patches_to_bspline"]
@@ -81,7 +81,7 @@ def _net(control_points: Any) -> np.ndarray:
 
 def _direction_seed(seed: str, direction: str, mu: Any, nu: Any, gamma: Any) -> Seed:
     """``make_seed`` for one direction; a bad shape parameter's message names ``mu_u``, ``gamma_v``, ..."""
-    from ._validate import check_shape_parameter
+    from .core._validate import check_shape_parameter
 
     if isinstance(seed, str) and seed.lower() in ("ght", "gbt", "bernstein"):  # built-in seeds: [-1, 1]
         for name, value in (("mu", mu), ("nu", nu), ("gamma", gamma)):
@@ -376,7 +376,7 @@ class GHTSurface:
 
     def to_face(self, tol: float | None = None, degree: int = 5) -> Any:
         """build123d ``Face`` on :meth:`to_bspline` (imports the CAD adapter lazily)."""
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         if self.dim != 3:
             raise GHTError(f"a CAD face needs a 3-D patch; this patch has dim={self.dim}")

@@ -21,7 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .errors import DegenerateGeometryError, GHTError
+from .core.errors import DegenerateGeometryError, GHTError
 
 __all__ = [
     "plane_from_point_normal",

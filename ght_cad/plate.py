@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from .bspline import BSplineCurveData, BSplineSurfaceData, fit_function, join_bsplines
-from .errors import ConversionError, GHTError
+from .core.errors import ConversionError, GHTError
 from .ruled import RuledSurface
 
 __all__ = ["PlateBSplineData", "plate_bspline", "plate_volume", "PLATE_FACES"]

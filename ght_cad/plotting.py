@@ -2,7 +2,7 @@ r"""PNG figures of GHT bases, curves, curvature, surfaces, flat patterns and opt
 
 Headless: matplotlib is imported inside each function and only its object-oriented API with the
 Agg canvas is used (no ``pyplot``, no global backend switch), so ``import ght_cad`` never imports
-matplotlib. Every PNG is written atomically through :func:`ght_cad.io.atomic_path` and has a
+matplotlib. Every PNG is written atomically through :func:`ght_cad.core.io.atomic_path` and has a
 fixed pixel size, listed in :data:`SIZES` (width, height in pixels at 100 dpi):
 
 ==============  ===========
@@ -26,9 +26,9 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from ._validate import check_degree, check_shape_parameter
-from .errors import GHTError
-from .io import atomic_path
+from .core._validate import check_degree, check_shape_parameter
+from .core.errors import GHTError
+from .core.io import atomic_path
 
 __all__ = [
     "SIZES",

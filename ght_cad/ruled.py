@@ -18,13 +18,13 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._cache import readonly_cache
-from ._validate import as_parameter_array
-from ._vec import cross as _cross
-from ._vec import dot as _dot
-from ._vec import norm as _norm
+from .core._cache import readonly_cache
+from .core._validate import as_parameter_array
+from .core._vec import cross as _cross
+from .core._vec import dot as _dot
+from .core._vec import norm as _norm
 from .curve import GHTCurve, gauss_legendre
-from .errors import DegenerateGeometryError, GHTError
+from .core.errors import DegenerateGeometryError, GHTError
 
 __all__ = [
     "Developability",

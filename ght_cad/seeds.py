@@ -28,8 +28,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._validate import check_shape_parameter
-from .errors import GHTError
+from .core._validate import check_shape_parameter
+from .core.errors import GHTError
 
 __all__ = [
     "Seed",

@@ -41,8 +41,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ._quadrature import leggauss
-from .errors import GHTError
+from .core._quadrature import leggauss
+from .core.errors import GHTError
 from .ruled import SINGULAR_NORMAL_TOL, RuledSurface
 
 __all__ = [
@@ -732,7 +732,7 @@ def plot_roll_chart(pattern: Any, path: Any, *, dpi: int = 120, title: str | Non
     """
     from matplotlib.figure import Figure
 
-    from .io import atomic_path
+    from .core.io import atomic_path
 
     panels = [p for p in pattern.panels if p.info.get("sheet")]
     if not panels:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
-from .errors import GHTError
+from .core.errors import GHTError
 
 __all__ = ["SweepError", "Variant", "Sweep", "expand_sweep", "SWEEP_FIGURES", "MAX_VARIANTS", "plot_sweep"]
 
@@ -229,7 +229,7 @@ def plot_sweep(sweep: Sweep, rows: Sequence[dict[str, Any]], path: str | os.Path
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .io import atomic_path
+    from .core.io import atomic_path
 
     k = len(sweep.plot)
     fig = Figure(figsize=(9, 3 * k), dpi=100)

@@ -32,14 +32,14 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .curve import gauss_legendre, integrate
-from .errors import DegenerateGeometryError, GHTError, NotDevelopableError
-from ._validate import is_real
-from ._vec import cross as _cross
-from ._vec import einsum as _einsum
-from ._vec import stack as _stack
-from ._vec import dot as _dot
-from ._vec import norm as _norm
-from ._vec import unique_inverse as _unique_inverse
+from .core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from .core._validate import is_real
+from .core._vec import cross as _cross
+from .core._vec import einsum as _einsum
+from .core._vec import stack as _stack
+from .core._vec import dot as _dot
+from .core._vec import norm as _norm
+from .core._vec import unique_inverse as _unique_inverse
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from .ruled import RuledSurface
 
@@ -662,7 +662,7 @@ def unroll(
             sheet=sheet,
         )
     if hasattr(surface_or_face, "wrapped") or type(surface_or_face).__module__.startswith("OCP"):
-        from ._kernel import adapter
+        from .core._kernel import adapter
 
         faces = adapter("shape_faces")(surface_or_face)
         if len(faces) > 1:  # a shell, solid or compound: one panel per face

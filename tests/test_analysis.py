@@ -22,7 +22,7 @@ from ght_cad.analysis import (
     signed_curvature,
 )
 from ght_cad.composite import CompositeCurve
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

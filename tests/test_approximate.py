@@ -30,7 +30,7 @@ import ght_cad  # noqa: E402
 from ght_cad.approximation import SurfaceTarget, approximate  # noqa: E402
 from ght_cad.cad.approximate import face_target, panels_shell  # noqa: E402
 from ght_cad.cad.unroll_faces import shape_faces  # noqa: E402
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 
 
 def _face(geom):

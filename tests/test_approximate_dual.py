@@ -14,7 +14,7 @@ import pytest
 
 from ght_cad.approximation import SurfaceTarget, _Frame, approximate
 from ght_cad.approximation_dual import fit_strip
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 
 def bump_target(amp: float, width: float = 0.1, R1: float = 800.0, R2: float = 4000.0) -> SurfaceTarget:

@@ -23,7 +23,7 @@ pytest.importorskip("OCP")
 import ght_cad  # noqa: E402
 from ght_cad.cad.approximate import panels_shell  # noqa: E402
 from ght_cad.cad.unroll_faces import shape_faces  # noqa: E402
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 
 from test_approximate import bspline_face, twist_deg, two_way  # noqa: E402
 

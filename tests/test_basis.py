@@ -271,7 +271,7 @@ def test_ght_seed_high_orders_are_derivatives(mu: float, nu: float, gamma: float
 
 
 def test_jets_reject_orders_a_seed_does_not_provide() -> None:
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     cubic = _cubic_seed_class("cubic-jets-test")()
     with pytest.raises(GHTError, match="derivative order 4 .* provides orders 0..3"):

@@ -10,7 +10,7 @@ import pytest
 
 from ght_cad.cli import main
 from ght_cad.design import unroll_step
-from ght_cad.errors import NotDevelopableError
+from ght_cad.core.errors import NotDevelopableError
 
 pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]  # process pools over STEP files
 

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
 from ght_cad.bspline import BSplineCurveData, _banded_least_squares, _nonzero_basis, clamped_knots, curve_to_bspline, fit_function
-from ght_cad.errors import ConversionError, GHTError
+from ght_cad.core.errors import ConversionError, GHTError
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)
 

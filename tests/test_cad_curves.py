@@ -26,7 +26,7 @@ from ght_cad.cad.occ import read_step, volume, write_step  # noqa: E402
 from ght_cad.composite import CompositeCurve  # noqa: E402
 from cad_checks import green_area as _green_area  # noqa: E402
 from ght_cad.curve import gauss_legendre  # noqa: E402
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 from ght_cad.patch import GHTSurface  # noqa: E402
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)

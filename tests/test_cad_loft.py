@@ -25,7 +25,7 @@ from ght_cad.cad.curves import ght_edge  # noqa: E402
 from ght_cad.cad.developable_faces import _internal_edges, face_developability, shell_faces  # noqa: E402
 from ght_cad.cad.loft import OCPCurveRail, developable_loft, rail_of  # noqa: E402
 from ght_cad.cad.occ import is_valid, read_step, write_step  # noqa: E402
-from ght_cad.errors import DegenerateGeometryError, GHTError, NotDevelopableError  # noqa: E402
+from ght_cad.core.errors import DegenerateGeometryError, GHTError, NotDevelopableError  # noqa: E402
 
 THETA_STEP_DEG = 0.01  # acceptance: twist of every face read back from STEP
 COVER_REL = 1e-6  # acceptance: rails covered by the faces' edges, relative to the size

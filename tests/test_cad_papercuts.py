@@ -12,7 +12,7 @@ from build123d import BuildLine  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.curves import GHTBezierLine  # noqa: E402
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 
 POINTS = [(0.0, 0.0), (4.0, 3.0), (8.0, 0.0)]
 DTYPES = [np.int8, np.int16, np.int32, np.int64, np.uint8, np.float16, np.float32, np.float64]

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from ght_cad.cli import main
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from dxf_read import dxf_outline_areas, outline_bulges, outline_entities, outline_vertices, svg_outline_areas
 

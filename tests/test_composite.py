@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from ght_cad import GHTCurve
 from ght_cad.composite import CompositeCurve
 from ght_cad.continuity import Continuity
-from ght_cad.errors import GHTError, SingularJoinError
+from ght_cad.core.errors import GHTError, SingularJoinError
 
 param = st.floats(-1.0, 1.0, allow_nan=False)
 shape3 = st.tuples(param, param, param)

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
 from ght_cad.continuity import Continuity, join, measure_continuity, reverse_g_parameters
-from ght_cad.errors import GHTError, SingularJoinError
+from ght_cad.core.errors import GHTError, SingularJoinError
 
 # Tolerances: measure_continuity's default relative tol (1e-9) is used throughout; a join is
 # exact up to rounding, so residuals are ~1e-15, six orders below it.

@@ -104,7 +104,7 @@ def test_messages_show_the_exact_bad_value_and_complex_parameters_are_named() ->
     import pytest as _pytest
 
     from ght_cad import GHTCurve
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     with _pytest.raises(GHTError, match=r"gamma=-1\.0000001 is outside the allowed range \[-1, 1\]"):
         GHTCurve([[0, 0], [1, 1], [2, 0]], gamma=-1.0000001)

@@ -23,7 +23,7 @@ import ght_cad.cad.cq_plugin  # noqa: E402,F401  (registers Workplane.ghtBezier 
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.cq_plugin import developable_loft_cq  # noqa: E402
 from ght_cad.cad.occ import read_step, read_step_products, write_step  # noqa: E402
-from ght_cad.errors import GHTError, NotDevelopableError  # noqa: E402
+from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
 
 BLOCKER = Path(__file__).resolve().parent / "no_kernel"
 ROOT = Path(__file__).resolve().parent.parent

@@ -540,7 +540,7 @@ def test_planes_objective_is_inf_exactly_when_the_surface_degenerates(x: list[fl
     integrand is smooth. AL's |U'| has a near-kink where U' almost vanishes on this design, and
     64-node Gauss–Legendre AL is only within ~1e-4 relative of the converged integral there)."""
     from ght_cad.design import OptimizeSpec, _objective_fn, build_surface
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
     from ght_cad.planes import normalize_planes
 
     d = parse_design_text((EXAMPLES / "design_duct.toml").read_text(), "duct.toml")

@@ -241,7 +241,7 @@ def test_candidate_objective_is_inf_exactly_when_the_composite_degenerates(x: li
     """Over the whole box: +inf iff building the composite fails (singular join, stationary dual
     curve, ...); otherwise finite, the joint measures G1 as requested and both strips are
     developable."""
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     d = parse_design_text(deg2(), "deg2.toml")
     shape = dict(zip([f"{g}.{k}" for g in "ab" for k in ("mu", "nu", "gamma")], x))

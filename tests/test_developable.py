@@ -23,7 +23,7 @@ from ght_cad.developable import (
     join_developable,
     measure_developable_joint,
 )
-from ght_cad.errors import (
+from ght_cad.core.errors import (
     DegenerateGeometryError,
     EdgeOfRegressionError,
     GHTError,

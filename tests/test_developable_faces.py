@@ -35,7 +35,7 @@ from ght_cad.developable import (  # noqa: E402
     developable_from_planes,
     join_developable,
 )
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 from ght_cad.planes import plane_from_point_normal  # noqa: E402
 from ght_cad.ruled import CurvePairRuledSurface  # noqa: E402
 

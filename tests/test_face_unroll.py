@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from ght_cad.errors import NotDevelopableError
+from ght_cad.core.errors import NotDevelopableError
 from ght_cad.face_unroll import (
     EdgeData,
     FaceData,
@@ -393,7 +393,7 @@ def test_hole_given_as_outer_wire_is_reordered(kind: str) -> None:
 def test_hole_outside_the_outer_wire_is_refused() -> None:
     """A hole pcurve shifted by a period (u + 2π, outside the face's box): refused naming the wire
     (before: a pattern with the hole drawn beside the outline, area and errors still "right")."""
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     R, H, r = 4.0, 10.0, 1.5
     surf = Cylinder(R, "cylinder")

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ght_cad import GHTCurve
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.flat_pattern import DistortionReport, FlatPattern, clip_segments, romberg_length
 from ght_cad.ruled import CurvePairRuledSurface
 from ght_cad.unroll import unroll, unroll_composite

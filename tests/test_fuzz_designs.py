@@ -277,7 +277,7 @@ def test_mutated_design(case: tuple[str, bytes, str], tmp_path_factory: pytest.T
     path.write_bytes(text)
     if name in SLOW_BUILD:  # validation only (the surface command's first step)
         from ght_cad.design import load_design
-        from ght_cad.errors import GHTError
+        from ght_cad.core.errors import GHTError
 
         err = ""
         with warnings.catch_warnings(record=True) as caught, _limit(CASE_LIMIT_S):

@@ -78,7 +78,7 @@ def test_basis_parameter_derivatives_match_population_basis_and_validate():
         for r in (0, 2):
             assert np.allclose(got[r][:, i], basis_parameter_derivatives(T, 5, m, n, g, r), atol=1e-14)
     assert basis_parameter_derivatives(0.5, 3, 0.2, 0.1, 0.0).shape == (3, 4)
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     with pytest.raises(GHTError, match="mu"):
         basis_parameter_derivatives(T, 3, 1.5, 0.0, 0.0)

@@ -193,7 +193,7 @@ def test_empty_out_is_refused(argv: list[str], tiny: Path, tmp_path: Path, capsy
 
 
 def test_empty_output_folder_refused_by_the_library(tmp_path: Path) -> None:
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
     from ght_cad.outdir import OutputFolder, StagedFiles
 
     with pytest.raises(GHTError, match="empty"):
@@ -319,8 +319,8 @@ def test_step_scan_keeps_legal_numbers(cylinder_step: bytes, tmp_path: Path, cap
 
 
 def test_step_scan_names_the_entity() -> None:
-    from ght_cad.errors import GHTError
-    from ght_cad.step_guard import check_step_numbers
+    from ght_cad.core.errors import GHTError
+    from ght_cad.core.step_guard import check_step_numbers
 
     for text, token in [(b"#7=CARTESIAN_POINT('',(3E+291,0.,0.));", "#7 CARTESIAN_POINT"),
                         (b"#1=A(1.);\n#8=B_SPLINE_CURVE_WITH_KNOTS('',(-1.E+20));", "#8 B_SPLINE_CURVE_WITH_KNOTS"),
@@ -345,7 +345,7 @@ def test_pencil_of_control_planes_is_degenerate() -> None:
     import numpy as np
 
     from ght_cad import developable_from_planes
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     planes = [[0.0, np.sin(a), -np.cos(a), 0.0] for a in (0.1, 0.7, 1.3)]
     with pytest.raises(DegenerateGeometryError, match="pencil"):
@@ -361,7 +361,7 @@ def test_curvature_where_the_tangent_vanishes_raises() -> None:
     import numpy as np
 
     from ght_cad import GHTCurve
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     c = GHTCurve([[0, 0], [0, 0], [1, 1]])
     with pytest.raises(DegenerateGeometryError, match=r"t=0\b"):
@@ -375,7 +375,7 @@ def test_control_points_near_1e300_are_refused_without_warnings() -> None:
     import warnings
 
     from ght_cad import GHTCurve
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -385,7 +385,7 @@ def test_control_points_near_1e300_are_refused_without_warnings() -> None:
 
 def test_zero_width_ruled_surface_is_degenerate_not_nan() -> None:
     from ght_cad import GHTCurve, unroll
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
     from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
 
     c = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 1]])
@@ -402,7 +402,7 @@ def test_join_with_huge_k_is_refused_naming_k() -> None:
 
     from ght_cad import GHTCurve
     from ght_cad.continuity import join
-    from ght_cad.errors import SingularJoinError
+    from ght_cad.core.errors import SingularJoinError
 
     a = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 0]])
     with warnings.catch_warnings():

@@ -35,23 +35,24 @@ WORKBENCH = ROOT / "freecad_workbench" / "freecad"
 LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
 
 _LAYER_OF = {
-    "core": ["errors", "_validate", "_vec", "_quadrature", "_cache", "io", "outdir", "progress", "step_guard", "_kernel", "_lazy"],
-    "curves": ["seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
+    # the layer packages of issue 27 are named after their layer; a few modules stay top-level
+    "core": ["core", "outdir"],
+    "curves": ["curves", "seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
                "patch", "plotting"],
-    "surfaces": ["ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern", "pattern", "faces", "developables", "join_panels",
-                 "outline_arcs", "blank"],
+    "surfaces": ["surfaces", "ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern",
+                 "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],
     "kernel": ["cad"],
     "app": ["cli", "commands", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
 }
 
-#: The core's one way to the kernel layer: ``ght_cad._kernel.load_kernel`` imports ``ght_cad.cad``,
+#: The core's one way to the kernel layer: ``ght_cad.core._kernel.load_kernel`` imports ``ght_cad.cad``,
 #: which registers its adapters with the registry (``to_face``, unrolling a CAD face, STEP output
-#: and the like go through ``ght_cad._kernel.adapter``). It is the only upward import allowed for
+#: and the like go through ``ght_cad.core._kernel.adapter``). It is the only upward import allowed for
 #: good, and it is not an edge of the cycle check (``ght_cad.cad`` importing the registry to fill
 #: it is the point of the plug-in).
-KERNEL_HOOK = ("ght_cad._kernel", "ght_cad.cad")
+KERNEL_HOOK = ("ght_cad.core._kernel", "ght_cad.cad")
 
 #: Imports from a lower layer into a higher one that exist today: (importer, imported).
 ALLOWED_UPWARD = {
@@ -118,7 +119,35 @@ def import_graph() -> dict[str, set[str]]:
     return {m: imports_of(f.read_text(encoding="utf-8"), m, is_pkg, known) for m, (f, is_pkg) in mods.items()}
 
 
+def shim_target(path: Path) -> str | None:
+    """The module an old path's shim stands for (issue 27), or None if ``path`` is no shim.
+
+    A shim is ``from .<package> import <name> as _module`` and ``sys.modules[__name__] = _module``:
+    importing the old path gives the moved module itself.
+    """
+    text = path.read_text(encoding="utf-8")
+    if "sys.modules[__name__] = _module" not in text:
+        return None
+    for node in ast.parse(text).body:
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and [a.asname for a in node.names] == ["_module"]:
+            return f"ght_cad.{node.module}.{node.names[0].name}"
+    raise AssertionError(f"{path} sets sys.modules[__name__] but imports no _module from a layer package")
+
+
+def shims() -> dict[str, str]:
+    """Old module path -> the module it is now (every shim left by a move of issue 27)."""
+    return {m: t for m, (f, is_pkg) in modules().items() if not is_pkg and (t := shim_target(f)) is not None}
+
+
+_SHIMS: dict[str, str] | None = None
+
+
 def layer(module: str) -> str:
+    """The layer of ``module``: by its first package below ``ght_cad``; a shim's is its target's."""
+    global _SHIMS
+    if _SHIMS is None:
+        _SHIMS = shims()
+    module = _SHIMS.get(module, module)
     if module == "ght_cad":
         return "facade"
     if module.startswith("ght_workbench"):

@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from ght_cad.io import atomic_path, atomic_write, write_text_atomic
+from ght_cad.core.io import atomic_path, atomic_write, write_text_atomic
 
 
 def test_success_replaces_and_leaves_no_temporary(tmp_path) -> None:

@@ -1,4 +1,4 @@
-"""The core's kernel dispatch (``ght_cad._kernel``, issue 27): the kernel-free core reaches the CAD
+"""The core's kernel dispatch (``ght_cad.core._kernel``, issue 27): the kernel-free core reaches the CAD
 adapters through a registry that ``ght_cad.cad`` fills, never through imports of its own."""
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad import _kernel
-from ght_cad.errors import GHTError
+from ght_cad.core import _kernel
+from ght_cad.core.errors import GHTError
 
 ROOT = Path(__file__).resolve().parents[1]
 BLOCKER = Path(__file__).resolve().parent / "no_kernel"
@@ -29,7 +29,7 @@ def _run(code: str, blocked: bool = False) -> subprocess.CompletedProcess[str]:
 
 def test_import_ght_cad_registers_nothing_and_loads_no_kernel() -> None:
     out = _run(
-        "import sys, json, ght_cad, ght_cad._kernel as k; "
+        "import sys, json, ght_cad, ght_cad.core._kernel as k; "
         "print(json.dumps([sorted(k.registered()), sorted(m for m in sys.modules "
         "if m.split('.')[0] in ('OCP', 'build123d', 'cadquery', 'matplotlib') or m.startswith('scipy.optimize') "
         "or m.startswith('ght_cad.cad'))]))"
@@ -41,7 +41,7 @@ def test_import_ght_cad_registers_nothing_and_loads_no_kernel() -> None:
 def test_asking_for_an_adapter_loads_the_adapters_but_no_kernel() -> None:
     """The registered adapters import their module (and OCP) only when called."""
     out = _run(
-        "import sys, json, ght_cad._kernel as k; f = k.adapter('developable_face'); "
+        "import sys, json, ght_cad.core._kernel as k; f = k.adapter('developable_face'); "
         "print(json.dumps([f.__name__, sorted(k.registered()), 'ght_cad.cad' in sys.modules, "
         "sorted(m for m in sys.modules if m.split('.')[0] in ('OCP', 'build123d', 'cadquery'))]))"
     )

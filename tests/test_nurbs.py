@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots
 
 RTOL = 1e-12

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.optimize import METHODS, differential_evolution, hybrid, minimize
 from ght_cad.optimize.problems import (
     cone_strip_problem,

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.optimize import METHODS, OptimizeResult, as_bounds, differential_evolution, gwo, igwo, minimize, pso, vectorize
 
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.optimize import igwo
 from ght_cad.optimize.pareto import (
     ParetoArchive,

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.optimize import igwo, pso
 from ght_cad.optimize.compare import budget_sweep, compare, format_table
 from ght_cad.optimize.pipeline import optimize_design

@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 
 from ght_cad import GHTCurve, basis
 from ght_cad.curve import integrate
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.optimize import igwo, pso
 from ght_cad.optimize.problems import (
     CurveFairnessProblem,

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.outdir import (
     MANIFEST_NAME,
     FolderBusy,

@@ -114,7 +114,7 @@ def test_minimize_takes_scalar_objectives_and_scipy_bounds():
     ght_cad.optimize.minimize accepts those as well as population objectives and (lb, ub)."""
     from scipy.optimize import Bounds, rosen
 
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
     from ght_cad.optimize import minimize
 
     target = np.array([0.3, -0.2, 0.5])

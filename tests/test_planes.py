@@ -7,7 +7,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from ght_cad.errors import DegenerateGeometryError, GHTError
+from ght_cad.core.errors import DegenerateGeometryError, GHTError
 from ght_cad.planes import (
     as_planes,
     check_control_planes,

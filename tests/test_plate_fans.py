@@ -31,7 +31,7 @@ from ght_cad.bspline import BSplineCurveData, fit_function, join_bsplines  # noq
 from ght_cad.cad.occ import has_c0_faces, is_valid, read_step, volume  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
 from ght_cad.developable import developable_bspline, ruled_pieces  # noqa: E402
-from ght_cad.errors import GHTError, NotDevelopableError  # noqa: E402
+from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
 from ght_cad.loft import developable_loft  # noqa: E402
 from ght_cad.plate import plate_bspline, plate_volume  # noqa: E402
 from ght_cad.sheet import Sheet, SheetError, check_offset, ruling_normal  # noqa: E402

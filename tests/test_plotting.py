@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ght_cad import GHTCurve
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.plotting import (
     SIZES,
     plot_basis,
@@ -124,7 +124,7 @@ def test_joined_curves_in_one_figure(tmp_path: Path) -> None:
 def test_plot_basis_refuses_a_degree_too_large_to_draw(tmp_path) -> None:
     """degree 100000 drew 800,000 matplotlib lines (the command ran for minutes); above
     MAX_PLOT_DEGREE the plot is refused naming the value and the allowed range, nothing written."""
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
     from ght_cad.plotting import MAX_PLOT_DEGREE, plot_basis
 
     assert MAX_PLOT_DEGREE >= 20

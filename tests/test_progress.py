@@ -1,4 +1,4 @@
-"""ght_cad.progress: drawn on a TTY only, silent otherwise."""
+"""ght_cad.core.progress: drawn on a TTY only, silent otherwise."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ght_cad.optimize import pso
-from ght_cad.progress import Progress, progress_enabled
+from ght_cad.core.progress import Progress, progress_enabled
 
 
 class FakeTTY(io.StringIO):

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ght_cad._cache import readonly_cache
-from ght_cad._quadrature import gauss_legendre, gauss_legendre_unit, leggauss
+from ght_cad.core._cache import readonly_cache
+from ght_cad.core._quadrature import gauss_legendre, gauss_legendre_unit, leggauss
 
 
 @pytest.mark.parametrize("n", [1, 3, 8, 12, 16, 24, 64])

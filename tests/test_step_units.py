@@ -13,7 +13,7 @@ from OCP.Bnd import Bnd_Box  # noqa: E402
 from OCP.BRepBndLib import BRepBndLib  # noqa: E402
 
 from ght_cad.cad.occ import read_step, write_step  # noqa: E402
-from ght_cad.errors import GHTError  # noqa: E402
+from ght_cad.core.errors import GHTError  # noqa: E402
 
 
 def _extent(shape) -> tuple[float, ...]:

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import ght_cad
 from ght_cad import GHTCurve
 from ght_cad.curve import integrate
-from ght_cad.errors import GHTError, NotDevelopableError
+from ght_cad.core.errors import GHTError, NotDevelopableError
 from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
 from ght_cad.unroll import RuledDevelopment, unroll, unroll_composite
 
@@ -221,7 +221,7 @@ def test_unsupported_input_is_refused() -> None:
 
 def test_zero_length_ruling_is_degenerate() -> None:
     """Two identical rails: refused at construction as degenerate (zero width), issue 26."""
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     with pytest.raises(DegenerateGeometryError, match="zero width"):
         CurvePairRuledSurface(quarter(1.0, 0.0), quarter(1.0, 0.0))

@@ -17,7 +17,7 @@ from conftest import freecadcmd_or_skip
 from ght_cad.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face
 from ght_cad.cad.unroll_faces import face_ruling_direction, unroll_face
-from ght_cad.errors import GHTError, NotDevelopableError
+from ght_cad.core.errors import GHTError, NotDevelopableError
 from ght_cad.unroll import unroll, unroll_composite
 
 RTOL = 1e-9
@@ -313,7 +313,7 @@ def test_unbounded_face_is_refused(which: str) -> None:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
     from OCP.gp import gp_Ax3, gp_Cylinder, gp_Pln
 
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     geom = gp_Pln() if which == "plane" else gp_Cylinder(gp_Ax3(), 5.0)
     face = bd.Face(BRepBuilderAPI_MakeFace(geom).Face())
@@ -443,7 +443,7 @@ def test_sphere_deviations_are_circle_and_half_circle() -> None:
 
 
 def test_full_torus_best_effort_names_why() -> None:
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     with pytest.raises(DegenerateGeometryError, match="closed in both directions") as exc:
         unroll(_torus_face(), best_effort=True)
@@ -454,7 +454,7 @@ def test_full_sphere_best_effort_is_refused_naming_poles() -> None:
     """A full sphere: the meridians (v-isolines) are open but run from pole to pole, so the ruled
     surface between the boundary isolines S(·, -π/2), S(·, π/2) (two points) is a segment
     (before: a "pattern" of area 7.7e-14 for a 3-D area 100π, reported as error 1.0)."""
-    from ght_cad.errors import DegenerateGeometryError
+    from ght_cad.core.errors import DegenerateGeometryError
 
     with pytest.raises(DegenerateGeometryError, match=r"v-isolines run between two points.*sphere into sectors"):
         unroll(bd.Sphere(5.0).faces()[0], best_effort=True)

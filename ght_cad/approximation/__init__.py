@@ -32,7 +32,7 @@ Algorithm (all kernel-free, numpy/scipy):
    cone with its apex there) and its deviation is measured both ways (panel points projected onto
    the target and target points projected onto the panel, Gauss–Newton). If a panel exceeds
    ``tol``, the march is repeated with a smaller ``f``; a result needing more than ``max_panels``
-   panels raises :class:`ght_cad.errors.GHTError` naming the best deviation reached.
+   panels raises :class:`ght_cad.core.errors.GHTError` naming the best deviation reached.
 
 4. **Loft or dual fit per strip** (``method="auto"``, spec 10.1): every strip also gets the dual
    fit of the target's tangent planes along its middle curve (:mod:`ght_cad.approximation_dual`:
@@ -64,7 +64,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 # The moved names (issue 27), all importable from here.
 from .target import as_target, _ght_jet, _JET, _ruled_jet, SurfaceTarget  # noqa: F401

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .frame import _Frame
 from .seams import _Seam
 from .result import ConeStrip
@@ -92,7 +92,7 @@ def _build_panel(frame: _Frame, A: _Seam, B: _Seam) -> Any:
         return ConeStrip(A.rail(), B.eval(np.array([0.5]), 0)[0][0])
     if A.point:
         return ConeStrip(B.rail(), A.eval(np.array([0.5]), 0)[0][0])
-    from ..errors import NotDevelopableError
+    from ..core.errors import NotDevelopableError
     from ..loft import developable_loft
 
     try:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._vec import cross as _cross
+from ..core._vec import cross as _cross
 from .target import SurfaceTarget
 
 

@@ -11,9 +11,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._quadrature import leggauss
+from ..core._quadrature import leggauss
 from ..ruled import RuledSurface
-from .._vec import cross as _cross
+from ..core._vec import cross as _cross
 from .frame import _Frame
 
 

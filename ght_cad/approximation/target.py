@@ -10,7 +10,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from ..ruled import RuledSurface
 
 
@@ -99,7 +99,7 @@ def as_target(target: Any) -> SurfaceTarget:
         b = target.bounds() if callable(target.bounds) else target.bounds
         return SurfaceTarget(lambda u, v, k: target.jet(u, v, k), b, type(target).__name__)
     if hasattr(target, "wrapped") or type(target).__module__.startswith("OCP"):
-        from .._kernel import adapter  # the kernel adapter, through the core's dispatch
+        from ..core._kernel import adapter  # the kernel adapter, through the core's dispatch
 
         return adapter("face_target")(target)
     raise GHTError(

@@ -107,7 +107,7 @@ def unfold_skin(
         BlankError: a face that is not developable, a bad base face, overlapping pieces (without
             ``allow_split``), a face graph that is not connected.
     """
-    from ..errors import NotDevelopableError
+    from ..core.errors import NotDevelopableError
     from ..face_unroll import unroll_face_data
     from ..flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
     from ..sheet import Sheet, SheetError

@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 
 class BlankError(GHTError):

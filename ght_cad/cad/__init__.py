@@ -3,7 +3,7 @@
 Importing :mod:`ght_cad` never imports this package; importing this package itself imports no
 kernel (its modules import OCP). :func:`kernel_available` tells whether one can be imported.
 Importing it registers its adapters (:data:`ADAPTERS`, loaded on first call) with the core's
-kernel dispatch :mod:`ght_cad._kernel`, which is how the kernel-free core reaches them.
+kernel dispatch :mod:`ght_cad.core._kernel`, which is how the kernel-free core reaches them.
 """
 
 from __future__ import annotations
@@ -37,9 +37,9 @@ def is_missing_kernel(exc: BaseException) -> bool:
     return isinstance(exc, ModuleNotFoundError) and name.split(".")[0] in KERNEL_MODULES
 
 
-# -- the core's kernel dispatch (ght_cad._kernel) ---------------------------------------------------
+# -- the core's kernel dispatch (ght_cad.core._kernel) ---------------------------------------------------
 
-#: operation of :data:`ght_cad._kernel.OPERATIONS` -> (module of this package, function)
+#: operation of :data:`ght_cad.core._kernel.OPERATIONS` -> (module of this package, function)
 ADAPTERS = {
     "make_face": ("occ", "make_face"),
     "make_edge": ("occ", "make_edge"),
@@ -66,7 +66,7 @@ def _on_first_call(module: str, name: str) -> Callable[..., Any]:
 
 def _register_adapters() -> None:
     """Fill the core's kernel registry with this package's adapters (imports no kernel)."""
-    from .. import _kernel
+    from ..core import _kernel
 
     for operation, (module, name) in ADAPTERS.items():
         _kernel.register_adapter(operation, _on_first_call(module, name))

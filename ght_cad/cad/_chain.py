@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..curve import GHTCurve
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 
 def _as_curve(curve: Any) -> GHTCurve:

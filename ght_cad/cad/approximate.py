@@ -20,7 +20,7 @@ from OCP.TopExp import TopExp_Explorer
 from ._ocp import TopoDS
 
 from ..approximation import ApproximationResult, SurfaceTarget, approximate
-from ..errors import ConversionError, GHTError
+from ..core.errors import ConversionError, GHTError
 from .occ import is_valid, make_face
 from .unroll_faces import _open_face, shape_faces
 

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..bspline import curve_to_bspline
 from ..curve import GHTCurve
-from ..errors import GHTError
+from ..core.errors import GHTError
 from ._chain import segments_of
 from .occ import make_edge
 

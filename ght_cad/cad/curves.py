@@ -38,7 +38,7 @@ from OCP.gp import gp_Pnt
 
 from ..bspline import BSplineCurveData, curve_to_bspline
 from ..curve import GHTCurve
-from ..errors import GHTError
+from ..core.errors import GHTError
 from ..patch import GHTSurface
 from ._chain import _as_curve, segments_of
 from .certified import certified, certify

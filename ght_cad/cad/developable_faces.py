@@ -34,7 +34,7 @@ from ._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..bspline import BSplineSurfaceData
 from ..developable import _size, developable_bspline
-from ..errors import ConversionError, GHTError
+from ..core.errors import ConversionError, GHTError
 from ..ruled import RuledSurface
 from .occ import is_valid, make_face, shape_class, unwrap
 

@@ -40,9 +40,9 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 from ._ocp import TopoDS
 
-from .._validate import as_parameter_array
+from ..core._validate import as_parameter_array
 from ..curve import GHTCurve
-from ..errors import ConversionError, GHTError
+from ..core.errors import ConversionError, GHTError
 from .developable_faces import sew_shell
 from .occ import is_valid, make_face, shape_class, unwrap
 

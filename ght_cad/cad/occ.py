@@ -21,8 +21,8 @@ from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Wr
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
 
 from ..bspline import BSplineCurveData, BSplineSurfaceData
-from ..errors import GHTError
-from ..io import atomic_path
+from ..core.errors import GHTError
+from ..core.io import atomic_path
 from ._ocp import TColgp_Array1OfPnt, TColgp_Array2OfPnt, TColStd_Array1OfInteger, TColStd_Array1OfReal
 
 __all__ = [
@@ -342,9 +342,9 @@ def write_step(shapes: Any, path: str | os.PathLike, *, check: bool = True, unit
 
 
 def read_step(path: str | os.PathLike) -> TopoDS_Shape:
-    """Read a STEP file into one OCP shape (after :func:`ght_cad.step_guard.check_step_numbers`:
+    """Read a STEP file into one OCP shape (after :func:`ght_cad.core.step_guard.check_step_numbers`:
     a real beyond ±1e12 or not finite is refused with a GHTError before OCCT sees it)."""
-    from ..step_guard import check_step_numbers
+    from ..core.step_guard import check_step_numbers
 
     check_step_numbers(path)
     with quiet_occt():

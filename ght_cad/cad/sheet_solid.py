@@ -57,7 +57,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ._ocp import TopoDS
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from ..ruled import RuledSurface
 from ..sheet import Sheet, SheetError, make_sheet
 from .occ import is_valid, quiet_occt, unwrap
@@ -361,7 +361,7 @@ def write_plate_step(plate: PlateSolid | list[PlateSolid], path: str | os.PathLi
     from OCP.TCollection import TCollection_HAsciiString
     from OCP.TopoDS import TopoDS_Compound
 
-    from ..io import atomic_path
+    from ..core.io import atomic_path
     from .occ import STEP_UNITS, _stem, name_products, step_writer
 
     plates = plate if isinstance(plate, list) else [plate]

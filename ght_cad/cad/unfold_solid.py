@@ -41,7 +41,7 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 
 from ._ocp import TopoDS, TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from .._vec import cross
+from ..core._vec import cross
 from ..blank import DIST_TOL, BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, classify_skin, k_factor_table, unfold_skins
 from .occ import unwrap
 from .unroll_faces import _SurfEval, face_data

@@ -56,7 +56,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ._ocp import TopoDS
 
 from .. import face_unroll as _core
-from ..errors import GHTError
+from ..core.errors import GHTError
 from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
 from ..flat_pattern import FlatPattern
 from ..nurbs import NurbsCurve, NurbsSurface

@@ -152,7 +152,7 @@ def _check_suffix(option: str, value: str | os.PathLike | None, allowed: Sequenc
 
 
 def _progress(total: int | None, label: str) -> Any:
-    from ..progress import Progress
+    from ..core.progress import Progress
 
     return Progress(total, label)
 

@@ -8,7 +8,7 @@ shape-parameter optimization (of one strip, or of every strip of a composite wit
 outputs to write. The schema is
 documented in ``docs/design-files.md``; :func:`parse_design` validates a parsed file completely
 before anything is computed, and every error is one line naming the file, the key and the
-allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.errors.GHTError`, so
+allowed values, raised as :class:`DesignError` (a :class:`~ght_cad.core.errors.GHTError`, so
 ``ght-cad`` exits with code 2).
 
 :func:`run_design` computes everything into a temporary folder beside the output folder and moves

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .schema import DesignError, SurfaceSpec
 
 __all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "is_approximation", "plot_deviation",

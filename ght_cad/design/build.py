@@ -9,7 +9,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .objectives import dual_curve_objectives
 from .schema import SHAPE_NAMES, Design, DesignError, SurfaceSpec
 

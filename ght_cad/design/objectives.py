@@ -8,8 +8,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
-from ..errors import GHTError
+from ..core._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
+from ..core.errors import GHTError
 from .schema import PLANE_OBJECTIVES
 
 

@@ -29,7 +29,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .build import (_initial_shape, _joined_curves, _make_composite, _make_surface, build_curves, build_surface, check_sheet,
                     make_loft)
 from .objectives import _gauss_legendre, composite_dual_objectives, composite_dual_objectives_grad, dual_curve_objectives
@@ -113,7 +113,7 @@ def _composite_candidate(design: Design, shape: dict[str, float]) -> Any:
     Raises:
         GHTError: a singular join, a degenerate strip, or a joint below its requested order.
     """
-    from ..errors import SingularJoinError
+    from ..core.errors import SingularJoinError
 
     comp = _make_composite(design, shape)
     for row in _composite_joint_rows(design, comp):
@@ -574,7 +574,7 @@ def _check_start(design: Design, curves: dict[str, Any], shape: dict[str, float]
     A refused start is said at once on a terminal (one ``note`` line on stderr) when ``progress``."""
     import sys
 
-    from ..progress import progress_enabled
+    from ..core.progress import progress_enabled
     from ..sheet import SheetError
 
     try:
@@ -671,7 +671,7 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         GHTError: no admissible shape parameters found.
     """
     from ..optimize import minimize
-    from ..progress import Progress
+    from ..core.progress import Progress
 
     if design.surface is None:
         if design.surfaces:

@@ -87,7 +87,7 @@ def sew_shell(shapes: Sequence[Any], sew_tol: float | None = None) -> Any:
 
     from ..cad.developable_faces import shell_faces
     from ..cad.occ import is_valid, unwrap
-    from ..errors import ConversionError
+    from ..core.errors import ConversionError
 
     faces = [f for sh in shapes for f in shell_faces(sh)]
     if sew_tol is None:
@@ -381,7 +381,7 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
     """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
     import json
 
-    from ..io import write_text_atomic
+    from ..core.io import write_text_atomic
 
     suf = target.suffix.lower()
     if suf in (".step", ".stp"):

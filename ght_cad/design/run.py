@@ -17,7 +17,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .build import (GHT_DEFINITION, _developability_dict, _is_approximation, _is_composite, build_curves, build_surface, build_surfaces,
                     check_sheet, surface_summary, surface_view, surfaces_summary)
 from .optimize import optimize_design
@@ -160,7 +160,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     import sys
 
     from ..outdir import OutputFolder
-    from ..progress import progress_enabled
+    from ..core.progress import progress_enabled
 
     t_start = time.perf_counter()
     if not os.fspath(out_dir).strip():  # Path("") would be the current folder
@@ -376,7 +376,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         report["versions"] = _versions()
         report["elapsed_s"] = time.perf_counter() - t_start
         report = _jsonable(report)
-        from ..io import write_text_atomic
+        from ..core.io import write_text_atomic
         import json
 
         if "json" in want_files:

@@ -36,7 +36,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .build import BuiltSurface, sheet_parts, table_k_factor
 from .schema import Design, DesignError, SheetSpec
 

@@ -12,8 +12,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
-from .._validate import is_real
+from ..core.errors import GHTError
+from ..core._validate import is_real
 from .schema import DesignError
 
 
@@ -77,7 +77,7 @@ def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
     OCCT converts STEP lengths to its system length unit (``SetSystemLengthUnit``, in mm), so
     asking for ``MM_PER_UNIT[u]`` gives the coordinates in unit ``u``.
 
-    Guards (issue 26): the file's text is scanned first (:func:`ght_cad.step_guard.check_step_numbers`:
+    Guards (issue 26): the file's text is scanned first (:func:`ght_cad.core.step_guard.check_step_numbers`:
     a real beyond ±1e12 or not finite -- OCCT hung on ``1.E400`` -- is refused before OCCT sees it);
     then, where ``os.fork`` exists, OCCT reads the file in a forked worker process that hands the
     shape back as a BRep file: a reader that crashes (mutated files made OCCT segfault) or runs
@@ -87,7 +87,7 @@ def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
     Raises:
         DesignError: unreadable, hostile or crashing file; a reader past the time limit.
     """
-    from ..step_guard import check_step_numbers
+    from ..core.step_guard import check_step_numbers
 
     try:
         check_step_numbers(path)  # absurd or overflowing reals: refused before OCCT sees them (it hung)
@@ -443,7 +443,7 @@ def unroll_step_face(p: Path, face: Any, k: int, n: int, *, best_effort: bool, t
         NotDevelopableError: the face is not developable within ``tol_deg`` (and not ``best_effort``).
         GHTError: any other refusal, the message prefixed with the file and face number.
     """
-    from ..errors import NotDevelopableError
+    from ..core.errors import NotDevelopableError
     from ..unroll import unroll
 
     kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")

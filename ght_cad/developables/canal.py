@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import as_parameter_array
+from ..core._validate import as_parameter_array
 from ..curve import GHTCurve
-from ..errors import DegenerateGeometryError, GHTError
+from ..core.errors import DegenerateGeometryError, GHTError
 from .checks import _check_3d_curve
 
 

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..curve import GHTCurve
-from ..errors import EdgeOfRegressionError, GHTError
+from ..core.errors import EdgeOfRegressionError, GHTError
 from ..ruled import regression_v, RuledSurface
 from .jets import _fmt
 

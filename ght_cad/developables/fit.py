@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..bspline import BSplineSurfaceData, fit_function
-from ..errors import ConversionError, GHTError
+from ..core.errors import ConversionError, GHTError
 from ..ruled import RuledSurface
 
 

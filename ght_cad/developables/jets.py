@@ -12,10 +12,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._validate import as_parameter_array, check_unit_interval
+from ..core._validate import as_parameter_array, check_unit_interval
 from ..basis import _check_order, evaluate_derivatives
 from ..curve import GHTCurve
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 
 _Jet = list  # list of arrays: value and derivatives 0..K

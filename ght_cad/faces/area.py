@@ -10,14 +10,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._cache import readonly_cache
-from .._quadrature import leggauss
-from .._vec import cross as _cross, norm as _norm, stack as _stack
+from ..core._cache import readonly_cache
+from ..core._quadrature import leggauss
+from ..core._vec import cross as _cross, norm as _norm, stack as _stack
 from .adapter import SurfaceAdapter, U_FREE_DENSITY_KINDS
 
 
 def _gauss12() -> tuple[np.ndarray, np.ndarray]:
-    """12-point Gauss–Legendre nodes and weights on [-1, 1] (:func:`ght_cad._quadrature.leggauss`:
+    """12-point Gauss–Legendre nodes and weights on [-1, 1] (:func:`ght_cad.core._quadrature.leggauss`:
     computed once; read-only arrays)."""
     return leggauss(12)
 

@@ -10,8 +10,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._vec import stack as _stack
-from ..errors import DegenerateGeometryError
+from ..core._vec import stack as _stack
+from ..core.errors import DegenerateGeometryError
 from ..pattern.model import _point_in_polygon, _unit_samples, BoundaryEdge
 from .area import _edge_nodes
 

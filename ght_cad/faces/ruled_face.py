@@ -9,8 +9,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._vec import unique_inverse
-from ..errors import GHTError
+from ..core._vec import unique_inverse
+from ..core.errors import GHTError
 from ..ruled import RuledSurface
 from .adapter import Bounds, surface_jet, SurfaceAdapter
 from .loops import _flat1

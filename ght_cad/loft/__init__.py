@@ -39,7 +39,7 @@ exact gradients live in :mod:`ght_cad.optimize.problems.loft`; ``ght_cad.loft.Lo
 
 from __future__ import annotations
 
-from .._lazy import lazy_getattr
+from ..core._lazy import lazy_getattr
 from .build import developable_loft
 from .equation import CORNER_RADIUS, CORNER_TOL, MIN_FAN, loft_function
 from .plot import plot_loft_sign

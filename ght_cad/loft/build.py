@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import is_real
-from ..errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ..core._validate import is_real
+from ..core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from .equation import _Pair
 from .plot import plot_loft_sign
 from .rails import _Reversed, as_rail

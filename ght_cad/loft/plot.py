@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .equation import _Pair
 from .rails import as_rail
 from .surface import DevelopableLoft

@@ -8,9 +8,9 @@ from typing import Any, Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-from .._validate import as_parameter_array
+from ..core._validate import as_parameter_array
 from ..curve import GHTCurve
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 
 # ----------------------------------------------------------------------------------------------

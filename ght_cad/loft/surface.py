@@ -9,9 +9,9 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._validate import as_parameter_array
-from .._quadrature import gauss_legendre
-from ..errors import GHTError
+from ..core._validate import as_parameter_array
+from ..core._quadrature import gauss_legendre
+from ..core.errors import GHTError
 from ..ruled import Developability, RuledSurface, regression_v
 from .equation import MIN_FAN, _EPS, _Pair
 from .rails import _jet
@@ -400,7 +400,7 @@ class DevelopableLoft(RuledSurface):
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A build123d ``Shell`` of one B-spline face per segment sewn along the joint rulings
         (:func:`ght_cad.cad.developable_faces.composite_shell`; needs build123d)."""
-        from .._kernel import adapter
+        from ..core._kernel import adapter
 
         return adapter("composite_shell")(self.segments, tol=tol, **kwargs)
 

@@ -13,7 +13,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 
 
 Objective = Callable[[np.ndarray], Any]

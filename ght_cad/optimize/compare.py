@@ -23,7 +23,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .optimizers import METHODS, OptimizeResult
 
 __all__ = ["MethodStats", "BudgetSweep", "budget_sweep", "compare", "format_table", "set_target"]

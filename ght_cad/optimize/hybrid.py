@@ -11,7 +11,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .base import (_COMMON_ARGS, _FinishDone, _int_option, _Run, _Stop, DEFAULT_MAX_ITER, Objective, OptimizeResult,
                    OptimizerState)
 from .population import differential_evolution, gwo, igwo, pso

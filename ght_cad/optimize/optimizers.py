@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 # Moved to ght_cad.optimize.base, .population and .hybrid (issue 27); every name stays importable from here.
 from .base import (_check_box, _COMMON_ARGS, _FinishDone, _float_option, _FORMS, _int_option, _is_number, _Run,
                    _short_repr, _Stop, as_bounds, as_generator, DEFAULT_MAX_ITER, Objective, OptimizeResult,

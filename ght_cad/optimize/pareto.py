@@ -20,7 +20,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .optimizers import OptimizeResult, as_generator, minimize
 
 __all__ = [

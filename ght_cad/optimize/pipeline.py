@@ -27,10 +27,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .._kernel import adapter
-from ..errors import GHTError
-from ..io import write_text_atomic
-from ..progress import Progress
+from ..core._kernel import adapter
+from ..core.errors import GHTError
+from ..core.io import write_text_atomic
+from ..core.progress import Progress
 from ..ruled import RuledSurface
 from .optimizers import OptimizeResult, OptimizerState, minimize
 

@@ -11,8 +11,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import GHTError
-from ..io import atomic_path
+from ..core.errors import GHTError
+from ..core.io import atomic_path
 from .optimizers import OptimizeResult
 
 __all__ = ["plot_convergence", "plot_pareto"]

@@ -12,7 +12,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import GHTError
+from ..core.errors import GHTError
 from .base import _COMMON_ARGS, _float_option, _Run, _Stop, Objective, OptimizeResult, OptimizerState
 
 

@@ -10,9 +10,9 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import GHTError
-from .._vec import einsum as _einsum
-from .._vec import stack as _stack
+from ..core.errors import GHTError
+from ..core._vec import einsum as _einsum
+from ..core._vec import stack as _stack
 from .model import BoundaryEdge, FlatPanel, _inside
 
 

@@ -12,10 +12,10 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._cache import readonly_cache
-from ..errors import GHTError
-from .._vec import einsum as _einsum
-from .._vec import stack as _stack
+from ..core._cache import readonly_cache
+from ..core.errors import GHTError
+from ..core._vec import einsum as _einsum
+from ..core._vec import stack as _stack
 
 
 #: DXF $INSUNITS codes

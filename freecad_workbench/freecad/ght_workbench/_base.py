@@ -6,7 +6,7 @@ Command, CurvesWB style, built on these bases. Proxies persist through ``__getst
 panels are only created when ``FreeCAD.GuiUp``.
 
 Failed recomputes. A feature whose input is refused (an unset link, a
-:class:`ght_cad.errors.GHTError` such as a shape parameter outside [-1, 1], a negative tolerance, a
+:class:`ght_cad.core.errors.GHTError` such as a shape parameter outside [-1, 1], a negative tolerance, a
 non-developable face; :data:`EXPECTED_ERRORS`) prints one line ``"<Label>: <message>"`` in the
 Report view and goes to FreeCAD's error state (``State`` ``Invalid``, the tree's error mark,
 ``getStatusString()`` = the message, dependants skipped, the old shape kept), without a Python
@@ -23,7 +23,7 @@ from typing import Any, Callable, Iterable, NoReturn, Sequence
 import FreeCAD as App
 
 from . import icon
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 __all__ = [
     "SHAPE_PARAMETERS",
@@ -71,8 +71,8 @@ def add_shape_parameters(obj: Any, group: str = "Shape", values: Sequence[float]
 
 
 def check_shape(mu: float, nu: float, gamma: float) -> None:
-    """Raise :class:`ght_cad.errors.ShapeParameterError` if μ, ν or γ is outside [-1, 1] (no clamping)."""
-    from ght_cad._validate import check_shape_parameter
+    """Raise :class:`ght_cad.core.errors.ShapeParameterError` if μ, ν or γ is outside [-1, 1] (no clamping)."""
+    from ght_cad.core._validate import check_shape_parameter
 
     for n, v in (("mu", mu), ("nu", nu), ("gamma", gamma)):
         check_shape_parameter(n, v)
@@ -88,11 +88,11 @@ def tolerance_property(obj: Any, name: str = "Tolerance", *, zero_means: str | N
             function then returns None for 0.
 
     Raises:
-        ght_cad.errors.GHTError: NaN, ±inf, a negative value, or 0 when ``zero_means`` is None.
+        ght_cad.core.errors.GHTError: NaN, ±inf, a negative value, or 0 when ``zero_means`` is None.
     """
     import math
 
-    from ght_cad.errors import GHTError
+    from ght_cad.core.errors import GHTError
 
     v = float(getattr(obj, name))
     if zero_means is not None and v == 0.0:

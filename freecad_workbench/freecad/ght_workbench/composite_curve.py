@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import FreeCAD as App
 import Part
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only, tolerance_property
 from .convert import DEFAULT_TOL, curve_data, edge_from_data

@@ -17,7 +17,7 @@ import Part
 
 from . import _ensure_core  # noqa: F401  (makes ght_cad importable)
 from ght_cad.bspline import BSplineCurveData, BSplineSurfaceData, knots_and_multiplicities
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 __all__ = [
     "vec",

@@ -17,7 +17,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import (
     BaseCommand,

@@ -25,7 +25,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, failed, new_feature, register_command, set_read_only, tolerance_property
 from .convert import face_from_data
@@ -60,7 +60,7 @@ class PartEdgeRail:
 
     def derivative(self, t: Any, order: int = 1) -> np.ndarray:
         """``r^(order)(t)``, shape (n, 3), order 0..3."""
-        from ght_cad._validate import as_parameter_array
+        from ght_cad.core._validate import as_parameter_array
 
         if isinstance(order, bool) or order not in (0, 1, 2, 3):
             raise GHTError(f"order={order!r} is not allowed; an edge rail gives derivatives of order 0..3")

@@ -17,8 +17,8 @@ import Part
 
 from . import _ensure_core  # noqa: F401
 from ._base import BaseCommand, failed, failed_input, register_command
-from ght_cad.errors import GHTError
-from ght_cad.io import atomic_path, write_text_atomic
+from ght_cad.core.errors import GHTError
+from ght_cad.core.io import atomic_path, write_text_atomic
 from ght_cad.outdir import lock_target
 
 __all__ = [

@@ -35,7 +35,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, jets_agree,
                                  surface_jet, unroll_face_data)
 from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots

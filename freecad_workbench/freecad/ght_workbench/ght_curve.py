@@ -29,7 +29,7 @@ from ._base import (
     tolerance_property,
 )
 from .convert import DEFAULT_TOL, curve_data, edge_from_data, points_array
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 __all__ = ["GHTCurveFeature", "make_ght_curve", "points_from_links", "core_curve"]
 

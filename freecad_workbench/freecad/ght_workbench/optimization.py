@@ -26,7 +26,7 @@ from typing import Any, Callable
 
 import FreeCAD as App
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 

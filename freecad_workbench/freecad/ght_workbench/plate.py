@@ -37,7 +37,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 

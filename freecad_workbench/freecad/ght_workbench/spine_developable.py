@@ -16,7 +16,7 @@ import numpy as np
 
 import FreeCAD as App
 
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 from ._base import BaseCommand, FeatureProxy, ShapeParameterPanel, ViewProviderBase, new_feature, register_command, require_links, set_read_only
 from .developable import SurfaceOutputs

@@ -1,7 +1,7 @@
 r"""Design-file schema: the dataclasses of a design and their validation (:func:`parse_design`).
 
 Every check names the file, the key and the allowed values and raises :class:`DesignError`
-(a :class:`~ght_cad.errors.GHTError`, so ``ght-cad`` exits with code 2). The schema is documented
+(a :class:`~ght_cad.core.errors.GHTError`, so ``ght-cad`` exits with code 2). The schema is documented
 in ``docs/design-files.md``.
 
 Modules (issue 27, moved from ``ght_cad/design/schema.py``): :mod:`.constants` (allowed values

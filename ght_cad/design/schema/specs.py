@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ...errors import GHTError
+from ...core.errors import GHTError
 from .constants import FIGURE_OUTPUTS, FILE_OUTPUTS, SHAPE_NAMES
 
 

@@ -9,7 +9,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ...basis import _compact_differences, basis_from_jets, bernstein, parameter_jets
-from ...errors import GHTError
+from ...core.errors import GHTError
 from ...seeds import ght_seed_derivatives, ght_seed_jet, ght_seed_parameter_derivatives
 
 

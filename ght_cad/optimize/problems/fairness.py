@@ -8,10 +8,10 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..._vec import cross as _cross
-from ..._quadrature import gauss_legendre
+from ...core._vec import cross as _cross
+from ...core._quadrature import gauss_legendre
 from ...curve import GHTCurve
-from ...errors import GHTError
+from ...core.errors import GHTError
 from ...ruled import RuledSurface
 from .base import CurveParameterJets, FAIRNESS_MEASURES, PopulationBasis, Problem, SHAPE_NAMES, _split, population_basis
 

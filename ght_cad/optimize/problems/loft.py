@@ -10,11 +10,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..._validate import is_real
-from ..._vec import cross as _cross3
-from ..._quadrature import gauss_legendre
+from ...core._validate import is_real
+from ...core._vec import cross as _cross3
+from ...core._quadrature import gauss_legendre
 from ...curve import GHTCurve
-from ...errors import GHTError
+from ...core.errors import GHTError
 from ...loft.build import developable_loft
 from ...loft.equation import MIN_FAN
 from ...loft.rails import _det, _jet

@@ -8,11 +8,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..._vec import cross as _cross
+from ...core._vec import cross as _cross
 from ...basis import bernstein
-from ..._quadrature import gauss_legendre
+from ...core._quadrature import gauss_legendre
 from ...curve import GHTCurve
-from ...errors import GHTError
+from ...core.errors import GHTError
 from ...ruled import CurvePairRuledSurface
 from .base import CurveParameterJets, PopulationBasis, Problem, SHAPE_NAMES, _split
 

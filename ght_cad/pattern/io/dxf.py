@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ...io import atomic_path, write_text_atomic
+from ...core.io import atomic_path, write_text_atomic
 from ..model import INSUNITS
 
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ...io import atomic_path
+from ...core.io import atomic_path
 
 
 def plot_png(pattern: Any, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:

@@ -119,7 +119,7 @@ class GHTCurveTest(unittest.TestCase):
         obj.Mu = 5.0  # App::PropertyFloatConstraint clamps to [-1, 1]
         self.assertEqual(obj.Mu, 1.0)
         # the scripting API refuses out-of-range values instead of clamping them (spec section 1)
-        from ght_cad.errors import ShapeParameterError
+        from ght_cad.core.errors import ShapeParameterError
 
         with self.assertRaisesRegex(ShapeParameterError, "gamma"):
             ght_curve.make_ght_curve(QUARTER, gamma=1.5, doc=self.doc)

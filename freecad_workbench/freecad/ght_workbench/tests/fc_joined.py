@@ -261,7 +261,7 @@ class JoinedDevelopableTest(RefusalAssertions, unittest.TestCase):
     def test_bad_input(self):
         with self.assertRaisesRegex(ValueError, "G0"):
             joined_developable.make_joined_developable(self.first, "G0", doc=self.doc)
-        from ght_cad.errors import ShapeParameterError
+        from ght_cad.core.errors import ShapeParameterError
 
         with self.assertRaisesRegex(ShapeParameterError, "nu"):
             joined_developable.make_joined_developable(self.first, "G1", nu=1.5, doc=self.doc)

@@ -91,7 +91,7 @@ class RefusalAssertions:
         Returns:
             The message.
         """
-        from ght_cad.errors import GHTError
+        from ght_cad.core.errors import GHTError
 
         with self.assertRaisesRegex(GHTError, pattern) as ctx:  # type: ignore[attr-defined]
             call()
