@@ -103,7 +103,7 @@ def main() -> None:
                 print(f"{name:6} {tol:6.3g} {method:>6} {len(res.panels):6d} {nd:3d}/{len(res.panels) - nd:<3d} "
                       f"{res.max_deviation:9.4g} {dt:7.1f} {nb:8d} {nb / len(res.panels):6.2f}", flush=True)
     if args.png:
-        from ght_cad.plotting import _figure, _save
+        from ght_cad.curves.plotting import _figure, _save
 
         fig = _figure("convergence")
         ax = fig.add_subplot(1, 1, 1)

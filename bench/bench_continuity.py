@@ -17,8 +17,8 @@ import time
 import numpy as np
 
 from ght_cad import GHTCurve
-from ght_cad.composite import CompositeCurve
-from ght_cad.continuity import join, join_targets
+from ght_cad.curves.composite import CompositeCurve
+from ght_cad.curves.continuity import join, join_targets
 
 
 def _baseline(a: GHTCurve, cont: str, b: GHTCurve, **g) -> GHTCurve:

@@ -28,7 +28,7 @@ TAB_SHAPE = {"mu": 0.5, "nu": -0.3, "gamma": 0.2}
 def tab_area() -> float:
     r"""Area between the tab curve and the line y = R: ``∫ (y - R) x'(t) dt`` (reversed sign), exact quadrature."""
     from ght_cad import GHTCurve
-    from ght_cad.curve import integrate
+    from ght_cad.curves.curve import integrate
 
     c = GHTCurve(TAB, **TAB_SHAPE)
     return abs(integrate(lambda t: (c.evaluate(t)[:, 1] - R) * c.derivative(t, 1)[:, 0]))

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ght_cad import GHTCurve
-from ght_cad.composite import CompositeCurve
+from ght_cad.curves.composite import CompositeCurve
 
 HEIGHT = 4.0
 
@@ -41,10 +41,10 @@ def _chain(point, degree: int, continuity: list[str]) -> CompositeCurve:
     """Four segments sampled from ``point`` over quarter turns, then joined by the solver.
 
     The G parameters of each G joint are the "natural" ones of the unjoined segments (the
-    least-squares k, β2, β3 that :func:`ght_cad.continuity.measure_continuity` reports), so the
+    least-squares k, β2, β3 that :func:`ght_cad.curves.continuity.measure_continuity` reports), so the
     solver moves the dependent control points as little as possible.
     """
-    from ght_cad.continuity import measure_continuity
+    from ght_cad.curves.continuity import measure_continuity
 
     segs = []
     for q in range(4):
@@ -68,7 +68,7 @@ def glyph_outlines() -> tuple[CompositeCurve, CompositeCurve]:
 
 
 def _green_area(cc: CompositeCurve) -> float:
-    from ght_cad.curve import gauss_legendre
+    from ght_cad.curves.curve import gauss_legendre
 
     t, w = gauss_legendre(64)
     total = 0.0

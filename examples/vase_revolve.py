@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ght_cad import GHTCurve
-from ght_cad.composite import CompositeCurve
+from ght_cad.curves.composite import CompositeCurve
 
 WALL = 0.4
 
@@ -35,11 +35,11 @@ def profile() -> CompositeCurve:
     Each segment's control points are the least-squares fit of ``t ↦ (radius(z), 0, z)``,
     ``z = z0 + t (z1 - z0)``, at 200 parameters (so its end jets follow the design curve); the G3
     and G2 joints use the segments' natural G parameters
-    (:func:`ght_cad.continuity.measure_continuity`), so the join solver only nudges the dependent
+    (:func:`ght_cad.curves.continuity.measure_continuity`), so the join solver only nudges the dependent
     control points.
     """
     from ght_cad import basis
-    from ght_cad.continuity import measure_continuity
+    from ght_cad.curves.continuity import measure_continuity
 
     spans = [(0.0, 4.9, 6, (0.2, 0.1, -0.3)), (4.9, 9.0, 6, (0.0, 0.3, 0.2)), (9.0, 13.0, 6, (0.3, 0.0, 0.5))]
     segs = []
@@ -56,7 +56,7 @@ def profile() -> CompositeCurve:
 
 def _pappus_volume(outer: CompositeCurve, inner: CompositeCurve) -> float:
     """V = π |∮ x² dz| over the closed profile (the two horizontal lines contribute nothing)."""
-    from ght_cad.curve import gauss_legendre
+    from ght_cad.curves.curve import gauss_legendre
 
     t, w = gauss_legendre(64)
 

@@ -14,8 +14,12 @@ import importlib
 from typing import Any
 
 from .core._lazy import lazy_getattr
-from .basis import basis, bernstein
-from .curve import GHTCurve
+# ``ght_cad.basis`` is the function basis (spec section 9) and also the old path of the module
+# ght_cad.curves.basis: its shim is imported first, so that a later ``import ght_cad.basis`` finds
+# it in sys.modules and does not replace the function by the module.
+from . import basis as _basis_module  # noqa: F401
+from .curves.basis import basis, bernstein
+from .curves.curve import GHTCurve
 from .core.errors import (
     ConversionError,
     DegenerateGeometryError,
@@ -25,7 +29,7 @@ from .core.errors import (
     ShapeParameterError,
     SingularJoinError,
 )
-from .seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
+from .curves.seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
 
 # ``ght_cad.unroll`` is the submodule, made callable (its ``__call__`` is the stable function
 # ``unroll`` of spec section 9), so the package attribute is the same object whichever way and in
@@ -69,10 +73,10 @@ __all__ = [
 # ``import ght_cad`` stays fast (< 0.3 s) and never touches a CAD kernel.
 _LAZY: dict[str, str] = {
     "developable_from_planes": "ght_cad.developable",
-    "join": "ght_cad.continuity",
-    "measure_continuity": "ght_cad.continuity",
-    "Continuity": "ght_cad.continuity",
-    "CompositeCurve": "ght_cad.composite",
+    "join": "ght_cad.curves.continuity",
+    "measure_continuity": "ght_cad.curves.continuity",
+    "Continuity": "ght_cad.curves.continuity",
+    "CompositeCurve": "ght_cad.curves.composite",
     "curve_to_bspline": "ght_cad.bspline",
     "fit_function": "ght_cad.bspline",
     "GHTSurface": "ght_cad.patch",
@@ -87,6 +91,7 @@ _LAZY: dict[str, str] = {
 _MOVED: dict[str, str] = {
     **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
                                         "progress", "step_guard", "_kernel")},
+    **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
 }
 
 _lazy_name = lazy_getattr(__name__, _LAZY, globals())

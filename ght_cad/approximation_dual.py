@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from .basis import basis
+from .curves.basis import basis
 
 __all__ = ["DualFit", "PlaneSamples", "tangent_planes", "fit_dual_planes", "normal_hits", "fit_strip", "check_optimizer"]
 

@@ -19,7 +19,7 @@ from .core._quadrature import leggauss
 from .core.errors import ConversionError, GHTError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .curve import GHTCurve
+    from .curves.curve import GHTCurve
 
 __all__ = [
     "BSplineCurveData",
@@ -668,7 +668,7 @@ def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 
     B-spline edges. ``max_t |P(t) - C(t)| <= tol``.
 
     Args:
-        curve: the :class:`~ght_cad.curve.GHTCurve` (any dimension).
+        curve: the :class:`~ght_cad.curves.curve.GHTCurve` (any dimension).
         tol: maximum deviation; default ``1e-7 ×`` the diagonal of the curve's bounding box (at
             least 64 ulp of the largest control-point coordinate, the rounding floor).
         degree: B-spline degree p (>= 1).
@@ -693,7 +693,7 @@ def curve_to_bspline(curve: "GHTCurve", tol: float | None = None, degree: int = 
         ends = ([jets[k][0] for k in range(r + 1)], [jets[k][1] for k in range(r + 1)])
     else:
         ends = ([curve.derivative(0.0, k) for k in range(r + 1)], [curve.derivative(1.0, k) for k in range(r + 1)])
-    from .curve import GHTCurve
+    from .curves.curve import GHTCurve
 
     if isinstance(curve, GHTCurve):  # P(0) = P_0, P(1) = P_m exactly (b_{i,m}(0) = δ_i0, spec 2)
         cp = curve.control_points

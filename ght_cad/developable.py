@@ -1,7 +1,7 @@
 r"""Developable surfaces from GHT curves (spec section 5): planes (duality), spines, geodesics.
 
 * :class:`EnvelopeDevelopable` (5.2): the envelope of the one-parameter family of planes
-  ``U(t) = Σ b_{i,m}(t) U_i`` (the *dual curve*, a 4-D :class:`~ght_cad.curve.GHTCurve`).
+  ``U(t) = Σ b_{i,m}(t) U_i`` (the *dual curve*, a 4-D :class:`~ght_cad.curves.curve.GHTCurve`).
   Ruling ``U ∩ U'``, edge of regression ``U ∩ U' ∩ U''``, boundary curves
   ``a(t) = U ∩ U' ∩ E_a`` and ``b(t) = U ∩ U' ∩ E_b`` (pairing kept), surface
   ``X(t, v) = (1-v) a(t) + v b(t)``. Derivatives of ``a, b`` are analytic: the meet
@@ -14,7 +14,7 @@ r"""Developable surfaces from GHT curves (spec section 5): planes (duality), spi
   ``D = (τT + κB)/sqrt(κ² + τ²)``; C is a geodesic of it.
 * :class:`CanalSurface` (5.5): envelope of spheres ``(C(t), r(t))``; developable only as a cone or
   cylinder of revolution, otherwise only its (sampled Gaussian-curvature) report is given.
-* Joins (5.6): :func:`join_developable` applies :func:`ght_cad.continuity.join` to the 4-D dual
+* Joins (5.6): :func:`join_developable` applies :func:`ght_cad.curves.continuity.join` to the 4-D dual
   curves; :func:`measure_developable_joint` measures the achieved order independently (projective
   contact of the dual curves, i.e. common tangent plane, ruling, edge-of-regression point ...);
   :class:`CompositeDevelopable` chains segments that share their joint rulings.
@@ -32,8 +32,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from .core._validate import as_parameter_array, check_finite_array, check_unit_interval
-from .basis import evaluate_derivatives
-from .curve import GHTCurve
+from .curves.basis import evaluate_derivatives
+from .curves.curve import GHTCurve
 from .core.errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
 from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
 from .ruled import Developability, RuledSurface
@@ -155,7 +155,7 @@ class EnvelopeDevelopable(RuledSurface):
         """``[d^r U(t(u)) / du^r for r = 0..K]`` (K <= 3), read-only arrays.
 
         ``d^r U / du^r = h^r U^(r)(t)``, ``h = t1 - t0``; all orders from one basis pass
-        (:func:`ght_cad.basis.evaluate_derivatives`). The last few jets of up to
+        (:func:`ght_cad.curves.basis.evaluate_derivatives`). The last few jets of up to
         ``_JET_CACHE_MAX`` parameters are kept: the checks and the B-spline fit ask for the same
         parameters several times (a, b, ruling, edge of regression).
         """
@@ -675,7 +675,7 @@ class DevelopableJointReport:
         plane_angle: angle (degrees) between the end tangent planes.
         ruling_distance: largest distance of A's end ruling endpoints from B's start ruling,
             relative to the size of the ruling segment.
-        dual: :class:`ght_cad.continuity.JointReport` of the 4-D dual curves (affine G/C order), or
+        dual: :class:`ght_cad.curves.continuity.JointReport` of the 4-D dual curves (affine G/C order), or
             None if the continuity module is unavailable.
         tol: tolerance.
     """
@@ -722,7 +722,7 @@ def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *,
     The unknowns are fitted order by order by least squares (new unknowns at order r: ``λ_r`` and
     ``φ_r``, the rest being known), and the condition holds when the relative residual
     ``|residual| / max(|V^(r)|, Σ|terms|) <= tol``. This is independent of how the joint was built.
-    A 4-D affine G^r join (``λ ≡ 1``, :func:`ght_cad.continuity.join`) measures at least r.
+    A 4-D affine G^r join (``λ ≡ 1``, :func:`ght_cad.curves.continuity.join`) measures at least r.
 
     Args:
         a, b: enveloping developables (a's end meets b's start).
@@ -782,7 +782,7 @@ def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *,
             dist = max(dist, abs(float(P[0] + P[1:] @ p)) / float(np.linalg.norm(P[1:])) / seg)
     dual = None
     try:
-        from .continuity import measure_continuity
+        from .curves.continuity import measure_continuity
 
         dual = measure_continuity(a.dual_curve, b.dual_curve, tol=tol) if a.t_range == (0.0, 1.0) == b.t_range else None
     except ImportError:  # pragma: no cover - the continuity module ships with the package
@@ -807,7 +807,7 @@ def join_developable(
 
     Spec 5.6: section 4 applied to the 4-D dual curves, ``V(0) = U(1)``, G1 ``V'(0) = k U'(1)``,
     G2 ``V''(0) = k² U''(1) + β2 U'(1)``, G3 ``V''' = k³ U''' + 3kβ2 U'' + β3 U'`` (all at the joint),
-    solved for ``V_0..V_r`` by :func:`ght_cad.continuity.join`; the other control planes of
+    solved for ``V_0..V_r`` by :func:`ght_cad.curves.continuity.join`; the other control planes of
     ``planes`` are kept. G1 means a common tangent plane and a common ruling at the joint.
 
     Args:
@@ -824,7 +824,7 @@ def join_developable(
             order that the second surface's degree / shape parameters cannot take.
         GHTError: a trimmed ``first``; plus every error of :func:`developable_from_planes`.
     """
-    from .continuity import Continuity, join
+    from .curves.continuity import Continuity, join
 
     if not isinstance(first, EnvelopeDevelopable):
         raise GHTError(f"first must be an EnvelopeDevelopable, got {type(first).__name__}")

@@ -22,11 +22,11 @@ from typing import Any, Sequence
 import numpy as np
 
 from .core._validate import affine_parts, as_parameter_array, check_unit_interval
-from .basis import _check_order, seed_basis
+from .curves.basis import _check_order, seed_basis
 from .bspline import BSplineSurfaceData, fit_function
-from .curve import GHTCurve
+from .curves.curve import GHTCurve
 from .core.errors import GHTError
-from .seeds import Seed, make_seed
+from .curves.seeds import Seed, make_seed
 
 __all__ = ["GHTSurface", "join_patches", "measure_patch_continuity", "basis_bspline", "patches_to_bspline"]
 
@@ -428,7 +428,7 @@ def join_patches(
     ``direction="u"``: A's side u = 1 meets B's side u = 0. With equal v bases (same degree n and
     v shape parameters, required), ``S_B^{(r,0)}(0, v) = Σ_j b_j(v) R^{(r)}_j(0)``, so the surface
     condition holds for every v iff it holds for each column curve ``u ↦ Σ_i b_i(u) P_ij``:
-    each column of B is solved with :func:`ght_cad.continuity.join` (``R_0j = P_mj``; C1:
+    each column of B is solved with :func:`ght_cad.curves.continuity.join` (``R_0j = P_mj``; C1:
     ``∂_u S_B = ∂_u S_A``; G1: ``∂_u S_B = k ∂_u S_A``, k > 0, which gives a common tangent plane;
     C2/G2/C3/G3 likewise). ``direction="v"`` does the same with u and v swapped.
 
@@ -436,16 +436,16 @@ def join_patches(
         patch_a, patch_b: the two patches (B's first rows across the boundary are replaced).
         continuity: ``"C0".."C3"``, ``"G0".."G3"``.
         direction: ``"u"`` or ``"v"``.
-        k, beta2, beta3: G parameters (as in :func:`ght_cad.continuity.join`).
+        k, beta2, beta3: G parameters (as in :func:`ght_cad.curves.continuity.join`).
 
     Returns:
         The new patch B.
 
     Raises:
         GHTError: different dimensions, different bases along the boundary, bad direction;
-        SingularJoinError: as :func:`ght_cad.continuity.join`.
+        SingularJoinError: as :func:`ght_cad.curves.continuity.join`.
     """
-    from .continuity import join
+    from .curves.continuity import join
 
     if direction not in ("u", "v"):
         raise GHTError(f"direction={direction!r} is not allowed; use 'u' or 'v'")
@@ -476,10 +476,10 @@ def measure_patch_continuity(
 
     At ``samples`` values v_s the iso-curves ``u ↦ S_A(u, v_s)`` and ``u ↦ S_B(u, v_s)`` (exact
     GHT curves, :meth:`GHTSurface.iso_curve`) are measured with
-    :func:`ght_cad.continuity.measure_continuity` (relative tolerance ``tol``); the minimum over
+    :func:`ght_cad.curves.continuity.measure_continuity` (relative tolerance ``tol``); the minimum over
     the samples is returned. ``direction="v"`` swaps u and v.
     """
-    from .continuity import measure_continuity
+    from .curves.continuity import measure_continuity
 
     if direction not in ("u", "v"):
         raise GHTError(f"direction={direction!r} is not allowed; use 'u' or 'v'")

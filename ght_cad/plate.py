@@ -233,7 +233,7 @@ def plate_volume(surface: RuledSurface, sheet: Any, *, rtol: float = 1e-13) -> f
     Raises:
         GHTError: not a ruled surface or no thickness.
     """
-    from .curve import integrate
+    from .curves.curve import integrate
     from .sheet import ruling_normal
     from .unroll import _smooth_pieces, ruled_area
 

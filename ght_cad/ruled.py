@@ -23,7 +23,7 @@ from .core._validate import as_parameter_array
 from .core._vec import cross as _cross
 from .core._vec import dot as _dot
 from .core._vec import norm as _norm
-from .curve import GHTCurve, gauss_legendre
+from .curves.curve import GHTCurve, gauss_legendre
 from .core.errors import DegenerateGeometryError, GHTError
 
 __all__ = [

@@ -851,7 +851,7 @@ def unroll_ruled_sheet(surface: RuledSurface, sheet: Sheet, *, label: str = "P1"
     Raises:
         SheetError: the thickness is beyond a bending radius (:func:`check_offset`).
     """
-    from .curve import integrate
+    from .curves.curve import integrate
     from .unroll import _smooth_pieces, unroll_ruled
 
     rmin = check_offset(surface, sheet, f"surface {label!r}")

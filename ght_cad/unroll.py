@@ -31,7 +31,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .curve import gauss_legendre, integrate
+from .curves.curve import gauss_legendre, integrate
 from .core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from .core._validate import is_real
 from .core._vec import cross as _cross

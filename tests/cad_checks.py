@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ght_cad.curve import gauss_legendre
+from ght_cad.curves.curve import gauss_legendre
 
 
 def green_area(segments) -> float:

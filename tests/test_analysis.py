@@ -10,7 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.analysis import (
+from ght_cad.curves.analysis import (
     bezier_chain_like,
     compare_curvature,
     curvature,
@@ -21,7 +21,7 @@ from ght_cad.analysis import (
     joint_curvatures,
     signed_curvature,
 )
-from ght_cad.composite import CompositeCurve
+from ght_cad.curves.composite import CompositeCurve
 from ght_cad.core.errors import GHTError
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

@@ -15,7 +15,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from ght_cad import GBTSeed, GHTCurve, GHTSeed, basis, bernstein
-from ght_cad.basis import bernstein_recursive_basis, seed_basis
+from ght_cad.curves.basis import bernstein_recursive_basis, seed_basis
 
 params = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False)
 degrees = st.integers(min_value=2, max_value=10)
@@ -201,11 +201,11 @@ def _cubic_seed_class(name: str) -> type:
 
 def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
     """A user-registered seed plugs into the basis and curves."""
-    import ght_cad.seeds
+    import ght_cad.curves.seeds
     from ght_cad import Seed, make_seed, register_seed, seed_names
 
     # keep the global registry as it was after this test
-    monkeypatch.setattr(ght_cad.seeds, "_REGISTRY", dict(ght_cad.seeds._REGISTRY))
+    monkeypatch.setattr(ght_cad.curves.seeds, "_REGISTRY", dict(ght_cad.curves.seeds._REGISTRY))
 
     CubicSeed = _cubic_seed_class("cubic-test")
     assert issubclass(CubicSeed, Seed)
@@ -221,7 +221,7 @@ def test_custom_seed_registration(monkeypatch: pytest.MonkeyPatch) -> None:
 
 # -- one-pass jets and derivatives (seeds.ght_seed_jet / Seed.jets / basis.evaluate_derivatives) --
 def _seeds(mu: float, nu: float, gamma: float) -> list:
-    from ght_cad.seeds import BernsteinSeed, ReversedSeed
+    from ght_cad.curves.seeds import BernsteinSeed, ReversedSeed
 
     ght = GHTSeed(mu, nu, gamma)
     return [ght, GBTSeed(mu, nu), BernsteinSeed(), ReversedSeed(ght), _cubic_seed_class("cubic-jets-test")(), ReversedSeed(_cubic_seed_class("cubic-jets-test")())]
@@ -240,7 +240,7 @@ def test_seed_jets_equal_single_order_jets_exactly(mu: float, nu: float, gamma: 
 @given(st.lists(st.tuples(params, params, params), min_size=1, max_size=6), st.integers(0, 6))
 def test_ght_seed_jet_broadcasts_over_parameter_sets(P: list, r: int) -> None:
     """``ght_seed_jet`` on (P, 1) parameter columns gives, row by row, exactly ``GHTSeed.f0_f2``."""
-    from ght_cad.seeds import ght_seed_derivatives, ght_seed_jet
+    from ght_cad.curves.seeds import ght_seed_derivatives, ght_seed_jet
 
     arr = np.array(P)
     f0, f2 = ght_seed_jet(T, arr[:, :1], arr[:, 1:2], arr[:, 2:3], r)
@@ -260,7 +260,7 @@ def test_ght_seed_jet_broadcasts_over_parameter_sets(P: list, r: int) -> None:
 def test_ght_seed_high_orders_are_derivatives(mu: float, nu: float, gamma: float, r: int) -> None:
     """Order r of the GHT seed is the derivative of order r-1 (4th-order central differences, h=1e-3):
     relative 1e-6 of the order-r scale (which grows like (π)^r)."""
-    from ght_cad.seeds import ght_seed_jet
+    from ght_cad.curves.seeds import ght_seed_jet
 
     t = np.linspace(0.05, 0.95, 37)
     h = 1e-3
@@ -285,7 +285,7 @@ def test_jets_reject_orders_a_seed_does_not_provide() -> None:
 def test_evaluate_derivatives_equals_basis_matrix_products(m: int, mu: float, nu: float, gamma: float, which: int) -> None:
     """``evaluate_derivatives`` (compact form, one pass) = ``seed_basis(t, m, seed, r) @ P`` for r = 0..3,
     to 1e-13 relative to the size of the control points times (m+1) π^r (the scale of b^(r))."""
-    from ght_cad.basis import evaluate_derivatives, seed_basis_derivatives
+    from ght_cad.curves.basis import evaluate_derivatives, seed_basis_derivatives
 
     seed = _seeds(mu, nu, gamma)[which]
     P = np.random.default_rng(m).normal(size=(m + 1, 4))
@@ -300,7 +300,7 @@ def test_evaluate_derivatives_equals_basis_matrix_products(m: int, mu: float, nu
 
 def test_evaluate_derivatives_chunks_long_inputs() -> None:
     """Parameters beyond one chunk (32768) give the same values as evaluating the pieces."""
-    from ght_cad.basis import evaluate_derivatives
+    from ght_cad.curves.basis import evaluate_derivatives
 
     t = np.linspace(0.0, 1.0, 70001)
     P = np.random.default_rng(3).normal(size=(6, 3))

@@ -23,9 +23,9 @@ from ght_cad.cad._ocp import TopoDS  # noqa: E402
 from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.curves import GHTBezierLine, GHTCompositeLine, exact_edges, export_step, ght_edge, ght_face, ght_shape, ght_wire  # noqa: E402
 from ght_cad.cad.occ import read_step, volume, write_step  # noqa: E402
-from ght_cad.composite import CompositeCurve  # noqa: E402
+from ght_cad.curves.composite import CompositeCurve  # noqa: E402
 from cad_checks import green_area as _green_area  # noqa: E402
-from ght_cad.curve import gauss_legendre  # noqa: E402
+from ght_cad.curves.curve import gauss_legendre  # noqa: E402
 from ght_cad.core.errors import GHTError  # noqa: E402
 from ght_cad.patch import GHTSurface  # noqa: E402
 

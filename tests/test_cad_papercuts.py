@@ -175,8 +175,8 @@ def test_exact_edges_survives_a_nested_skipclean():
     from build123d import Box, BuildLine, BuildPart, BuildSketch, Line, Mode, SkipClean, extrude, make_face
 
     from ght_cad.cad.curves import GHTCompositeLine, exact_edges
-    from ght_cad.composite import CompositeCurve
-    from ght_cad.continuity import join
+    from ght_cad.curves.composite import CompositeCurve
+    from ght_cad.curves.continuity import join
 
     a = GHTCurve([(0, 0), (10, 12), (20, 12), (30, 0)], mu=0.3)
     b = join(a, "G2", [(30, 0), (40, -10), (50, -6), (60, 0)])

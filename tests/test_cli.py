@@ -288,7 +288,7 @@ def test_export_is_all_or_nothing_when_a_target_folder_is_unwritable(cone: Path,
 
 def test_export_is_all_or_nothing_when_a_writer_fails(cone: Path, tmp_path: Path, capsys, monkeypatch) -> None:
     """The last writer fails after the STEP and SVG were produced: none of the targets appears."""
-    import ght_cad.plotting as P
+    import ght_cad.curves.plotting as P
 
     def boom(*a, **k):
         raise RuntimeError("renderer exploded")

@@ -11,8 +11,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.composite import CompositeCurve
-from ght_cad.continuity import Continuity
+from ght_cad.curves.composite import CompositeCurve
+from ght_cad.curves.continuity import Continuity
 from ght_cad.core.errors import GHTError, SingularJoinError
 
 param = st.floats(-1.0, 1.0, allow_nan=False)

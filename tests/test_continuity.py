@@ -10,7 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.continuity import Continuity, join, measure_continuity, reverse_g_parameters
+from ght_cad.curves.continuity import Continuity, join, measure_continuity, reverse_g_parameters
 from ght_cad.core.errors import GHTError, SingularJoinError
 
 # Tolerances: measure_continuity's default relative tol (1e-9) is used throughout; a join is
@@ -225,7 +225,7 @@ def test_singular_cases_raise_clear_errors():
 def test_join_end_rows_match_full_basis_evaluation():
     # join uses closed-form end rows from the seed's end jets; measure_continuity evaluates the
     # full basis. Both must agree (reversed seeds go through the uncached generic path).
-    from ght_cad.continuity import _end_rows, _end_rows_fast
+    from ght_cad.curves.continuity import _end_rows, _end_rows_fast
 
     rng = np.random.default_rng(17)
     for m in range(2, 11):

@@ -69,7 +69,7 @@ def test_bad_parameters_and_orders() -> None:
 
 def test_seed_parameters_it_does_not_use_are_refused() -> None:
     """GBT is GHT at γ = -1 and Bernstein has no parameters: a value for them is an error, not ignored."""
-    from ght_cad.seeds import GHTSeed, make_seed
+    from ght_cad.curves.seeds import GHTSeed, make_seed
 
     with pytest.raises(GHTError, match=r"gamma=0\.5 is not used by the 'gbt' seed \(it is the GHT seed at gamma=-1\)"):
         make_seed("gbt", gamma=0.5)

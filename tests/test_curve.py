@@ -167,9 +167,9 @@ def test_with_shape_keeps_geometry_across_families() -> None:
 def test_straight_line_curvature_is_zero_to_round_off(m, dim, mu, nu, gamma, seed) -> None:
     """Control points on one line: the normal part of P'' that κ = |P''_⊥| / |P'|² measures is
     round-off, |P''_⊥| ≤ 1e-14 (|P''| + m² |P|) (the Gram-determinant form left ~1e-8 |P''| there:
-    κ = 3.6e-9 for (0,0) (1,1) (2,2)). Same for :func:`ght_cad.analysis.curvature` (and the
+    κ = 3.6e-9 for (0,0) (1,1) (2,2)). Same for :func:`ght_cad.curves.analysis.curvature` (and the
     composite curve's, which is the same function of the derivatives)."""
-    from ght_cad.analysis import curvature
+    from ght_cad.curves.analysis import curvature
 
     rng = np.random.default_rng(seed)
     a, d = rng.normal(size=dim), rng.normal(size=dim)
@@ -198,7 +198,7 @@ def test_degree_3000_evaluates_without_overflow() -> None:
     partition of unity (1e-11) and interpolation, and matches the direct path where both work."""
     import importlib
 
-    B, C = importlib.import_module("ght_cad.basis"), importlib.import_module("ght_cad.curve")
+    B, C = importlib.import_module("ght_cad.basis"), importlib.import_module("ght_cad.curves.curve")
 
     n = 3000
     x = np.linspace(0.0, 1.0, n)

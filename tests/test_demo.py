@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad.plotting import SIZES
+from ght_cad.curves.plotting import SIZES
 
 from dxf_read import dxf_outline_areas, svg_outline_areas
 
@@ -166,7 +166,7 @@ def test_report_optimization_is_consistent(demo) -> None:
 
 def test_report_curves_and_joins_match_recomputation(demo) -> None:
     from ght_cad import GHTCurve
-    from ght_cad.continuity import measure_continuity
+    from ght_cad.curves.continuity import measure_continuity
 
     _, report, _ = demo
     curves = {c["name"]: GHTCurve(c["control_points"], c["mu"], c["nu"], c["gamma"]) for c in report["curves"]}

@@ -130,7 +130,7 @@ def test_degenerate_geometry_exit_2_untouched(tmp_path: Path, out_dir: Path, cap
 
 def test_failure_after_files_were_written_leaves_out_untouched(tmp_path: Path, out_dir: Path, monkeypatch) -> None:
     """A crash in the last figure (after STEP and DXF were written) moves nothing into out."""
-    import ght_cad.plotting as P
+    import ght_cad.curves.plotting as P
 
     def boom(*a, **k):
         raise RuntimeError("renderer crashed")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from ght_cad.basis import basis, basis_parameter_derivatives
+from ght_cad.curves.basis import basis, basis_parameter_derivatives
 from ght_cad.optimize.problems import (
     CurveFairnessProblem,
     PopulationBasis,
@@ -23,8 +23,8 @@ from ght_cad.optimize.problems import (
     default_strip_problem,
     wave_strip_problem,
 )
-from ght_cad.curve import GHTCurve
-from ght_cad.seeds import ght_seed_jet, ght_seed_parameter_derivatives
+from ght_cad.curves.curve import GHTCurve
+from ght_cad.curves.seeds import ght_seed_jet, ght_seed_parameter_derivatives
 
 param = st.floats(-1.0, 1.0, allow_nan=False)
 T = np.linspace(0.0, 1.0, 11)

@@ -401,7 +401,7 @@ def test_join_with_huge_k_is_refused_naming_k() -> None:
     import warnings
 
     from ght_cad import GHTCurve
-    from ght_cad.continuity import join
+    from ght_cad.curves.continuity import join
     from ght_cad.core.errors import SingularJoinError
 
     a = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 0]])

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from ght_cad import GHTCurve, basis
-from ght_cad.curve import integrate
+from ght_cad.curves.curve import integrate
 from ght_cad.core.errors import GHTError
 from ght_cad.optimize import igwo, pso
 from ght_cad.optimize.problems import (
@@ -40,8 +40,8 @@ def test_population_basis_equals_core_basis(mu, nu, gamma, degree, r):
 def test_population_seed_jets_are_the_core_seed_formula(P, r):
     """One GHT seed formula: the population jets equal ``GHTSeed.f0_f2`` row by row, bit for bit,
     and the population basis equals the core ``seed_basis`` row by row, bit for bit."""
-    from ght_cad.basis import seed_basis
-    from ght_cad.seeds import GHTSeed
+    from ght_cad.curves.basis import seed_basis
+    from ght_cad.curves.seeds import GHTSeed
 
     t = np.linspace(0.0, 1.0, 17)
     arr = np.array(P)

@@ -88,7 +88,7 @@ def check_outside_at_thickness(plate, U: np.ndarray, V: np.ndarray, T: float) ->
 
 def _abs_turn(loft, sheet) -> float:
     """``(T²/2) ∫ |2H| dA = (T²/2) ∫ |ω| |g| du`` (ω = n'·e, module doc of ght_cad.plate)."""
-    from ght_cad.curve import integrate
+    from ght_cad.curves.curve import integrate
     from ght_cad.unroll import _smooth_pieces
 
     def f(u: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ import pytest
 
 from ght_cad import GHTCurve
 from ght_cad.core.errors import GHTError
-from ght_cad.plotting import (
+from ght_cad.curves.plotting import (
     SIZES,
     plot_basis,
     plot_convergence,
@@ -37,7 +37,7 @@ def no_leftovers(folder: Path) -> None:
 
 
 def test_core_import_does_not_import_matplotlib() -> None:
-    code = "import sys, ght_cad, ght_cad.plotting; print('matplotlib' in sys.modules)"
+    code = "import sys, ght_cad, ght_cad.curves.plotting; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
@@ -110,7 +110,7 @@ def test_failed_plot_keeps_existing_file(tmp_path: Path, monkeypatch: pytest.Mon
 
 
 def test_joined_curves_in_one_figure(tmp_path: Path) -> None:
-    from ght_cad.continuity import join
+    from ght_cad.curves.continuity import join
 
     a = GHTCurve([(0, 0, 0), (1, 2, 0), (3, 2, 1), (4, 0, 1)], gamma=-0.5)
     b = join(a, "G2", GHTCurve([(0, 0, 0), (0, 0, 0), (0, 0, 0), (7, 1, 2)], mu=0.2))
@@ -125,7 +125,7 @@ def test_plot_basis_refuses_a_degree_too_large_to_draw(tmp_path) -> None:
     """degree 100000 drew 800,000 matplotlib lines (the command ran for minutes); above
     MAX_PLOT_DEGREE the plot is refused naming the value and the allowed range, nothing written."""
     from ght_cad.core.errors import GHTError
-    from ght_cad.plotting import MAX_PLOT_DEGREE, plot_basis
+    from ght_cad.curves.plotting import MAX_PLOT_DEGREE, plot_basis
 
     assert MAX_PLOT_DEGREE >= 20
     with pytest.raises(GHTError, match=rf"degree=100000 .*2\.\.{MAX_PLOT_DEGREE}"):

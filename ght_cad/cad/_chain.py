@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 
 

@@ -35,7 +35,7 @@ import cadquery as cq
 import numpy as np
 
 from ..bspline import curve_to_bspline
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 from ._chain import segments_of
 from .occ import make_edge

@@ -37,7 +37,7 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVerte
 from OCP.gp import gp_Pnt
 
 from ..bspline import BSplineCurveData, curve_to_bspline
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 from ..patch import GHTSurface
 from ._chain import _as_curve, segments_of
@@ -310,7 +310,7 @@ class GHTBezierLine(BaseEdgeObject):
 
     Args:
         *control_points: three or more points (VectorLike, or one sequence of them), or a single
-            :class:`~ght_cad.curve.GHTCurve` (then mu, nu, gamma are ignored).
+            :class:`~ght_cad.curves.curve.GHTCurve` (then mu, nu, gamma are ignored).
         mu, nu, gamma: shape parameters in [-1, 1].
         tol: maximum deviation of the B-spline (default 1e-7 × bounding-box diagonal).
         degree: B-spline degree.

@@ -2,7 +2,7 @@ r"""build123d / OCP front end of the exact developable loft between two rails (s
 
 :func:`developable_loft` takes two rails as CAD edges (build123d or cadquery ``Edge``/``Wire``,
 OCP ``TopoDS_Edge``/``TopoDS_Wire``, any curve type: B-spline, circle, ellipse, line, ...) or
-:class:`~ght_cad.curve.GHTCurve` objects, runs the core :func:`ght_cad.loft.developable_loft`
+:class:`~ght_cad.curves.curve.GHTCurve` objects, runs the core :func:`ght_cad.loft.developable_loft`
 (the branch ``F(t, s) = det(a'(t), b'(s), b(s) - a(t)) = 0`` traced to round-off, fans at the
 rail ends) and returns its B-rep: one B-spline face per segment (main part and fans, degree 1
 across the rulings, the boundary curves fitted together so pole pair ``i`` spans one ruling:
@@ -41,7 +41,7 @@ from OCP.TopoDS import TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 from ._ocp import TopoDS
 
 from ..core._validate import as_parameter_array
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import ConversionError, GHTError
 from .developable_faces import sew_shell
 from .occ import is_valid, make_face, shape_class, unwrap
@@ -210,7 +210,7 @@ def rail_of(obj: Any, name: str = "rail") -> Any:
 
     Args:
         obj: build123d/cadquery ``Edge``/``Wire``, OCP ``TopoDS_Edge``/``TopoDS_Wire``, a 3-D
-            :class:`~ght_cad.curve.GHTCurve` (exact, no kernel in between), a
+            :class:`~ght_cad.curves.curve.GHTCurve` (exact, no kernel in between), a
             :class:`ght_cad.loft.CallableRail` or any object with ``evaluate``/``derivative``.
 
     Raises:
@@ -307,7 +307,7 @@ def developable_loft(
 
     Args:
         edge_a, edge_b: rails: build123d/cadquery ``Edge``/``Wire``, OCP ``TopoDS_Edge``/
-            ``TopoDS_Wire`` (any curve type) or 3-D :class:`~ght_cad.curve.GHTCurve`.
+            ``TopoDS_Wire`` (any curve type) or 3-D :class:`~ght_cad.curves.curve.GHTCurve`.
         tol, degree, sew_tol: see :func:`loft_shape`.
         mode: builder combination mode inside ``BuildPart`` (default ``Mode.ADD``: faces join
             the pending faces; ``Mode.PRIVATE``: nothing is added).

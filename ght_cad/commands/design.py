@@ -56,7 +56,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
         export_step(built, path)
 
     def write_surface_png(path: Path) -> None:
-        from ..plotting import plot_surface
+        from ..curves.plotting import plot_surface
 
         plot_surface(surface_view(built), path, title=design.name)
 
@@ -83,7 +83,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
                                  progress=not args.no_progress)
     result = {"command": "optimize", "name": design.name, **result_opt.summary(), "outputs": {}}
     if args.plot:
-        from ..plotting import plot_convergence
+        from ..curves.plotting import plot_convergence
 
         result["outputs"]["convergence_png"] = str(
             plot_convergence({result["method"]: result_opt.history}, args.plot, title=f"{design.name}: {result['objective']}")

@@ -155,7 +155,7 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
 def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
     """PNG (900 × 700 px) of the signed deviation (panel minus target along the target normal)
     over the target's (u, v), seams drawn as lines."""
-    from ..plotting import _figure, _save
+    from ..curves.plotting import _figure, _save
 
     fig = _figure("surface")
     ax = fig.add_subplot(1, 1, 1)

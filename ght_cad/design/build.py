@@ -25,8 +25,8 @@ def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple
     """GHT curves of the design with its joins applied, and a measured report per join.
 
     Joins are applied in file order: ``second`` gets its first ``r+1`` control points re-solved
-    (:func:`ght_cad.continuity.join`) so that the joint ``first(1) → second(0)`` has the requested
-    continuity; :func:`ght_cad.continuity.measure_continuity` then measures it independently.
+    (:func:`ght_cad.curves.continuity.join`) so that the joint ``first(1) → second(0)`` has the requested
+    continuity; :func:`ght_cad.curves.continuity.measure_continuity` then measures it independently.
 
     Args:
         design: a validated design.
@@ -42,7 +42,7 @@ def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple
 
 def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: bool) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """:func:`build_curves`; ``measure=False`` skips the join reports (optimizer candidates)."""
-    from ..curve import GHTCurve
+    from ..curves.curve import GHTCurve
 
     side_of: dict[str, str] = {}
     if shape and design.surface is not None and design.surface.type in ("curves", "rails"):
@@ -56,7 +56,7 @@ def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: b
         curves[c.name] = GHTCurve(c.control_points, sh["mu"], sh["nu"], sh["gamma"])
     reports = []
     for i, j in enumerate(design.joins):
-        from ..continuity import join, measure_continuity
+        from ..curves.continuity import join, measure_continuity
 
         a, b = curves[j.first], curves[j.second]
         if a.dim != b.dim:
@@ -376,7 +376,7 @@ def build_surfaces(design: Design, curves: dict[str, Any] | None = None) -> list
 
 
 def surface_view(built: "BuiltSurface | Sequence[BuiltSurface]") -> Any:
-    """What :func:`ght_cad.plotting.plot_surface` draws: the surface, all strips of a composite, or
+    """What :func:`ght_cad.curves.plotting.plot_surface` draws: the surface, all strips of a composite, or
     for several built surfaces all of them."""
     if isinstance(built, (list, tuple)):
         if len(built) == 1:
@@ -435,7 +435,7 @@ def surface_area(surface: Any) -> float:
 
 def ruled_area(surface: Any, nodes: int = 64) -> float:
     r"""Area ``∫_0^1 ∫_0^1 |X_u × X_v| dv du`` of a ruled surface (Gauss–Legendre, both directions)."""
-    from ..curve import gauss_legendre
+    from ..curves.curve import gauss_legendre
 
     t, w = gauss_legendre(nodes)
     v, wv = gauss_legendre(16)

@@ -88,9 +88,9 @@ def _end_basis(degree: int) -> Any:
 
 
 def _target_coefficients(continuity: Any, k: float, beta2: float, beta3: float) -> list[list[float]]:
-    r"""``T_r = Σ_j c[r][j] U^(j)(1)`` of :func:`ght_cad.continuity.join_targets`, r = 1..order
+    r"""``T_r = Σ_j c[r][j] U^(j)(1)`` of :func:`ght_cad.curves.continuity.join_targets`, r = 1..order
     (C: ``T_r = U^(r)(1)``; G1 ``k U'``, G2 ``k² U'' + β2 U'``, G3 ``k³ U''' + 3kβ2 U'' + β3 U'``)."""
-    from ..continuity import Continuity
+    from ..curves.continuity import Continuity
 
     cont = Continuity.parse(continuity)
     r = cont.order
@@ -108,7 +108,7 @@ def composite_dual_objectives_grad(composite: Any, joins: Sequence[tuple[Any, fl
     (spec 8.1), shape (strips, 3), through the joins re-solved for every parameter set.
 
     Strip ``s`` has dual curve ``U_s(t) = Σ_i b_{i,m}(t; θ_s) P_{s,i}``. Strip 0's control planes are
-    fixed; strip ``s > 0`` joined with order ``r`` to strip ``s-1`` has (:func:`ght_cad.continuity.join`)
+    fixed; strip ``s > 0`` joined with order ``r`` to strip ``s-1`` has (:func:`ght_cad.curves.continuity.join`)
     ``P_{s,0} = P_{s-1,m}`` and for ``q = 1..r``
 
     ``P_{s,q} = (T_q - Σ_{i<q} β^{(q)}_i P_{s,i}) / β^{(q)}_q``, ``β^{(q)}_i = b^{(q)}_{i}(0; θ_s)``,

@@ -174,7 +174,7 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
 
         return fc
     if surf.type == "planes":
-        from ..curve import GHTCurve
+        from ..curves.curve import GHTCurve
         from ..planes import normalize_planes
 
         U = normalize_planes(np.asarray(surf.planes, dtype=float))

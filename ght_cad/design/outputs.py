@@ -314,7 +314,7 @@ def pattern_errors(pattern: Any) -> dict[str, float]:
 
 def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None) -> Path:
     """Fixed-size PNG (900 x 700) of a flat pattern: outlines and bend lines."""
-    from ..plotting import plot_flat_pattern
+    from ..curves.plotting import plot_flat_pattern
 
     e = pattern.errors
     t = (title + ": " if title else "") + f"flat pattern, max rel. error {e['max']:.1e}"
@@ -403,7 +403,7 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
             summ["flat_pattern"] = pattern_report(pattern)
         write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
     else:
-        from ..plotting import plot_curve, plot_surface
+        from ..curves.plotting import plot_curve, plot_surface
 
         if builts:
             plot_surface(surface_view(builts), tmp, title=design.name)

@@ -45,7 +45,7 @@ def _versions() -> dict[str, str]:
 
 def _curve_max_curvature(c: Any) -> float | None:
     """Largest curvature over 513 parameters where it is defined (``P' != 0``); None for a point."""
-    from ..curve import curvature_from_derivatives
+    from ..curves.curve import curvature_from_derivatives
 
     t = np.linspace(0, 1, 513)
     kappa = curvature_from_derivatives(c.derivative(t, 1), c.derivative(t, 2))
@@ -322,7 +322,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
 
         # 7. figures
         step("figures")
-        from .. import plotting as P
+        from ..curves import plotting as P
 
         if "basis" in want_figs:
             if built is not None and design.surface is not None and design.surface.type == "composite":

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..core._validate import as_parameter_array
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import DegenerateGeometryError, GHTError
 from .checks import _check_3d_curve
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import EdgeOfRegressionError, GHTError
 from ..ruled import regression_v, RuledSurface
 from .jets import _fmt

@@ -13,8 +13,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ..core._validate import as_parameter_array, check_unit_interval
-from ..basis import _check_order, evaluate_derivatives
-from ..curve import GHTCurve
+from ..curves.basis import _check_order, evaluate_derivatives
+from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 
 
@@ -87,7 +87,7 @@ def curve_derivatives(curve: GHTCurve, t: Any, max_order: int) -> list[np.ndarra
     ``C^(r) = Σ_i b^{(r)}_{i,m} P_i`` with ``b^{(r)}_{i,m} = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} f_k^{(s)}``;
     seed derivatives of order > 3 come from the GHT seed formulas (sin/cos and polynomials), which
     hold for every order. All orders share one seed evaluation and one Bernstein matrix per order
-    (:func:`ght_cad.basis.evaluate_derivatives`).
+    (:func:`ght_cad.curves.basis.evaluate_derivatives`).
 
     Args:
         curve: a GHT curve (GHT/GBT/Bernstein seed, possibly reversed, for orders > 3).

@@ -19,13 +19,13 @@ def plot_loft_sign(rail_a: Any, rail_b: Any, path: Any, *, loft: DevelopableLoft
     Blue where F < 0, red where F > 0: the zero set (the boundary between the colours) holds the
     possible rulings; a developable loft over the whole rails is an increasing branch from the
     lower-left to the upper-right sides. With ``loft`` its path (fans along the sides, the traced
-    branch) is drawn in black. 800 x 800 pixels, written atomically (:mod:`ght_cad.plotting`
+    branch) is drawn in black. 800 x 800 pixels, written atomically (:mod:`ght_cad.curves.plotting`
     conventions: Agg canvas, no pyplot).
 
     Returns:
         The written path.
     """
-    from ..plotting import DPI, _save
+    from ..curves.plotting import DPI, _save
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import ListedColormap
     from matplotlib.figure import Figure

@@ -9,7 +9,7 @@ from typing import Any, Callable, Protocol, runtime_checkable
 import numpy as np
 
 from ..core._validate import as_parameter_array
-from ..curve import GHTCurve
+from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 
 
@@ -155,7 +155,7 @@ def as_rail(obj: Any, name: str = "rail") -> Any:
     """A rail object (``evaluate`` and ``derivative(t, order)`` of orders 0..3) for ``obj``.
 
     Args:
-        obj: a 3-D :class:`~ght_cad.curve.GHTCurve`, a :class:`CallableRail`, or any object with
+        obj: a 3-D :class:`~ght_cad.curves.curve.GHTCurve`, a :class:`CallableRail`, or any object with
             ``evaluate(t) -> (n, 3)`` and ``derivative(t, order=1) -> (n, 3)`` on [0, 1]. CAD
             edges (build123d/OCP, FreeCAD ``Part.Edge``) are wrapped by the adapters
             (``ght_cad.cad``, ``freecad_workbench``) into a :class:`CallableRail`.

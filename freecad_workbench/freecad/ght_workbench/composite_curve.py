@@ -2,9 +2,9 @@ r"""Composite curve feature: GHT segments joined with a continuity per joint (sp
 
 ``Segments`` links GHT curve features in order; joint j (between segment j and j+1) gets
 ``Continuity[j]`` ("C0".."C3", "G0".."G3") and, for G orders, ``K[j]`` (``R'(0) = k P'(1)``).
-Each following segment is re-solved with :func:`ght_cad.continuity.join` against the already
+Each following segment is re-solved with :func:`ght_cad.curves.continuity.join` against the already
 joined previous one (its first r+1 control points move, the rest and its own μ, ν, γ stay), and
-the measured order of every joint (:func:`ght_cad.continuity.measure_continuity`) is reported in
+the measured order of every joint (:func:`ght_cad.curves.continuity.measure_continuity`) is reported in
 ``JointOrders``. The linked segments themselves are not modified; the shape is a wire of B-spline
 edges whose end derivatives equal the GHT curves' (``curve_to_bspline`` imposes the end jets).
 """
@@ -27,7 +27,7 @@ __all__ = ["CompositeCurveFeature", "make_composite_curve", "joined_curves"]
 
 def joined_curves(obj: Any) -> list:
     """The segments as :class:`ght_cad.GHTCurve` objects after imposing each joint's continuity."""
-    from ght_cad.continuity import join
+    from ght_cad.curves.continuity import join
 
     segs = list(obj.Segments)
     if len(segs) < 2:
@@ -74,7 +74,7 @@ class CompositeCurveFeature(FeatureProxy):
         set_read_only(obj, ("JointOrders",))
 
     def compute(self, obj: Any) -> None:
-        from ght_cad.continuity import measure_continuity
+        from ght_cad.curves.continuity import measure_continuity
 
         curves = joined_curves(obj)
         tol = tolerance_property(obj)
@@ -118,7 +118,7 @@ def make_composite_curve(
     Returns:
         The recomputed feature; its ``JointOrders`` holds the measured continuity.
     """
-    from ght_cad.continuity import Continuity
+    from ght_cad.curves.continuity import Continuity
 
     n = len(segments) - 1
     conts = [continuity] * n if isinstance(continuity, str) else list(continuity)

@@ -8,9 +8,9 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ...basis import _compact_differences, basis_from_jets, bernstein, parameter_jets
+from ...curves.basis import _compact_differences, basis_from_jets, bernstein, parameter_jets
 from ...core.errors import GHTError
-from ...seeds import ght_seed_derivatives, ght_seed_jet, ght_seed_parameter_derivatives
+from ...curves.seeds import ght_seed_derivatives, ght_seed_jet, ght_seed_parameter_derivatives
 
 
 SHAPE_NAMES = ("mu", "nu", "gamma")
@@ -25,7 +25,7 @@ def ght_seed_jets(t: np.ndarray, mu: np.ndarray, nu: np.ndarray, gamma: np.ndarr
 
     ``f0 = (1-w)(1-s)(1-μs) + w(1-t)²``, ``f2 = (1-w)(1-c)(1-νc) + w t²``, ``w = (1+γ)/2``,
     ``s = sin(πt/2)``, ``c = cos(πt/2)`` (spec section 1), differentiated analytically by
-    :func:`ght_cad.seeds.ght_seed_jet` (the same formula as :class:`ght_cad.seeds.GHTSeed`).
+    :func:`ght_cad.curves.seeds.ght_seed_jet` (the same formula as :class:`ght_cad.curves.seeds.GHTSeed`).
 
     Args:
         t: nodes, shape (N,).
@@ -72,8 +72,8 @@ class PopulationBasis:
     def __call__(self, mu: Any, nu: Any, gamma: Any, orders: Sequence[int]) -> dict[int, np.ndarray]:
         """``{r: b^{(r)}}`` for the requested orders, each (P, N, m+1).
 
-        One sin/cos pass for all orders (:func:`ght_cad.seeds.ght_seed_derivatives`), combined
-        with the cached Bernstein matrices by :func:`ght_cad.basis.basis_from_jets`.
+        One sin/cos pass for all orders (:func:`ght_cad.curves.seeds.ght_seed_derivatives`), combined
+        with the cached Bernstein matrices by :func:`ght_cad.curves.basis.basis_from_jets`.
         """
         top = max(orders)
         jets = []
@@ -85,7 +85,7 @@ class PopulationBasis:
         r"""``{r: ∂b^{(r)}/∂(μ, ν, γ)}`` for the requested orders, each (3, P, N, m+1) (spec 8.1).
 
         ``∂b^{(r)}_{i,m}/∂θ = Σ_s C(r,s) Σ_k B^{(r-s)}_{i-k,n} ∂f_k^{(s)}/∂θ`` with the closed-form
-        seed derivatives (:func:`ght_cad.basis.parameter_jets`).
+        seed derivatives (:func:`ght_cad.curves.basis.parameter_jets`).
         """
         pj = parameter_jets(self.t, *_columns(mu, nu, gamma), max(orders))
         return {r: np.stack([basis_from_jets(self._bern, jets, r) for jets in pj]) for r in orders}
@@ -99,7 +99,7 @@ class CurveParameterJets:
 
     ``∂X^(r)/∂θ = Σ_s C(r,s) (∂f0^(s)/∂θ (Q0-Q1)^(r-s) + ∂f2^(s)/∂θ (Q2-Q1)^(r-s))``
 
-    with the closed-form seed derivatives (:func:`ght_cad.seeds.ght_seed_parameter_derivatives`;
+    with the closed-form seed derivatives (:func:`ght_cad.curves.seeds.ght_seed_parameter_derivatives`;
     ``∂f0/∂ν = ∂f2/∂μ = 0``). Only broadcasting products per call: the Bézier parts are computed once.
 
     Args:

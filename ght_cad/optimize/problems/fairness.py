@@ -10,7 +10,7 @@ import numpy as np
 
 from ...core._vec import cross as _cross
 from ...core._quadrature import gauss_legendre
-from ...curve import GHTCurve
+from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
 from ...ruled import RuledSurface
 from .base import CurveParameterJets, FAIRNESS_MEASURES, PopulationBasis, Problem, SHAPE_NAMES, _split, population_basis

@@ -13,7 +13,7 @@ import numpy as np
 from ...core._validate import is_real
 from ...core._vec import cross as _cross3
 from ...core._quadrature import gauss_legendre
-from ...curve import GHTCurve
+from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
 from ...loft.build import developable_loft
 from ...loft.equation import MIN_FAN

@@ -9,9 +9,9 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ...core._vec import cross as _cross
-from ...basis import bernstein
+from ...curves.basis import bernstein
 from ...core._quadrature import gauss_legendre
-from ...curve import GHTCurve
+from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
 from ...ruled import CurvePairRuledSurface
 from .base import CurveParameterJets, PopulationBasis, Problem, SHAPE_NAMES, _split
@@ -23,11 +23,11 @@ class _StripKernel:
     **Values**: bit for bit those of the basis-matrix route (:class:`PopulationBasis` ->
     ``b^(r) @ control_points`` -> ``numpy.cross``, kept as
     :meth:`StripProblem._r_and_grad_reference`). Every elementwise operation of the seed formula
-    (:func:`ght_cad.seeds.ght_seed_jet`, orders 0 and 1) is done once on arrays stacked over
+    (:func:`ght_cad.curves.seeds.ght_seed_jet`, orders 0 and 1) is done once on arrays stacked over
     (curve, f0/f2) instead of once per curve and order; everything that depends on the nodes only
     (sin/cos, their squares, ``(1-t)²``, ``t²``, Bernstein matrices) is computed once; the basis
     ``b^(r)_{i,m} = Σ_s C(r,s) Σ_k B^(r-s)_{i-k,n} f_k^(s)`` is one product with zero-padded
-    Bernstein matrices (terms in the order of :func:`ght_cad.basis.basis_from_jets`, the padding
+    Bernstein matrices (terms in the order of :func:`ght_cad.curves.basis.basis_from_jets`, the padding
     adds exact zeros) summed over the terms. Same operations in the same order per element: same
     floating-point results (checked in tests/test_optimize_problems.py).
 
@@ -46,7 +46,7 @@ class _StripKernel:
     """
 
     def __init__(self, t: np.ndarray, curves: Sequence[GHTCurve]) -> None:
-        from ...seeds import _HALF_PI, _trig_values
+        from ...curves.seeds import _HALF_PI, _trig_values
 
         self.t = t
         N = t.size

@@ -56,7 +56,7 @@ def _bspline(out: dict[str, Any]) -> None:
 
 def _join(out: dict[str, Any]) -> None:
     from ght_cad import GHTCurve
-    from ght_cad.continuity import join
+    from ght_cad.curves.continuity import join
 
     a = GHTCurve(POINTS[:4], 0.2, 0.4, -0.5)
     b = join(a, "G2", [(0, 0, 0), (0, 0, 0), (0, 0, 0), (60, 10, 0), (70, 0, 3)], mu=-0.6, k=1.5, beta2=0.3)

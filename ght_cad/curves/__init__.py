@@ -1,0 +1,1 @@
+"""The curves layer (issue 27)."""
