@@ -71,7 +71,7 @@ def many_faces_step(path: str | os.PathLike, n_faces: int) -> int:
     import build123d as bd
     import numpy as np
 
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
     from ght_cad.cad.occ import make_face, write_step
 
     shapes: list[Any] = []

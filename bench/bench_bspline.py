@@ -3,7 +3,7 @@ r"""Benchmark: certified GHT → B-spline conversion against OCCT's ``GeomAPI_Po
 For random 3-D GHT-Bézier curves of degrees 2..10 (random shape parameters in [-1, 1]) the
 target is the default tolerance ``tol = 1e-7 ×`` bounding-box diagonal.
 
-* ours: :func:`ght_cad.bspline.curve_to_bspline` at the default degree 5 and at degree 8 (OCCT's
+* ours: :func:`ght_cad.surfaces.bspline.curve_to_bspline` at the default degree 5 and at degree 8 (OCCT's
   DegMax below), end jets exact; deviation measured at matched parameters
   ``max_t |P(t) - C(t)|`` on 20 000 random + 4001 uniform fresh t.
 * OCCT, two modes, each on N uniform samples ``P(t_k)`` (t_k = k/(N-1)) with DegMin 3, DegMax 8,
@@ -34,7 +34,7 @@ import time
 import numpy as np
 
 from ght_cad import GHTCurve
-from ght_cad.bspline import BSplineCurveData, curve_to_bspline
+from ght_cad.surfaces.bspline import BSplineCurveData, curve_to_bspline
 
 
 def _timed(fn, repeat: int = 3):

@@ -24,10 +24,10 @@ def main(repeat: int = 5) -> dict[str, float]:
     from build123d import Face
 
     from ght_cad import developable_from_planes
-    from ght_cad.bspline import BSplineCurveData
+    from ght_cad.surfaces.bspline import BSplineCurveData
     from ght_cad.cad.developable_faces import developable_surface_data
     from ght_cad.cad.occ import is_valid, make_edge
-    from ght_cad.planes import plane_from_point_normal
+    from ght_cad.surfaces.planes import plane_from_point_normal
 
     planes = [
         plane_from_point_normal((0, 5, 0), (0, 1, -0.15)),

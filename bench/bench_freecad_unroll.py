@@ -3,7 +3,7 @@ r"""Flat-pattern unrolling inside FreeCAD: the core NURBS evaluator vs FreeCAD's
 The workbench's Flat pattern feature unrolls a Part face by
 ``ght_cad.face_unroll.unroll_face_data(flat_pattern.face_data(face), rulings=8, samples=65)``.
 ``face_data(face, fast=True)`` reads B-spline/Bézier surfaces and line/circle/B-spline/Bézier
-pcurves and edge curves into :mod:`ght_cad.nurbs` (vectorized, exact pcurve derivatives);
+pcurves and edge curves into :mod:`ght_cad.surfaces.nurbs` (vectorized, exact pcurve derivatives);
 ``fast=False`` is the old path (``value``/``getDN``/``valueAt`` point by point, pcurve derivatives
 by finite differences). Both are timed in the same FreeCAD process (fastest of ``GHT_BENCH_REPS``
 calls, default 10, alternating) on the four faces of ``bench/flatmesh_compare.py:default_faces()``

@@ -33,7 +33,7 @@ def bench_construction(repeat: int) -> dict[str, float]:
 
     from ght_cad import GHTCurve, developable_loft
     from ght_cad.cad.curves import ght_edge
-    from ght_cad.ruled import CurvePairRuledSurface
+    from ght_cad.surfaces.ruled import CurvePairRuledSurface
 
     chine, sheer = GHTCurve(CHINE), GHTCurve(SHEER)
     u = np.linspace(0.0, 1.0, 1000)

@@ -267,7 +267,7 @@ def default_faces() -> dict[str, Any]:
     import build123d as bd
 
     from ght_cad import developable_from_planes
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
     from ght_cad.cad.occ import make_face
 
     faces: dict[str, Any] = {}

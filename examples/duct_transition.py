@@ -27,7 +27,7 @@ OUTLET = (-2.5, -0.15, 0.0, 1.0)  # z = 2.5 + 0.15 x
 
 def tangent_plane(phi_deg: float) -> np.ndarray:
     """Plane through the apex tangent to the inlet circle (radius 1) at angle ``phi``."""
-    from ght_cad.planes import plane_from_points
+    from ght_cad.surfaces.planes import plane_from_points
 
     p = math.radians(phi_deg)
     base = np.array([math.cos(p), math.sin(p), 0.0])

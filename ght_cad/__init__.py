@@ -77,9 +77,9 @@ _LAZY: dict[str, str] = {
     "measure_continuity": "ght_cad.curves.continuity",
     "Continuity": "ght_cad.curves.continuity",
     "CompositeCurve": "ght_cad.curves.composite",
-    "curve_to_bspline": "ght_cad.bspline",
-    "fit_function": "ght_cad.bspline",
-    "GHTSurface": "ght_cad.patch",
+    "curve_to_bspline": "ght_cad.surfaces.bspline",
+    "fit_function": "ght_cad.surfaces.bspline",
+    "GHTSurface": "ght_cad.surfaces.patch",
     "developable_loft": "ght_cad.loft",
     "unfold": "ght_cad.cad.unfold_solid",
     "approximate": "ght_cad.approximation",
@@ -92,6 +92,7 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
                                         "progress", "step_guard", "_kernel")},
     **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
+    **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
 }
 
 _lazy_name = lazy_getattr(__name__, _LAZY, globals())

@@ -249,7 +249,7 @@ class _StripGrid:
 
 def _regression_in_strip(frame: Any, P: np.ndarray, params: tuple[float, float, float], y_lo: float, y_hi: float) -> bool:
     """The edge of regression ``U ∩ U' ∩ U''`` near the target inside the strip (module doc)."""
-    from .planes import meet
+    from .surfaces.planes import meet
 
     x0 = np.linspace(0.0, 1.0, 33)
     t = _t_of_x(x0)

@@ -5,7 +5,7 @@ r"""Developable surfaces from GHT curves (spec section 5): planes (duality), spi
   Ruling ``U ∩ U'``, edge of regression ``U ∩ U' ∩ U''``, boundary curves
   ``a(t) = U ∩ U' ∩ E_a`` and ``b(t) = U ∩ U' ∩ E_b`` (pairing kept), surface
   ``X(t, v) = (1-v) a(t) + v b(t)``. Derivatives of ``a, b`` are analytic: the meet
-  (:func:`ght_cad.planes.meet`) is trilinear, so with ``X = meet(U, U', E)``
+  (:func:`ght_cad.surfaces.planes.meet`) is trilinear, so with ``X = meet(U, U', E)``
   ``X' = meet(U, U'', E)``, ``X'' = meet(U', U'', E) + meet(U, U''', E)`` and the Cartesian point
   ``x = (X1, X2, X3)/X0`` follows by the quotient rule.
 * :class:`TangentDevelopable` (5.3): ``X(t, v) = C(t) + v T(t)``, trimmed to ``v ∈ [v0, v1]`` not
@@ -35,8 +35,8 @@ from .core._validate import as_parameter_array, check_finite_array, check_unit_i
 from .curves.basis import evaluate_derivatives
 from .curves.curve import GHTCurve
 from .core.errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
-from .planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
-from .ruled import Developability, RuledSurface
+from .surfaces.planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
+from .surfaces.ruled import Developability, RuledSurface
 # Moved to ght_cad.developables (issue 27); every name stays importable from here.
 from .developables.canal import (CanalReport, CanalSurface)  # noqa: F401
 from .developables.checks import (_check_3d_curve, _check_strip_regular, _check_v_range)  # noqa: F401

@@ -38,7 +38,7 @@ from .core.errors import DegenerateGeometryError, NotDevelopableError
 from .core._vec import norm as _norm
 from .core._vec import stack as _stack
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _unit_samples, measure_panel
-from .ruled import _theta_parameters
+from .surfaces.ruled import _theta_parameters
 from .unroll import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes, metric_angles,
                      metric_stencil)
 # Moved to ght_cad.faces (issue 27); every name stays importable from here.

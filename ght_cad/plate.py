@@ -22,10 +22,10 @@ bounded by six ruled faces, all of degree 1 in their second parameter:
   segment (their end pole columns are snapped to the same points).
 
 The four boundary curves are fitted TOGETHER as one 12-D function
-``f(u) = (a, b, a + σT n, b + σT n)`` by :func:`ght_cad.bspline.fit_function` (one knot vector,
+``f(u) = (a, b, a + σT n, b + σT n)`` by :func:`ght_cad.surfaces.bspline.fit_function` (one knot vector,
 deviation at matched parameters, values and first derivatives exact at the ends), piece by piece
 between the surface's ``breakpoints`` (:func:`ght_cad.developable.ruled_pieces`, e.g. a loft's
-fans and main part) and joined with knots of multiplicity ``p`` (:func:`ght_cad.bspline.join_bsplines`).
+fans and main part) and joined with knots of multiplicity ``p`` (:func:`ght_cad.surfaces.bspline.join_bsplines`).
 Every two faces that meet share their boundary curve pole for pole, so a kernel sews them exactly
 (:func:`ght_cad.cad.sheet_solid.plate_solid`). A boundary that stands still on a piece (a fan's
 apex) gets its exact point as every pole of that piece.
@@ -48,9 +48,9 @@ from typing import Any
 
 import numpy as np
 
-from .bspline import BSplineCurveData, BSplineSurfaceData, fit_function, join_bsplines
+from .surfaces.bspline import BSplineCurveData, BSplineSurfaceData, fit_function, join_bsplines
 from .core.errors import ConversionError, GHTError
-from .ruled import RuledSurface
+from .surfaces.ruled import RuledSurface
 
 __all__ = ["PlateBSplineData", "plate_bspline", "plate_volume", "PLATE_FACES"]
 
@@ -146,7 +146,7 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
     self-intersecting offset).
 
     Args:
-        surface: the developable design surface (a :class:`~ght_cad.ruled.RuledSurface`, with or
+        surface: the developable design surface (a :class:`~ght_cad.surfaces.ruled.RuledSurface`, with or
             without ``breakpoints``).
         sheet: the :class:`ght_cad.sheet.Sheet` (``outside_offset = σ T``; K does not change the
             solid).

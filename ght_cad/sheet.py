@@ -43,7 +43,7 @@ import numpy as np
 
 from .core._quadrature import leggauss
 from .core.errors import GHTError
-from .ruled import SINGULAR_NORMAL_TOL, RuledSurface
+from .surfaces.ruled import SINGULAR_NORMAL_TOL, RuledSurface
 
 __all__ = [
     "SIDES",

@@ -41,7 +41,7 @@ from .core._vec import dot as _dot
 from .core._vec import norm as _norm
 from .core._vec import unique_inverse as _unique_inverse
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
-from .ruled import RuledSurface
+from .surfaces.ruled import RuledSurface
 
 __all__ = [
     "unroll",
@@ -532,7 +532,7 @@ def unroll_ruled(
     breakpoints: Sequence[float] = (),
     sheet: Any = None,
 ) -> FlatPattern:
-    r"""Unroll a :class:`~ght_cad.ruled.RuledSurface` by quadrature along its rulings.
+    r"""Unroll a :class:`~ght_cad.surfaces.ruled.RuledSurface` by quadrature along its rulings.
 
     ``Y(u, v) = A(u) + v |g(u)| D(u)`` with ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥`` (module
     doc); the panel's outline is a(u), the ruling u = 1, b(u) reversed and the ruling u = 0.
@@ -609,7 +609,7 @@ def unroll(
 ) -> FlatPattern:
     r"""Unroll a developable surface or face into a flat pattern (spec section 6).
 
-    For a :class:`~ght_cad.ruled.RuledSurface` the development is computed by quadrature along the
+    For a :class:`~ght_cad.surfaces.ruled.RuledSurface` the development is computed by quadrature along the
     rulings: ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥``, ``Y(u, v) = A(u) + v |g(u)| D(u)``
     (adaptive Chebyshev panels, near machine precision). Anything else (a build123d/cadquery
     ``Face`` or an OCP ``TopoDS_Face``: cylinder, cone, plane, surface of extrusion, B-spline or

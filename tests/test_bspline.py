@@ -1,4 +1,4 @@
-"""Certified B-spline conversion (ght_cad.bspline.fit_function / curve_to_bspline)."""
+"""Certified B-spline conversion (ght_cad.surfaces.bspline.fit_function / curve_to_bspline)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.bspline import BSplineCurveData, _banded_least_squares, _nonzero_basis, clamped_knots, curve_to_bspline, fit_function
+from ght_cad.surfaces.bspline import BSplineCurveData, _banded_least_squares, _nonzero_basis, clamped_knots, curve_to_bspline, fit_function
 from ght_cad.core.errors import ConversionError, GHTError
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)

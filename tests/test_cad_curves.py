@@ -27,7 +27,7 @@ from ght_cad.curves.composite import CompositeCurve  # noqa: E402
 from cad_checks import green_area as _green_area  # noqa: E402
 from ght_cad.curves.curve import gauss_legendre  # noqa: E402
 from ght_cad.core.errors import GHTError  # noqa: E402
-from ght_cad.patch import GHTSurface  # noqa: E402
+from ght_cad.surfaces.patch import GHTSurface  # noqa: E402
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)
 

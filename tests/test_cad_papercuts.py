@@ -79,7 +79,7 @@ def _moves():
 def test_moved_edges_carry_their_transformed_curve_and_bspline(make):
     """A moved/rotated/mirrored/scaled ght edge used to keep the untransformed ght_bspline and
     ght_curve: now both describe the edge where it is, with the deviation scaled."""
-    from ght_cad.bspline import BSplineCurveData
+    from ght_cad.surfaces.bspline import BSplineCurveData
     from ght_cad.cad.curves import ght_edge
 
     curve = (GHTCurve([(0, 0), (4, 3), (8, 0)], mu=0.3, gamma=-0.5) if make.startswith("GHTBezier")
@@ -212,7 +212,7 @@ def test_ght_shapes_still_pickle_with_their_metadata():
     from build123d import Location
 
     from ght_cad.cad.curves import ght_edge, ght_face, ght_wire
-    from ght_cad.patch import GHTSurface
+    from ght_cad.surfaces.patch import GHTSurface
 
     c1 = GHTCurve([(0, 0), (1, 1), (2, 0)], mu=0.2)
     c2 = GHTCurve([(2, 0), (3, -1), (4, 0)])

@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ght_cad.bspline import BSplineSurfaceData
+from ght_cad.surfaces.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face, write_step
 from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
 from ght_cad.design import unroll_step

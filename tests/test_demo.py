@@ -148,7 +148,7 @@ def test_report_optimization_is_consistent(demo) -> None:
     from ght_cad import GHTCurve
     from ght_cad.design import dual_curve_objectives, parse_design_text
     from ght_cad.demo import default_design_text
-    from ght_cad.planes import normalize_planes
+    from ght_cad.surfaces.planes import normalize_planes
 
     _, report, _ = demo
     o = report["optimization"]

@@ -541,7 +541,7 @@ def test_planes_objective_is_inf_exactly_when_the_surface_degenerates(x: list[fl
     64-node Gauss–Legendre AL is only within ~1e-4 relative of the converged integral there)."""
     from ght_cad.design import OptimizeSpec, _objective_fn, build_surface
     from ght_cad.core.errors import GHTError
-    from ght_cad.planes import normalize_planes
+    from ght_cad.surfaces.planes import normalize_planes
 
     d = parse_design_text((EXAMPLES / "design_duct.toml").read_text(), "duct.toml")
     f = _objective_fn(d, {}, OptimizeSpec(objective="En", parameters=["mu", "nu", "gamma"]))

@@ -133,8 +133,8 @@ def test_two_surfaces_and_ght_target_and_deviation_figure() -> None:
 
 def test_inline_targets_evaluate_the_patch_and_degenerate_nets_are_refused() -> None:
     from ght_cad.design.approximate import approximation_target
-    from ght_cad.nurbs import NurbsSurface
-    from ght_cad.patch import GHTSurface
+    from ght_cad.surfaces.nurbs import NurbsSurface
+    from ght_cad.surfaces.patch import GHTSurface
 
     spec = parse_design(BASE, "d.toml").surface
     tgt = approximation_target(spec, "d.toml")
@@ -175,7 +175,7 @@ def test_run_refusals_exit_2_with_one_line(tmp_path: Path, capsys: pytest.Captur
 def _target_face():
     """The example's target as an OCCT B-spline face (the quadratic Bezier patch of its poles)."""
     pytest.importorskip("OCP")
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
     from ght_cad.cad.occ import make_face
 
     k = np.array([0.0, 0, 0, 1, 1, 1])
@@ -336,7 +336,7 @@ def test_sheet_side_is_measured_on_the_target_normal() -> None:
     from scipy.optimize import minimize
 
     from ght_cad.design import build_surface, plate_solids
-    from ght_cad.patch import GHTSurface
+    from ght_cad.surfaces.patch import GHTSurface
 
     net = [[[600.0 * i, 400.0 * j, [0.0, 80.0, 0.0][j]] for j in range(3)] for i in range(3)]
     g = GHTSurface(np.array(net))

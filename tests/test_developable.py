@@ -10,7 +10,7 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 import ght_cad
-import ght_cad.ruled
+import ght_cad.surfaces.ruled
 from ght_cad import GHTCurve
 from ght_cad.developable import (
     CanalSurface,
@@ -30,7 +30,7 @@ from ght_cad.core.errors import (
     ShapeParameterError,
     SingularJoinError,
 )
-from ght_cad.planes import plane_from_point_normal, signed_distance
+from ght_cad.surfaces.planes import plane_from_point_normal, signed_distance
 
 shape = st.floats(-1, 1, allow_nan=False)
 ROUND_OFF_DEG = 1e-9  # θ_max at round-off (degrees)
@@ -126,7 +126,7 @@ def test_envelope_developable_at_round_off(mu, nu, gamma):
     s = ship(mu, nu, gamma)
     dev = s.developability()
     assert dev.theta_max <= ROUND_OFF_DEG, dev
-    u = ght_cad.ruled._theta_parameters(64, 257)       # the parameters developability() samples
+    u = ght_cad.surfaces.ruled._theta_parameters(64, 257)       # the parameters developability() samples
     a1, g1, b1 = s.a(u, 1), s.ruling(u, 1), s.b(u, 1)
     floor = 256 * np.finfo(float).eps * (1 + (np.linalg.norm(a1, axis=1) + np.linalg.norm(b1, axis=1)) / np.linalg.norm(g1, axis=1))
     assert np.all(np.abs(s.developability_residual(u)) <= floor), dev
@@ -253,7 +253,7 @@ def test_sampled_gaussian_curvature_is_an_independent_check():
     for s in (ship(), cone(0.5, 2.0, 1.0), TangentDevelopable(SPACE, 0.2, 1.0), RectifyingDevelopable(SPACE, -0.1, 0.2)):
         L = np.ptp(s.grid(9, 3).reshape(-1, 3), axis=0).max()
         assert np.abs(s.gaussian_curvature(u, v)).max() * L**2 <= 1e-18
-    twisted = ght_cad.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
+    twisted = ght_cad.surfaces.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
     assert np.abs(twisted.gaussian_curvature(u, v)).max() > 1e-2
 
 
@@ -514,7 +514,7 @@ def test_bspline_data_meets_a_theta_tolerance():
     assert coarse.info["theta_max_deg"] <= 1e-3 and fine.info["theta_max_deg"] <= 1e-5
     assert fine.poles.shape[0] > coarse.poles.shape[0] and fine.info["fit_tol"] < coarse.info["fit_tol"]
     # a non-developable strip is converted at the requested tol and reports its own θ
-    twisted = ght_cad.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
+    twisted = ght_cad.surfaces.ruled.CurvePairRuledSurface(GHTCurve([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), GHTCurve([(0, 1, 0), (1, 1, 0.5), (2, 1, 1)]))
     assert developable_bspline(twisted).info["theta_max_deg"] > 10
     with pytest.raises(GHTError, match=r"theta_tol_deg=0.0 must be > 0"):
         developable_bspline(s, theta_tol_deg=0.0)

@@ -36,8 +36,8 @@ from ght_cad.developable import (  # noqa: E402
     join_developable,
 )
 from ght_cad.core.errors import GHTError  # noqa: E402
-from ght_cad.planes import plane_from_point_normal  # noqa: E402
-from ght_cad.ruled import CurvePairRuledSurface  # noqa: E402
+from ght_cad.surfaces.planes import plane_from_point_normal  # noqa: E402
+from ght_cad.surfaces.ruled import CurvePairRuledSurface  # noqa: E402
 
 THETA_FACE_DEG = 0.01  # acceptance: θ_max of a B-rep face, from OCCT normals
 

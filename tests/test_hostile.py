@@ -350,7 +350,7 @@ def test_pencil_of_control_planes_is_degenerate() -> None:
     planes = [[0.0, np.sin(a), -np.cos(a), 0.0] for a in (0.1, 0.7, 1.3)]
     with pytest.raises(DegenerateGeometryError, match="pencil"):
         developable_from_planes(planes, [[0, 0, 0, 1], [-1, 0, 0, 1]])
-    from ght_cad.planes import check_control_planes
+    from ght_cad.surfaces.planes import check_control_planes
 
     moved = [list(p) for p in planes]
     moved[1][3] = 0.5  # the middle plane tilted out of the pencil: accepted by the pencil test
@@ -386,7 +386,7 @@ def test_control_points_near_1e300_are_refused_without_warnings() -> None:
 def test_zero_width_ruled_surface_is_degenerate_not_nan() -> None:
     from ght_cad import GHTCurve, unroll
     from ght_cad.core.errors import DegenerateGeometryError
-    from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
+    from ght_cad.surfaces.ruled import CurvePairRuledSurface, FunctionRuledSurface
 
     c = GHTCurve([[0, 0, 0], [1, 1, 0], [2, 0, 1]])
     with pytest.raises(DegenerateGeometryError, match="same curve"):

@@ -1,19 +1,24 @@
-"""Import direction of TODAY's flat layout: the stepping stone to the layered sub-packages (issue 27).
+"""Import direction of the layered package (issue 27): sub-packages for the low layers, the rest flat.
 
 Every import of every module of ``ght_cad`` and of the FreeCAD workbench is read with ``ast``
 (function-local imports included: they are the ones that break the layering quietly) and resolved
 to a module. Each module has a layer, lowest first:
 
 =========  ====================================================================================
-core       errors, validation, small vector kernels, atomic files, output folders, progress
-curves     seeds, basis, curves, continuity, composites, analysis, planes, B-splines, NURBS,
-           patches, plotting
-surfaces   ruled surfaces, developables, the loft, sheet, plate, unrolling, flat patterns
+core       ``ght_cad.core``: errors, validation, small vector kernels, quadrature, caches, atomic
+           files, progress, the STEP text guard, the kernel registry; and ``ght_cad.outdir``
+curves     ``ght_cad.curves``: seeds, basis, curves, continuity, composites, analysis, plotting
+surfaces   ``ght_cad.surfaces`` (planes, B-splines, NURBS, patches, ruled surfaces); developables,
+           the loft, sheet, plate, unrolling, flat patterns
 optimize   ``ght_cad.optimize`` (optimizers, problems, Pareto, pipeline)
 facade     the package ``ght_cad`` itself (its ``__init__`` re-exports)
 kernel     CAD adapters: ``ght_cad.cad`` (OCP/build123d/cadquery), the FreeCAD workbench
 app        CLI, design files, batch, sweeps, demo
 =========  ====================================================================================
+
+A module is in the layer of its first package below ``ght_cad`` (:data:`_LAYER_OF`). The old
+path of a moved module (``ght_cad.curve``, a shim that is the module ``ght_cad.curves.curve``) is
+in the layer of the module it stands for, so importing it is never an upward import.
 
 An import may go to the same or a lower layer. The imports that go UP today and the import
 cycles of today are listed below as explicit allow-lists: a new upward import or a new cycle fails
@@ -37,9 +42,8 @@ LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
 _LAYER_OF = {
     # the layer packages of issue 27 are named after their layer; a few modules stay top-level
     "core": ["core", "outdir"],
-    "curves": ["curves", "seeds", "basis", "curve", "continuity", "composite", "analysis", "planes", "bspline", "nurbs",
-               "patch", "plotting"],
-    "surfaces": ["surfaces", "ruled", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern",
+    "curves": ["curves"],
+    "surfaces": ["surfaces", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern",
                  "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],

@@ -102,7 +102,7 @@ def test_write_step_product_defaults_to_the_file_name(tmp_path: Path) -> None:
     pytest.importorskip("OCP")
     import numpy as np
 
-    from ght_cad.bspline import BSplineCurveData
+    from ght_cad.surfaces.bspline import BSplineCurveData
     from ght_cad.cad.occ import make_edge, read_step_products, write_step
 
     edge = make_edge(BSplineCurveData(np.array([[0.0, 0, 0], [1, 1, 0], [2, 0, 0]]), np.array([0, 0, 0, 1, 1, 1.0]), 2))

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ght_cad.join_panels import outline_self_overlap, rigid_motion_onto
-from ght_cad.ruled import FunctionRuledSurface
+from ght_cad.surfaces.ruled import FunctionRuledSurface
 from ght_cad.sheet import Sheet
 from ght_cad.unroll import unroll_composite
 

@@ -70,7 +70,7 @@ def test_nothing_registered_names_the_extra_to_install(monkeypatch: pytest.Monke
 def test_the_core_calls_whatever_is_registered(monkeypatch: pytest.MonkeyPatch) -> None:
     """to_face of a developable and of a patch, and the unroll of a foreign face, go through the registry."""
     from ght_cad import GHTSurface, developable_from_planes, unroll
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
 
     _kernel.load_kernel()
     calls: list[tuple[str, object]] = []

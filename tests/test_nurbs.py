@@ -1,4 +1,4 @@
-"""The core NURBS evaluator (:mod:`ght_cad.nurbs`) against an independent reference.
+"""The core NURBS evaluator (:mod:`ght_cad.surfaces.nurbs`) against an independent reference.
 
 Reference: scipy's ``BSpline`` (its own de Boor evaluation) gives every basis function and its
 derivatives (``BSpline(U, I, p)(x, nu=k)``); the homogeneous surface / curve and its partials are
@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
 from ght_cad.core.errors import GHTError
-from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots
+from ght_cad.surfaces.nurbs import NurbsCurve, NurbsSurface, expand_knots
 
 RTOL = 1e-12
 

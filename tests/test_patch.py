@@ -10,7 +10,7 @@ from scipy.interpolate import BSpline
 
 from ght_cad import basis
 from ght_cad.core.errors import GHTError, ShapeParameterError, SingularJoinError
-from ght_cad.patch import GHTSurface, join_patches, measure_patch_continuity, patches_to_bspline
+from ght_cad.surfaces.patch import GHTSurface, join_patches, measure_patch_continuity, patches_to_bspline
 
 shape = st.floats(-1.0, 1.0, allow_nan=False)
 params6 = st.tuples(shape, shape, shape, shape, shape, shape)

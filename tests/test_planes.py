@@ -8,7 +8,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from ght_cad.core.errors import DegenerateGeometryError, GHTError
-from ght_cad.planes import (
+from ght_cad.surfaces.planes import (
     as_planes,
     check_control_planes,
     line_of_planes,

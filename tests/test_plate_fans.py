@@ -27,7 +27,7 @@ from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf  # noqa: E402
 from OCP.gp import gp_Pnt  # noqa: E402
 
 from ght_cad import GHTCurve  # noqa: E402
-from ght_cad.bspline import BSplineCurveData, fit_function, join_bsplines  # noqa: E402
+from ght_cad.surfaces.bspline import BSplineCurveData, fit_function, join_bsplines  # noqa: E402
 from ght_cad.cad.occ import has_c0_faces, is_valid, read_step, volume  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
 from ght_cad.developable import developable_bspline, ruled_pieces  # noqa: E402
@@ -263,7 +263,7 @@ def test_plate_step_names_readers_and_unroll(tmp_path) -> None:
     """The plate of the hull loft in STEP: one inside and one outside face (C0 at the joint rulings),
     found by names and by geometry, thickness T, unrolled as one panel equal to the loft's own
     neutral pattern; with extra curve edges (a compound) the names are read all the same."""
-    from ght_cad.bspline import curve_to_bspline
+    from ght_cad.surfaces.bspline import curve_to_bspline
     from ght_cad.cad.occ import make_edge
 
     loft, sheet = developable_loft(CHINE, SHEER), Sheet(4.0, 0.4)
@@ -287,7 +287,7 @@ def test_plate_step_names_readers_and_unroll(tmp_path) -> None:
 
 def test_c0_knots_of_a_joined_surface() -> None:
     """``NurbsSurface.c0_knots``: interior knots of full multiplicity (the degree) only."""
-    from ght_cad.nurbs import NurbsSurface
+    from ght_cad.surfaces.nurbs import NurbsSurface
 
     U = np.array([0, 0, 0, 0.25, 0.5, 0.5, 0.75, 0.75, 0.75, 1, 1, 1], float)  # degree 2: 0.5 and 0.75 are C0
     V = np.array([0, 0, 1, 1], float)

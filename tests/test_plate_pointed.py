@@ -130,7 +130,7 @@ def test_too_thick_is_refused_at_the_point_with_the_radius() -> None:
 
 def test_tangent_rails_at_the_point_are_refused() -> None:
     # a ruled surface whose boundaries meet tangentially at u = 1: c' x g' = 0 there
-    from ght_cad.ruled import CurvePairRuledSurface
+    from ght_cad.surfaces.ruled import CurvePairRuledSurface
 
     a = GHTCurve(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]], float))
     b = GHTCurve(np.array([[0, 1, 0.2], [1, 1, 0.1], [2, 0, 0], [3, 0, 0]], float))  # same end tangent
@@ -266,7 +266,7 @@ def test_unroll_step_of_a_plain_pointed_loft(tmp_path, capsys) -> None:
 def test_theta_skips_a_ruling_that_is_rounding_noise() -> None:
     """θ at a ruling shorter than SINGULAR_NORMAL_TOL of the boundary speeds is NaN (skipped), as
     at an exact zero ruling; a short but real ruling (1e-6 of the speeds) keeps its θ."""
-    from ght_cad.ruled import _theta
+    from ght_cad.surfaces.ruled import _theta
 
     a1 = np.array([[100.0, 0.0, 0.0]] * 3)
     b1 = np.array([[90.0, 5.0, 0.0]] * 3)

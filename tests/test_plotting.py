@@ -21,7 +21,7 @@ from ght_cad.curves.plotting import (
     plot_flat_pattern,
     plot_surface,
 )
-from ght_cad.ruled import CurvePairRuledSurface
+from ght_cad.surfaces.ruled import CurvePairRuledSurface
 
 
 def png_size(path: Path) -> tuple[int, int]:

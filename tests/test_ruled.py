@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
+from ght_cad.surfaces.ruled import CurvePairRuledSurface, FunctionRuledSurface
 
 
 def _circle(r: float, z: float, cx: float = 0.0) -> GHTCurve:

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from ght_cad import GHTCurve
 from ght_cad.developable import RectifyingDevelopable, TangentDevelopable, developable_from_planes
 from ght_cad.core.errors import GHTError
-from ght_cad.ruled import CurvePairRuledSurface
+from ght_cad.surfaces.ruled import CurvePairRuledSurface
 from ght_cad.sheet import (
     OffsetRuledSurface,
     Sheet,

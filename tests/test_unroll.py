@@ -13,7 +13,7 @@ import ght_cad
 from ght_cad import GHTCurve
 from ght_cad.curves.curve import integrate
 from ght_cad.core.errors import GHTError, NotDevelopableError
-from ght_cad.ruled import CurvePairRuledSurface, FunctionRuledSurface
+from ght_cad.surfaces.ruled import CurvePairRuledSurface, FunctionRuledSurface
 from ght_cad.unroll import RuledDevelopment, unroll, unroll_composite
 
 CLOSED_FORM_RTOL = 1e-9

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from conftest import freecadcmd_or_skip
-from ght_cad.bspline import BSplineSurfaceData
+from ght_cad.surfaces.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face
 from ght_cad.cad.unroll_faces import face_ruling_direction, unroll_face
 from ght_cad.core.errors import GHTError, NotDevelopableError
@@ -498,7 +498,7 @@ def _nurbs_faces():
     import build123d as bd
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
     from ght_cad.cad.occ import make_face
 
     rng = np.random.default_rng(7)

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from .frame import _Frame
 from .seams import _Seam
 

@@ -11,7 +11,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 
 
 # ----------------------------------------------------------------------------------------------

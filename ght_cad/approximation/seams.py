@@ -12,7 +12,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..core._quadrature import leggauss
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from ..core._vec import cross as _cross
 from .frame import _Frame
 
@@ -66,7 +66,7 @@ class _Seam:
         if getattr(self, key, None) is None:
             from scipy.interpolate import PchipInterpolator
 
-            from ..bspline import fit_function
+            from ..surfaces.bspline import fit_function
 
             # by normalized arc length (chords of 4096 pieces): a target whose speed jumps at its
             # knots (a rational sphere's G1 joints) still gives a smooth rail
@@ -113,7 +113,7 @@ class SeamCurve:
 
 
 class BSplineRuled(RuledSurface):
-    r"""The ruled surface of :class:`~ght_cad.bspline.BSplineSurfaceData` of degree 1 across:
+    r"""The ruled surface of :class:`~ght_cad.surfaces.bspline.BSplineSurfaceData` of degree 1 across:
     ``X(u, w) = (1 - w) A(u) + w B(u)`` (the face written to STEP); ``breakpoints`` at its knots of
     multiplicity >= degree (a loft's fan joints)."""
 

@@ -11,7 +11,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..core.errors import GHTError
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 
 
 _JET = Callable[[np.ndarray, np.ndarray, int], list]
@@ -82,8 +82,8 @@ def as_target(target: Any) -> SurfaceTarget:
     Raises:
         GHTError: anything else.
     """
-    from ..nurbs import NurbsSurface
-    from ..patch import GHTSurface
+    from ..surfaces.nurbs import NurbsSurface
+    from ..surfaces.patch import GHTSurface
 
     if isinstance(target, SurfaceTarget):
         return target

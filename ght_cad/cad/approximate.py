@@ -5,7 +5,7 @@ r"""OCP / build123d / cadquery side of :func:`ght_cad.approximate` (issue 24).
   evaluator where it is a B-spline, else evaluated through OCCT; the face's (u, v) bounding box).
 * :func:`panel_faces` / :func:`panels_shell`: the panels as B-spline faces of degree 1 across the
   rulings (:func:`ght_cad.cad.occ.make_face` of each panel's
-  :class:`~ght_cad.bspline.BSplineSurfaceData`), sewn into one shell with
+  :class:`~ght_cad.surfaces.bspline.BSplineSurfaceData`), sewn into one shell with
   ``BRepBuilderAPI_Sewing`` at ``1e-6`` of the size: adjacent panels are lofted from the same seam
   curve and their faces agree along it to the fit tolerance (1e-7 of the size).
 """

@@ -125,7 +125,7 @@ def _map_points(pts: np.ndarray, s: float, R: np.ndarray, b: np.ndarray, size: f
 
 
 def _transformed(value: Any, s: float, R: np.ndarray, b: np.ndarray, size: float) -> Any:
-    from ..bspline import BSplineCurveData, BSplineSurfaceData
+    from ..surfaces.bspline import BSplineCurveData, BSplineSurfaceData
     from ..curves.curve import GHTCurve
 
     if isinstance(value, (list, tuple)):

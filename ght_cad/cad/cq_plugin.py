@@ -34,7 +34,7 @@ from typing import Any, Iterable
 import cadquery as cq
 import numpy as np
 
-from ..bspline import curve_to_bspline
+from ..surfaces.bspline import curve_to_bspline
 from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
 from ._chain import segments_of
@@ -70,7 +70,7 @@ def _local_points(wp: "cq.Workplane", control_points: Iterable[Any], include_cur
 
 
 def _edge(curve: GHTCurve, tol: float | None, degree: int) -> "cq.Edge":
-    """``cq.Edge`` on the certified B-spline of a 3-D GHT curve (:func:`ght_cad.bspline.curve_to_bspline`)."""
+    """``cq.Edge`` on the certified B-spline of a 3-D GHT curve (:func:`ght_cad.surfaces.bspline.curve_to_bspline`)."""
     return cq.Edge(make_edge(curve_to_bspline(curve, tol, degree)).wrapped)
 
 

@@ -1,7 +1,7 @@
 r"""build123d adapters: GHT-Bézier curves, composite curves and patches as Edges, Wires and Faces.
 
-Every shape holds a *certified* B-spline (:func:`ght_cad.bspline.curve_to_bspline`,
-:meth:`ght_cad.patch.GHTSurface.to_bspline`): maximum deviation from the exact GHT geometry at
+Every shape holds a *certified* B-spline (:func:`ght_cad.surfaces.bspline.curve_to_bspline`,
+:meth:`ght_cad.surfaces.patch.GHTSurface.to_bspline`): maximum deviation from the exact GHT geometry at
 matched parameters below ``tol`` (default ``1e-7 ×`` bounding-box diagonal), parametrization kept
 (the edge's parameter is the curve's t ∈ [0, 1]) and end derivatives up to order
 ``min(3, degree-1)`` exact, so G2/G3 joints stay G2/G3 in the B-rep. The conversion record is
@@ -36,10 +36,10 @@ from build123d.objects_curve import BaseEdgeObject, BaseLineObject
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex, BRepBuilderAPI_MakeWire
 from OCP.gp import gp_Pnt
 
-from ..bspline import BSplineCurveData, curve_to_bspline
+from ..surfaces.bspline import BSplineCurveData, curve_to_bspline
 from ..curves.curve import GHTCurve
 from ..core.errors import GHTError
-from ..patch import GHTSurface
+from ..surfaces.patch import GHTSurface
 from ._chain import _as_curve, segments_of
 from .certified import certified, certify
 from .occ import geom_bspline_curve, make_face
@@ -213,7 +213,7 @@ def ght_face(patch: GHTSurface, tol: float | None = None, degree: int = 5) -> Fa
     r"""build123d ``Face`` on the certified B-spline surface of a GHT patch.
 
     ``|S(u,v) - S~(u,v)| <= tol`` (default 1e-7 × bounding-box diagonal; see
-    :meth:`ght_cad.patch.GHTSurface.to_bspline` for the bound).
+    :meth:`ght_cad.surfaces.patch.GHTSurface.to_bspline` for the bound).
 
     Returns:
         ``Face`` with ``face.ght_bspline`` = the BSplineSurfaceData.

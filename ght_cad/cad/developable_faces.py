@@ -3,7 +3,7 @@ r"""Developable surfaces as B-rep: one B-spline face per strip, shells for compo
 A developable strip ``X(u, v) = (1-v) a(u) + v b(u)`` becomes ONE B-spline surface of degree 1
 across the rulings (``knots_v = [0, 0, 1, 1]``) whose u-direction poles come from *compatible
 directrix poles*: the two boundary curves are fitted TOGETHER as one 6-D function
-``f(u) = (a(u), b(u))`` by :func:`ght_cad.bspline.fit_function` (one common knot vector, deviation
+``f(u) = (a(u), b(u))`` by :func:`ght_cad.surfaces.bspline.fit_function` (one common knot vector, deviation
 measured at matched parameters), so pole pair ``i`` of a and b spans one ruling. End values and
 derivatives up to order 2 are reproduced exactly (joint rulings and tangent planes of composites
 match exactly). Fitting the boundaries separately, or lofting by arc length, would break
@@ -32,10 +32,10 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from ._ocp import TopoDS
 from ._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
-from ..bspline import BSplineSurfaceData
+from ..surfaces.bspline import BSplineSurfaceData
 from ..developable import _size, developable_bspline
 from ..core.errors import ConversionError, GHTError
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from .occ import is_valid, make_face, shape_class, unwrap
 
 __all__ = [

@@ -20,7 +20,7 @@ from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
 from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
 
-from ..bspline import BSplineCurveData, BSplineSurfaceData
+from ..surfaces.bspline import BSplineCurveData, BSplineSurfaceData
 from ..core.errors import GHTError
 from ..core.io import atomic_path
 from ._ocp import TColgp_Array1OfPnt, TColgp_Array2OfPnt, TColStd_Array1OfInteger, TColStd_Array1OfReal

@@ -2,7 +2,7 @@ r"""The sheet as a solid plate (spec 6.1) through OCCT, and plates read back fro
 
 :func:`plate_solid` makes the plate of thickness ``T`` on the material side of the design surface.
 
-* A developable :class:`~ght_cad.ruled.RuledSurface` (``method="exact"``, the default) gets its
+* A developable :class:`~ght_cad.surfaces.ruled.RuledSurface` (``method="exact"``, the default) gets its
   plate built exactly: the region ``{X(u, v) + t n(u), t between 0 and σT}`` (n is constant along
   each ruling) is bounded by six ruled B-spline faces from ONE joint fit of the four boundary
   curves ``a, b, a + σT n, b + σT n`` (:func:`ght_cad.plate.plate_bspline`, tolerance
@@ -58,7 +58,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ._ocp import TopoDS
 
 from ..core.errors import GHTError
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from ..sheet import Sheet, SheetError, make_sheet
 from .occ import is_valid, quiet_occt, unwrap
 
@@ -183,7 +183,7 @@ def plate_solid(
     ``V = T A + σ (T²/2) ∫ 2H dA`` (:func:`ght_cad.plate.plate_volume`).
 
     Args:
-        surface_or_face: a developable :class:`~ght_cad.ruled.RuledSurface` (fans and other
+        surface_or_face: a developable :class:`~ght_cad.surfaces.ruled.RuledSurface` (fans and other
             breakpoints included) or a build123d/cadquery/OCP face (thickened by OCCT).
         sheet: the sheet, or give ``thickness``, ``k_factor``, ``side``
             (:func:`ght_cad.sheet.make_sheet`; K does not change the solid).

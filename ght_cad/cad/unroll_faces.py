@@ -59,7 +59,7 @@ from .. import face_unroll as _core
 from ..core.errors import GHTError
 from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
 from ..flat_pattern import FlatPattern
-from ..nurbs import NurbsCurve, NurbsSurface
+from ..surfaces.nurbs import NurbsCurve, NurbsSurface
 from ..unroll import DEFAULT_TOL_DEG
 
 __all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "face_data", "shape_faces"]
@@ -272,7 +272,7 @@ class _SurfEval(SurfaceAdapter):
 
 
 def _nurbs_of(ad: BRepAdaptor_Surface) -> NurbsSurface | None:
-    """The core evaluator (:class:`ght_cad.nurbs.NurbsSurface`) of the adaptor's B-spline/Bézier
+    """The core evaluator (:class:`ght_cad.surfaces.nurbs.NurbsSurface`) of the adaptor's B-spline/Bézier
     surface, read once from OCCT (None: periodic, or another kind)."""
     if ad.GetType() == GeomAbs_BSplineSurface:
         g = ad.BSpline()
@@ -415,7 +415,7 @@ def _curve_eval(c: Any, dim: int) -> Callable[[np.ndarray], np.ndarray] | None:
 
 
 def _nurbs_curve_of(c: Any, dim: int) -> NurbsCurve | None:
-    """The core evaluator (:class:`ght_cad.nurbs.NurbsCurve`) of a B-spline/Bézier curve adaptor
+    """The core evaluator (:class:`ght_cad.surfaces.nurbs.NurbsCurve`) of a B-spline/Bézier curve adaptor
     (2-D or 3-D), read once from OCCT (None: periodic)."""
     if c.GetType() == GeomAbs_BSplineCurve:
         g = c.BSpline()
@@ -459,7 +459,7 @@ def _edge_samples(edge: Any, face: TopoDS_Face, reversed_: bool) -> tuple[Callab
     """(t -> (u, v), t -> xyz, 3-D length, t -> (u', v')) of one edge, t ∈ [0, 1] in wire order.
 
     Line, circle and non-periodic B-spline/Bézier curves (pcurve and 3-D curve) are evaluated in
-    numpy (:func:`_curve_eval`, :class:`ght_cad.nurbs.NurbsCurve`),
+    numpy (:func:`_curve_eval`, :class:`ght_cad.surfaces.nurbs.NurbsCurve`),
     others point by point through OCCT; results are memoized per parameter array (:func:`_memo`).
     """
     c2 = BRepAdaptor_Curve2d(edge, face)

@@ -80,7 +80,7 @@ def cmd_curve(args: argparse.Namespace) -> int:
                          "point, not an edge; allowed: control points that are not all equal")
 
     def write_step_edge(path: Path) -> None:
-        from ..bspline import curve_to_bspline
+        from ..surfaces.bspline import curve_to_bspline
         from ..cad.occ import make_edge, write_step
 
         data = curve_to_bspline(curve)

@@ -302,7 +302,7 @@ def plot_surface(
     when ``colour_by_theta`` (a developable surface is uniform), else by a fixed light shading.
 
     Args:
-        surface: a :class:`ght_cad.ruled.RuledSurface` (anything with ``grid`` and ``theta``).
+        surface: a :class:`ght_cad.surfaces.ruled.RuledSurface` (anything with ``grid`` and ``theta``).
         path: PNG file to write (900 x 700 pixels).
         nu, nv: grid resolution along u and v.
         title: figure title.

@@ -3,7 +3,7 @@ r"""Design-file surfaces of ``type = "approximate"`` (issue 24): developable pan
 The target of ``[[surfaces]] type = "approximate"`` (``[surfaces.target]``, :class:`~ght_cad.design.schema.TargetSpec`)
 is a face of a STEP file (path relative to the design file, 1-based face number, as ``ght-cad
 approximate --face``), a GHT patch ``S(u, v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P_ij``
-(:class:`ght_cad.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.nurbs.NurbsSurface`). It is
+(:class:`ght_cad.surfaces.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.surfaces.nurbs.NurbsSurface`). It is
 covered by :func:`ght_cad.approximate` with the surface's ``tol``, ``max_panels`` and ``direction``:
 the same call ``ght-cad approximate`` (:mod:`ght_cad.approximate_cli`) makes, and both write their
 outputs through the functions of this module: the panels sewn into one shell
@@ -103,12 +103,12 @@ def _patch(t: Any) -> Any:
     """The GHTSurface or NurbsSurface of an inline target."""
     net = np.asarray(t.control_points, dtype=float)
     if t.kind == "ght":
-        from ..patch import GHTSurface
+        from ..surfaces.patch import GHTSurface
 
         s = t.shape
         return GHTSurface(net, s.get("mu_u", 0.0), s.get("nu_u", 0.0), s.get("gamma_u", 0.0),
                           s.get("mu_v", 0.0), s.get("nu_v", 0.0), s.get("gamma_v", 0.0))
-    from ..nurbs import NurbsSurface
+    from ..surfaces.nurbs import NurbsSurface
 
     return NurbsSurface.from_poles(t.knots_u, t.knots_v, t.degree_u, t.degree_v, net, t.weights)
 

@@ -139,7 +139,7 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
     cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
     if spec.type == "rails":
         return make_loft(spec, ca, cb)
-    from ..ruled import CurvePairRuledSurface
+    from ..surfaces.ruled import CurvePairRuledSurface
 
     return CurvePairRuledSurface(ca, cb)
 
@@ -169,7 +169,7 @@ def _make_composite(design: Design, shape: dict[str, float]) -> Any:
         GHTError: a join that cannot be solved or a degenerate strip, naming the segment.
     """
     from ..developable import CompositeDevelopable, developable_from_planes, join_developable
-    from ..planes import normalize_planes
+    from ..surfaces.planes import normalize_planes
 
     spec = design.surface
     assert spec is not None and spec.segments
@@ -228,7 +228,7 @@ def inside_radius(surface: Any, side: str, thickness: float, *, samples: int = 5
     the smaller one, ``R = min(|ρ_0|, |ρ_0 + σ T|)``; apex ends (a stationary boundary, the point of
     a cone or fan) are skipped as in ``check_offset``. ``inf`` for a flat surface.
     """
-    from ..ruled import SINGULAR_NORMAL_TOL
+    from ..surfaces.ruled import SINGULAR_NORMAL_TOL
     from ..sheet import bending_radius
 
     sigma = 1.0 if side == "normal" else -1.0

@@ -175,7 +175,7 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
         return fc
     if surf.type == "planes":
         from ..curves.curve import GHTCurve
-        from ..planes import normalize_planes
+        from ..surfaces.planes import normalize_planes
 
         U = normalize_planes(np.asarray(surf.planes, dtype=float))
         w = np.asarray(spec.weights, dtype=float)
@@ -195,7 +195,7 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
     rejoin = bool({str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins})
     if surf.type == "rails":
         return _rails_objective_fn(design, curves, spec, rejoin, accept)
-    from ..ruled import developability_from_jets
+    from ..surfaces.ruled import developability_from_jets
 
     t, wq = _gauss_legendre(64)
 

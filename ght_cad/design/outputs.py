@@ -22,7 +22,7 @@ def _ruled_face(surface: Any, tol: float) -> Any:
     ``a`` and ``b`` are fitted together as one 6-D function (one knot vector, pole i of each at
     the same parameter), so the face is ``(1-v) A(u) + v B(u)`` with ``|A - a|, |B - b| <= tol``.
     """
-    from ..bspline import BSplineSurfaceData, fit_function
+    from ..surfaces.bspline import BSplineSurfaceData, fit_function
     from ..cad.occ import make_face
 
     fit = fit_function(lambda t: np.hstack([surface.a(t), surface.b(t)]), tol=tol, degree=5)
@@ -126,7 +126,7 @@ def shared_edge_count(shape: Any) -> int:
 
 def curve_edges(curves: dict[str, Any]) -> list[Any]:
     """Certified B-spline edges (``curve_to_bspline``) of the 2-D/3-D curves."""
-    from ..bspline import curve_to_bspline
+    from ..surfaces.bspline import curve_to_bspline
     from ..cad.occ import make_edge
 
     return [make_edge(curve_to_bspline(c)) for c in curves.values() if c.dim in (2, 3)]

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..curves.curve import GHTCurve
 from ..core.errors import EdgeOfRegressionError, GHTError
-from ..ruled import regression_v, RuledSurface
+from ..surfaces.ruled import regression_v, RuledSurface
 from .jets import _fmt
 
 

@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from ..bspline import BSplineSurfaceData, fit_function
+from ..surfaces.bspline import BSplineSurfaceData, fit_function
 from ..core.errors import ConversionError, GHTError
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 
 
 # ----------------------------------------------------------------------------------------------
@@ -30,7 +30,7 @@ def _size(surface: RuledSurface) -> float:
 
 def _bspline_theta(curve: Any, samples: int = 513) -> float:
     """θ_max (degrees) of the ruled B-spline ``(A(u), B(u))`` from its own derivatives."""
-    from ..ruled import _theta
+    from ..surfaces.ruled import _theta
 
     u = np.linspace(0.0, 1.0, samples)
     F = curve.evaluate(u)
@@ -45,7 +45,7 @@ class RuledPiece:
 
     Attributes:
         lo, hi: the piece's parameter interval ``[λ_lo, λ_hi]`` on the whole surface.
-        surface: the piece as a :class:`~ght_cad.ruled.RuledSurface` on ``x ∈ [0, 1]``,
+        surface: the piece as a :class:`~ght_cad.surfaces.ruled.RuledSurface` on ``x ∈ [0, 1]``,
             ``λ = λ_lo + x (λ_hi - λ_lo)`` (derivatives with respect to x).
         end_orders: the highest end derivative order of ``surface`` that is exact (one-sided) at
             ``x = 0`` and at ``x = 1`` (0..2).
@@ -93,7 +93,7 @@ def ruled_pieces(surface: RuledSurface) -> list[RuledPiece]:
     one-sided).
 
     Args:
-        surface: any :class:`~ght_cad.ruled.RuledSurface` (``breakpoints`` optional).
+        surface: any :class:`~ght_cad.surfaces.ruled.RuledSurface` (``breakpoints`` optional).
 
     Returns:
         One :class:`RuledPiece` per interval; a single piece ``(0, 1, surface, (2, 2))`` without
@@ -198,7 +198,7 @@ def developable_bspline(
 ) -> BSplineSurfaceData:
     r"""B-spline surface data of a ruled strip from compatible directrix poles.
 
-    ``f(u) = (a(u), b(u)) ∈ R^6`` is fitted by :func:`ght_cad.bspline.fit_function` with
+    ``f(u) = (a(u), b(u)) ∈ R^6`` is fitted by :func:`ght_cad.surfaces.bspline.fit_function` with
     ``max_u |f(u) - F(u)| <= tol`` at matched parameters and exact end derivatives up to
     ``end_order``; poles ``F_i = (A_i, B_i)`` give the net ``P[i, 0] = A_i``, ``P[i, 1] = B_i`` with
     ``degree_v = 1``, ``knots_v = [0, 0, 1, 1]``, so ``S(u, v) = (1-v) A(u) + v B(u)``.
@@ -207,7 +207,7 @@ def developable_bspline(
     stands still while the other rail moves) is fitted piece by piece (:func:`ruled_pieces`: each
     piece with its exact one-sided end jets, end order ``min(end_order, piece)``) and the pieces
     are joined with knots of multiplicity ``degree`` at the breakpoints
-    (:func:`ght_cad.bspline.join_bsplines`): ``S`` is then each piece's fit exactly (C0 at the
+    (:func:`ght_cad.surfaces.bspline.join_bsplines`): ``S`` is then each piece's fit exactly (C0 at the
     joint rulings, the joint ruling an exact pole pair), with the surface's own parameter u = λ.
     A surface without breakpoints takes the single fit as before (bit for bit).
 
@@ -217,14 +217,14 @@ def developable_bspline(
     face is then developable to ``theta_tol_deg`` by construction, not only close to a developable.
 
     Args:
-        surface: any :class:`~ght_cad.ruled.RuledSurface`.
+        surface: any :class:`~ght_cad.surfaces.ruled.RuledSurface`.
         tol: absolute deviation bound; default ``1e-7`` times the bounding-box diagonal.
         degree: B-spline degree in u (>= 3 recommended).
         end_order: highest end derivative reproduced exactly (0..2).
         theta_tol_deg: required θ_max of the B-spline surface (degrees); ``inf`` skips the check.
 
     Returns:
-        :class:`~ght_cad.bspline.BSplineSurfaceData` with ``max_deviation`` and ``info``
+        :class:`~ght_cad.surfaces.bspline.BSplineSurfaceData` with ``max_deviation`` and ``info``
         (``info["theta_max_deg"]``: θ_max of the B-spline surface, ``info["fit_tol"]``; with
         breakpoints also ``info["pieces"]``, ``info["breaks"]``, ``info["joint_gaps"]``).
 
@@ -237,7 +237,7 @@ def developable_bspline(
     if len(pieces) == 1:
         curve, theta, tol = _strip_fit(surface, tol, degree, (end_order, end_order), theta_tol_deg)
     else:
-        from ..bspline import join_bsplines
+        from ..surfaces.bspline import join_bsplines
 
         fits = [_strip_fit(pc.surface, tol, degree, tuple(min(end_order, k) for k in pc.end_orders), theta_tol_deg)
                 for pc in pieces]

@@ -1,4 +1,4 @@
-"""A face whose isolines in one direction are straight, as a :class:`ght_cad.ruled.RuledSurface`.
+"""A face whose isolines in one direction are straight, as a :class:`ght_cad.surfaces.ruled.RuledSurface`.
 
 Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
 """
@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core._vec import unique_inverse
 from ..core.errors import GHTError
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from .adapter import Bounds, surface_jet, SurfaceAdapter
 from .loops import _flat1
 

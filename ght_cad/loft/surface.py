@@ -12,7 +12,7 @@ import numpy as np
 from ..core._validate import as_parameter_array
 from ..core._quadrature import gauss_legendre
 from ..core.errors import GHTError
-from ..ruled import Developability, RuledSurface, regression_v
+from ..surfaces.ruled import Developability, RuledSurface, regression_v
 from .equation import MIN_FAN, _EPS, _Pair
 from .rails import _jet
 from .tracing import _Branch, _Path
@@ -428,7 +428,7 @@ class DevelopableLoft(RuledSurface):
     # -- report --------------------------------------------------------------------------
     def _make_report(self, samples: int, candidates: list[dict[str, Any]], area_rtol: float) -> LoftReport:
         from ..unroll import ruled_area
-        from ..ruled import _theta
+        from ..surfaces.ruled import _theta
 
         size = self._pair.size
         seg_info = []

@@ -6,7 +6,7 @@ optimized object (``problem.build(x)``: a ruled/developable surface or a curve),
 
 * the B-rep: a build123d ``Face`` for surfaces (``surface.to_face()``, else
   :func:`ght_cad.cad.developable_faces.developable_face`), an ``Edge`` for curves
-  (certified B-spline, :func:`ght_cad.bspline.curve_to_bspline`);
+  (certified B-spline, :func:`ght_cad.surfaces.bspline.curve_to_bspline`);
 * ``<stem>.step`` (:func:`ght_cad.cad.occ.write_step`, atomic);
 * ``<stem>.dxf`` flat pattern of a surface (:func:`ght_cad.unroll`; a quasi-developable strip
   whose ``θ_max`` exceeds the unroll tolerance is flattened with ``best_effort=True`` and its
@@ -31,7 +31,7 @@ from ..core._kernel import adapter
 from ..core.errors import GHTError
 from ..core.io import write_text_atomic
 from ..core.progress import Progress
-from ..ruled import RuledSurface
+from ..surfaces.ruled import RuledSurface
 from .optimizers import OptimizeResult, OptimizerState, minimize
 
 __all__ = ["DesignResult", "optimize_design"]
@@ -98,7 +98,7 @@ def _brep(obj: Any, notes: list[str]) -> Any:
             if hasattr(obj, "to_face"):
                 return obj.to_face()
             return adapter("developable_face")(obj)
-        from ..bspline import curve_to_bspline
+        from ..surfaces.bspline import curve_to_bspline
 
         if getattr(obj, "dim", 3) not in (2, 3):
             notes.append(f"no B-rep for a {obj.dim}-D curve")

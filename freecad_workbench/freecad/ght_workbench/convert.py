@@ -1,7 +1,7 @@
 """Plain B-spline data from the ght_cad core -> FreeCAD ``Part`` geometry (and back to arrays).
 
-The core hands over poles/knots/degrees (:class:`ght_cad.bspline.BSplineCurveData`,
-:class:`ght_cad.bspline.BSplineSurfaceData`); here they become ``Part.BSplineCurve`` /
+The core hands over poles/knots/degrees (:class:`ght_cad.surfaces.bspline.BSplineCurveData`,
+:class:`ght_cad.surfaces.bspline.BSplineSurfaceData`); here they become ``Part.BSplineCurve`` /
 ``Part.BSplineSurface`` through ``buildFromPolesMultsKnots`` (distinct knots + multiplicities,
 OCCT's form). No build123d/OCP: this runs in FreeCAD's own Python.
 """
@@ -16,7 +16,7 @@ import FreeCAD as App
 import Part
 
 from . import _ensure_core  # noqa: F401  (makes ght_cad importable)
-from ght_cad.bspline import BSplineCurveData, BSplineSurfaceData, knots_and_multiplicities
+from ght_cad.surfaces.bspline import BSplineCurveData, BSplineSurfaceData, knots_and_multiplicities
 from ght_cad.core.errors import GHTError
 
 __all__ = [
@@ -51,18 +51,18 @@ def points_array(points: Iterable[Any]) -> np.ndarray:
 def fit_curve_function(f: Callable[[np.ndarray], np.ndarray], tol: float = DEFAULT_TOL) -> BSplineCurveData:
     """B-spline data of a vector function ``f(t)`` on [0, 1] (shape (len(t), d)), deviation <= tol.
 
-    ``ght_cad.bspline.fit_function``: one common knot vector for every coordinate, so a 6-D stack
+    ``ght_cad.surfaces.bspline.fit_function``: one common knot vector for every coordinate, so a 6-D stack
     of two boundary curves keeps its pairing; the deviation is measured at matched parameters.
     """
-    from ght_cad.bspline import fit_function
+    from ght_cad.surfaces.bspline import fit_function
 
     return fit_function(f, tol=tol)
 
 
 def curve_data(curve: Any, tol: float = DEFAULT_TOL) -> BSplineCurveData:
-    """B-spline data of a :class:`ght_cad.GHTCurve` via ``ght_cad.bspline.curve_to_bspline``
+    """B-spline data of a :class:`ght_cad.GHTCurve` via ``ght_cad.surfaces.bspline.curve_to_bspline``
     (same parametrization, end derivatives up to order 3 exact, deviation <= tol)."""
-    from ght_cad.bspline import curve_to_bspline
+    from ght_cad.surfaces.bspline import curve_to_bspline
 
     return curve_to_bspline(curve, tol=tol)
 
@@ -121,7 +121,7 @@ def face_from_data(data: BSplineSurfaceData) -> "Part.Face":
 def ruled_surface_data(surface: Any, tol: float | None = None, degree: int = 5, end_order: int = 2) -> BSplineSurfaceData:
     r"""B-spline surface data of a ruled strip ``X(u, v) = (1-v) a(u) + v b(u)`` (any ght_cad RuledSurface).
 
-    The 6-D function ``f(u) = (a(u), b(u))`` is fitted once by ``ght_cad.bspline.fit_function``
+    The 6-D function ``f(u) = (a(u), b(u))`` is fitted once by ``ght_cad.surfaces.bspline.fit_function``
     (deviation <= tol at matched parameters, exact end derivatives up to ``end_order``), so both
     boundary curves share one knot vector and pole ``i`` of ``a`` and of ``b`` belong to the same
     ruling neighbourhood; the net is ``P[i, 0] = A_i``, ``P[i, 1] = B_i``, degree 1 in v. This keeps
@@ -135,7 +135,7 @@ def ruled_surface_data(surface: Any, tol: float | None = None, degree: int = 5, 
     def f(u: np.ndarray) -> np.ndarray:
         return np.hstack([surface.a(u), surface.b(u)])
 
-    from ght_cad.bspline import fit_function
+    from ght_cad.surfaces.bspline import fit_function
 
     order = min(end_order, degree - 1)
     ends = tuple([np.concatenate([surface.a(e, r)[0], surface.b(e, r)[0]]) for r in range(order + 1)] for e in (0.0, 1.0))

@@ -16,7 +16,7 @@ module only adapts FreeCAD to it and back:
   ``face.toNurbs()`` (OCCT's exact NURBS conversion of the face, its pcurves converted with it, so
   the parameter box is the converted face's). Whatever cannot be read that way is evaluated point
   by point by FreeCAD (``value``/``getDN``: correct, slow).
-* the panels (the core's :class:`~ght_cad.bspline.BSplineSurfaceData`, degree 1 across the
+* the panels (the core's :class:`~ght_cad.surfaces.bspline.BSplineSurfaceData`, degree 1 across the
   rulings, fitted to 1e-7 of the size) become ``Part.BSplineSurface`` faces
   (:func:`.convert.face_from_data`) joined into one shell along their seams at 1e-6 of the target
   size (:func:`panel_shell`: adjacent panels are lofted from the same seam curve).

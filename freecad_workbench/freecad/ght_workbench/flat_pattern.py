@@ -7,7 +7,7 @@ maps), a plane, a surface of extrusion, a ruled B-spline or Bézier face (``Part
 re-imported STEP), trimmed or with holes. Faces go through the kernel-free
 :func:`ght_cad.face_unroll.unroll_face_data` (the same code that unrolls build123d/OCP faces)
 via the small adapter below (:func:`face_data`): FreeCAD's ``face.Surface`` (B-spline and
-Bézier surfaces read into the core's :mod:`ght_cad.nurbs`, others evaluated with
+Bézier surfaces read into the core's :mod:`ght_cad.surfaces.nurbs`, others evaluated with
 ``value``/``getDN``), every wire (``OuterWire`` first) in ``OrderedEdges`` order with its pcurve
 ``face.curveOnSurface(edge)``, the edges' 3-D curves and lengths. The face's real outline and
 holes are kept. Non-developable faces (sphere, torus, twisted loft) are refused with the
@@ -38,7 +38,7 @@ import Part
 from ght_cad.core.errors import GHTError
 from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, jets_agree,
                                  surface_jet, unroll_face_data)
-from ght_cad.nurbs import NurbsCurve, NurbsSurface, expand_knots
+from ght_cad.surfaces.nurbs import NurbsCurve, NurbsSurface, expand_knots
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 from .convert import edge_from_data
@@ -72,7 +72,7 @@ def _vec(v: Any, dim: int) -> tuple[float, ...]:
 
 
 def read_surface(s: Any) -> NurbsSurface | None:
-    """The core evaluator (:class:`ght_cad.nurbs.NurbsSurface`) of a ``Part.BSplineSurface`` or
+    """The core evaluator (:class:`ght_cad.surfaces.nurbs.NurbsSurface`) of a ``Part.BSplineSurface`` or
     ``Part.BezierSurface``, read once: poles (``getPoles``, rows along u), weights (``getWeights``,
     only when ``isURational``/``isVRational``), flat knot vectors from ``getUKnots`` /
     ``getUMultiplicities`` (v likewise), degrees. None for other surfaces, periodic B-splines (left
@@ -112,7 +112,7 @@ def read_curve(c: Any, dim: int, p0: float, p1: float) -> _CurveEval | None:
     Lines (``Line2d``/``Line``: ``P + p D`` from ``Location``/``Direction``; a ``Line2dSegment`` /
     ``LineSegment``: affine through its values at p0 and p1), circles and arcs (``O + R (cos p X +
     sin p Y)`` from ``Location``/``Center``, ``Radius``, ``XAxis``, ``YAxis``), B-splines and
-    Béziers (:class:`ght_cad.nurbs.NurbsCurve` from ``getPoles``, ``getWeights``,
+    Béziers (:class:`ght_cad.surfaces.nurbs.NurbsCurve` from ``getPoles``, ``getWeights``,
     ``getKnots``/``getMultiplicities``, ``Degree``; a periodic B-spline, e.g. a drilled hole's
     pcurve, from a ``setNotPeriodic`` copy: the same curve on clamped knots, checked like the
     others), with exact first derivatives. Other kinds: None.
@@ -175,7 +175,7 @@ class FreeCADSurface(SurfaceAdapter):
     ``kind`` from the surface's Python type, ``radius`` (``Radius``) and ``semi_angle``
     (``SemiAngle``) for cylinders and cones, ``ruled_hint`` for B-spline/Bézier surfaces of degree
     1 with 2 poles across. Non-periodic B-spline and Bézier surfaces are read once into the core's
-    vectorized evaluator (:func:`read_surface`, :class:`ght_cad.nurbs.NurbsSurface`) when it
+    vectorized evaluator (:func:`read_surface`, :class:`ght_cad.surfaces.nurbs.NurbsSurface`) when it
     agrees with FreeCAD's ``value``/``getDN`` at four points to 1e-12 of the size (derivatives
     relative to their own size); planes, cylinders and cones are evaluated in numpy by OCCT's
     formulas (:func:`ght_cad.face_unroll.analytic_jet`) from their placement (``Center`` or
@@ -492,7 +492,7 @@ def surface_of_source(obj: Any) -> Any:
 
 def _planar_edge(f: Callable[[np.ndarray], np.ndarray], tol: float) -> "Part.Edge":
     """Edge of the planar curve ``f(t)`` (t ∈ [0, 1], 2-D points), exact end points."""
-    from ght_cad.bspline import fit_function
+    from ght_cad.surfaces.bspline import fit_function
 
     p0, p1 = f(np.array([0.0]))[0], f(np.array([1.0]))[0]
     t = np.linspace(0.0, 1.0, 65)

@@ -2,7 +2,7 @@ r"""GHT-Bézier curve feature: ``P(t) = Σ_{i=0..m} b_{i,m}(t; μ, ν, γ) P_i``
 
 Control points come from a list (``ControlPoints``) or from linked geometry (``Source``: selected
 vertices, a sketch's points or any shape's vertices, in order). The core evaluates the curve and
-``ght_cad.bspline.curve_to_bspline`` turns it into B-spline data within ``Tolerance``; that data
+``ght_cad.surfaces.bspline.curve_to_bspline`` turns it into B-spline data within ``Tolerance``; that data
 becomes a ``Part.BSplineCurve``.
 """
 

@@ -187,7 +187,7 @@ class PlateFeature(FeatureProxy):
 
     def compute(self, obj: Any) -> None:
         from ght_cad.plate import plate_bspline, plate_volume
-        from ght_cad.ruled import RuledSurface
+        from ght_cad.surfaces.ruled import RuledSurface
         from ght_cad.sheet import check_offset
 
         from .joined_developable import core_frame

@@ -12,7 +12,7 @@ from ...core._vec import cross as _cross
 from ...core._quadrature import gauss_legendre
 from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
-from ...ruled import RuledSurface
+from ...surfaces.ruled import RuledSurface
 from .base import CurveParameterJets, FAIRNESS_MEASURES, PopulationBasis, Problem, SHAPE_NAMES, _split, population_basis
 
 
@@ -247,7 +247,7 @@ class EnvelopeStrip(RuledSurface):
         self.dual, self.E = dual, E
 
     def _end(self, u: Any, derivative: int, E: np.ndarray) -> np.ndarray:
-        from ...planes import meet
+        from ...surfaces.planes import meet
 
         if derivative not in (0, 1):
             raise GHTError(f"derivative={derivative} is not available here; EnvelopeStrip gives orders 0 and 1")
@@ -295,7 +295,7 @@ class DualCurveFairnessProblem(FairnessProblem):
                  free: Sequence[str] | None = None, bounds: Mapping[str, tuple[float, float]] | None = None,
                  nodes: int = 64, mu: float = 0.0, nu: float = 0.0, gamma: float = 0.0,
                  check_surface: bool = True) -> None:
-        from ...planes import check_control_planes, normalize_planes
+        from ...surfaces.planes import check_control_planes, normalize_planes
 
         U = check_control_planes(planes)
         self.raw_planes = U

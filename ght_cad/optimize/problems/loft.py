@@ -20,7 +20,7 @@ from ...loft.equation import MIN_FAN
 from ...loft.rails import _det, _jet
 from ...loft.surface import DevelopableLoft, LoftSegment
 from ...loft.tracing import _at_corner
-from ...ruled import regression_v
+from ...surfaces.ruled import regression_v
 from .base import CurveParameterJets, Problem
 
 
@@ -372,7 +372,7 @@ class _LoftJets:
 
     def regression(self, margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r"""``q = max(0, 1 - c/margin)²``, ``c = dist(v*, [0, 1])``, ``v* = -(c1·c2)/|c2|²``,
-        ``c1 = a_λ × g``, ``c2 = g_λ × g`` (:func:`ght_cad.ruled.regression_v`), its derivative at
+        ``c1 = a_λ × g``, ``c2 = g_λ × g`` (:func:`ght_cad.surfaces.ruled.regression_v`), its derivative at
         fixed λ (``dc/dv* = -1`` below 0, ``+1`` above 1) and ``q_λ`` (``c1_λ = a_λλ × g + a_λ × g_λ``,
         ``c2_λ = g_λλ × g``): q is only C¹ in λ, so the penalty's quadrature is differentiated
         node by node (moving nodes) rather than as the exact integral."""

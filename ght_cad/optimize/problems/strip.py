@@ -13,7 +13,7 @@ from ...curves.basis import bernstein
 from ...core._quadrature import gauss_legendre
 from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
-from ...ruled import CurvePairRuledSurface
+from ...surfaces.ruled import CurvePairRuledSurface
 from .base import CurveParameterJets, PopulationBasis, Problem, SHAPE_NAMES, _split
 
 
@@ -176,7 +176,7 @@ class StripProblem(Problem):
     r"""Problem 1: make the strip between two GHT boundary curves as developable as possible.
 
     The ruled surface ``X(u, v) = (1-v) A(u) + v B(u)`` pairs the two curves by their common
-    parameter (:class:`~ght_cad.ruled.CurvePairRuledSurface`). Parameters ``a.mu, a.nu, a.gamma``
+    parameter (:class:`~ght_cad.surfaces.ruled.CurvePairRuledSurface`). Parameters ``a.mu, a.nu, a.gamma``
     (curve A) and ``b.mu, b.nu, b.gamma`` (curve B). Objective (spec section 5):
 
     ``R = ∫_0^1 (1 - n_a·n_b) du``, ``n_a = A'×g/|A'×g|``, ``n_b = B'×g/|B'×g|``, ``g = B - A``,
@@ -290,7 +290,7 @@ class StripProblem(Problem):
         return a, b
 
     def build(self, x: Any) -> CurvePairRuledSurface:
-        """The strip :class:`~ght_cad.ruled.CurvePairRuledSurface` for free parameters ``x``."""
+        """The strip :class:`~ght_cad.surfaces.ruled.CurvePairRuledSurface` for free parameters ``x``."""
         return CurvePairRuledSurface(*self.curves(x))
 
     def report(self, x: Any) -> dict[str, float]:

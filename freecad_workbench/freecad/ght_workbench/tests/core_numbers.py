@@ -45,7 +45,7 @@ def _curve(out: dict[str, Any]) -> None:
 
 def _bspline(out: dict[str, Any]) -> None:
     from ght_cad import GHTCurve
-    from ght_cad.bspline import curve_to_bspline
+    from ght_cad.surfaces.bspline import curve_to_bspline
 
     c = GHTCurve(POINTS, 0.3, -0.2, 0.1)
     d = curve_to_bspline(c, tol=BSPLINE_TOL)

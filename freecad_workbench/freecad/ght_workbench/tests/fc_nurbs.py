@@ -1,10 +1,10 @@
-"""The FreeCAD adapter reads B-spline surfaces and curves into the core evaluator (:mod:`ght_cad.nurbs`).
+"""The FreeCAD adapter reads B-spline surfaces and curves into the core evaluator (:mod:`ght_cad.surfaces.nurbs`).
 
 Inside Debian's FreeCAD (headless):
 
 * a rational B-spline generalized cylinder (interior knot, weights equal across the rulings) with
   a hole cut by a boolean, the bench's polynomial tangent-developable B-spline, and a rational
-  Bézier quarter cylinder are read into :class:`ght_cad.nurbs.NurbsSurface` (``path == "nurbs"``),
+  Bézier quarter cylinder are read into :class:`ght_cad.surfaces.nurbs.NurbsSurface` (``path == "nurbs"``),
   their line/B-spline pcurves and 3-D curves into numpy (``_Edge.paths``); ``jet`` and
   ``density_grid`` match FreeCAD's own ``value``/``getDN`` to 1e-12 of the size; the flat
   outlines equal the old point-by-point path's to 1e-9 of the size (that path differentiates

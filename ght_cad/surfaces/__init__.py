@@ -1,0 +1,1 @@
+"""The surfaces layer (issue 27)."""
