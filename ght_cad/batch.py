@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from .core.errors import GHTError
+from .core.workers import _dask_client, _limit_threads, _one_line, _worker_threads
 
 __all__ = ["BatchJob", "BatchResult", "collect_jobs", "run_batch", "run_task", "MAX_ATTEMPTS", "batch_markdown",
            "map_step_faces", "preload_run_modules"]
@@ -112,10 +113,6 @@ class BatchResult:
                        for s in self.sweeps],
             "files": self.files,
         }
-
-
-def _one_line(exc: BaseException | str) -> str:
-    return " ".join(str(exc).split())
 
 
 def _folder_name(name: str) -> str:
@@ -319,24 +316,6 @@ def preload_run_modules() -> float:
     return time.perf_counter() - t0
 
 
-def _limit_threads(threads: int) -> None:
-    """Worker initializer: at most ``threads`` BLAS/OpenMP threads in this process.
-
-    numpy's and scipy's OpenBLAS and OCCT's OpenMP start one thread per core in every process;
-    ``n`` workers on as many cores would run ``n`` times too many (and OpenBLAS's idle threads spin),
-    so each worker gets ``max(1, cores // n)`` (:mod:`threadpoolctl` when installed; else unchanged).
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - threadpoolctl comes with scikit-learn (build123d)
-        return
-    threadpool_limits(threads)
-
-
-def _worker_threads(n: int) -> int:
-    return max(1, (os.cpu_count() or 1) // max(1, n))
-
-
 def _local(jobs: list[BatchJob], n: int, finish: Callable[[BatchJob, dict[str, Any] | None, int, str | None], None]) -> None:
     """Run ``jobs`` in ``n`` local processes; ``finish(job, result, attempts, death)`` per design."""
     import multiprocessing
@@ -428,19 +407,6 @@ def _dask(jobs: list[BatchJob], scheduler: str,
             finish(j, res, 1, None)
     finally:
         client.close()
-
-
-def _dask_client(scheduler: str) -> Any:
-    """A ``distributed.Client`` connected to ``scheduler`` (GHTError if dask is missing or it is unreachable)."""
-    try:
-        from distributed import Client
-    except ImportError:
-        raise GHTError("--scheduler needs dask.distributed; install it with pip install 'ght_cad[dask]'") from None
-    try:
-        return Client(scheduler, timeout="15s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise GHTError(f"cannot reach the Dask scheduler {scheduler!r}: {_one_line(exc)}; allowed: the address "
-                       "of a running scheduler, e.g. tcp://127.0.0.1:8786") from None
 
 
 def run_batch(
@@ -582,122 +548,14 @@ def batch_markdown(result: BatchResult) -> str:
 
 
 # ---------------------------------------------------------------------------------------------
-# faces of one STEP file in parallel (ght-cad unroll FILE.step --jobs / --scheduler)
-# ---------------------------------------------------------------------------------------------
-#: Faces of STEP files already read in this process, by (digest or path+mtime, unit). The caller
-#: fills it before forking its local workers, so they start with the faces in memory.
-_STEP_FACES: dict[tuple[str, str], list[Any]] = {}
 
 
-def _file_key(path: Path) -> str:
-    st = path.stat()
-    return f"{path.resolve()}:{st.st_size}:{st.st_mtime_ns}"
+def __getattr__(name: str) -> Any:
+    """``ght_cad.batch.map_step_faces``: moved to :func:`ght_cad.design.step_input.map_step_faces`
+    (issue 27: the STEP input no longer imports this module), still importable from here; imported
+    on first use, so ``import ght_cad.batch`` does not load the design package."""
+    if name == "map_step_faces":
+        from .design.step_input import map_step_faces
 
-
-def _portable(panels: list[Any]) -> list[Any]:
-    """The panels without what cannot leave the process (edge functions, development map over
-    an OCCT adaptor): their sampled outlines, marks, rulings and report are kept."""
-    for panel in panels:
-        panel.development = None
-        for loop in panel.loops:
-            for e in loop:
-                _ = e.xyz  # the 3-D samples travel, their function does not
-                e.flat_fn = e.xyz_fn = None
-    return panels
-
-
-def _step_faces_task(spec: dict[str, Any], data: bytes | None = None) -> list[tuple[Any, ...]]:
-    """Unroll some faces of one STEP file in a worker: per face ``("ok", panels, row)`` or
-    ``("error", exception)`` (the file is read once per process, :data:`_STEP_FACES`)."""
-    from .cad.unroll_faces import shape_faces
-    from .design.step_input import _read_step_in, unroll_step_face
-
-    key = (spec["key"], spec["unit"])
-    if key not in _STEP_FACES:
-        if data is not None:  # a Dask worker, maybe on another machine: the file came as bytes
-            with tempfile.TemporaryDirectory(prefix="ght-cad-step.") as tmp:
-                f = Path(tmp) / "input.step"
-                f.write_bytes(data)
-                shape, _, _ = _read_step_in(f, spec["unit"])
-        else:
-            shape, _, _ = _read_step_in(Path(spec["path"]), spec["unit"])
-        _STEP_FACES[key] = shape_faces(shape)
-    faces = _STEP_FACES[key]
-    out: list[tuple[Any, ...]] = []
-    for k in spec["faces"]:
-        try:
-            pans, row = unroll_step_face(Path(spec["path"]), faces[k - 1], k, spec["n"], **spec["fkw"])
-            out.append(("ok", _portable(pans), row))
-        except GHTError as exc:
-            out.append(("error", exc))
-    return out
-
-
-def map_step_faces(path: Path, all_faces: list[Any], chosen: Sequence[int], fkw: dict[str, Any], *,
-                   jobs: int | None = None, scheduler: str | None = None) -> list[tuple[list[Any], dict[str, Any]]]:
-    """:func:`ght_cad.design.step_input.unroll_step_face` of the ``chosen`` faces in parallel.
-
-    The faces are cut into about four chunks per worker, in face order. Local workers are forked
-    processes (``concurrent.futures``) that start with ``all_faces`` in memory; Dask workers get
-    the file's bytes once (``scatter``, broadcast) and read it once each. Results come back in
-    face order; the first face (in that order) that fails raises its error, as the serial loop
-    would.
-
-    Args:
-        path: the STEP file.
-        all_faces: its faces as read here (used by forked local workers).
-        chosen: 1-based face numbers.
-        fkw: ``best_effort``, ``tol_deg``, ``rulings``, ``unit``.
-        jobs: local processes (default: the machine's cores); ignored with ``scheduler``.
-        scheduler: Dask scheduler address.
-
-    Returns:
-        Per chosen face ``(panels, report row)``.
-
-    Raises:
-        GHTError: the first failing face's error, ``jobs < 1``, or an unreachable scheduler.
-    """
-    import hashlib
-
-    if jobs is None:
-        jobs = os.cpu_count() or 1
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise GHTError(f"jobs={jobs!r}; allowed: an integer >= 1")
-    chosen = list(chosen)
-    workers = jobs if scheduler is None else 8
-    size = max(1, -(-len(chosen) // (4 * workers)))
-    chunks = [chosen[i:i + size] for i in range(0, len(chosen), size)]
-    base = {"path": str(path), "unit": fkw["unit"], "n": len(all_faces), "fkw": dict(fkw)}
-    parts: list[list[tuple[Any, ...]]]
-    if scheduler is None:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
-        key = _file_key(Path(path))
-        _STEP_FACES[(key, fkw["unit"])] = all_faces
-        ctx = multiprocessing.get_context("fork" if sys.platform.startswith("linux") else None)
-        try:
-            workers = min(jobs, len(chunks))
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_limit_threads,
-                                     initargs=(_worker_threads(workers),)) as ex:
-                parts = list(ex.map(_step_faces_task, [{**base, "key": key, "faces": c} for c in chunks]))
-        finally:
-            _STEP_FACES.pop((key, fkw["unit"]), None)
-    else:
-        client = _dask_client(scheduler)
-        try:
-            data = Path(path).read_bytes()
-            key = hashlib.sha256(data).hexdigest()
-            remote = client.scatter(data, broadcast=True)
-            futs = [client.submit(_step_faces_task, {**base, "key": key, "faces": c}, remote, pure=False)
-                    for c in chunks]
-            parts = client.gather(futs)
-        finally:
-            client.close()
-    results = []
-    for part in parts:
-        for item in part:
-            if item[0] == "error":
-                raise item[1]
-            results.append((item[1], item[2]))
-    return results
+        return map_step_faces
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -69,8 +69,6 @@ KNOWN_CYCLES = [
     {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.join_panels"},
     # FreeCAD workbench: the Flat pattern feature and the sheet-skin reader use each other
     {"ght_workbench.flat_pattern", "ght_workbench.sheet_skin"},
-    # the application: batch runs designs, design files read STEP through batch's helpers
-    {"ght_cad.batch", "ght_cad.design", "ght_cad.design.step_input"},
 ]
 
 

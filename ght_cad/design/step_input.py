@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 import os
+import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -14,6 +16,7 @@ import numpy as np
 
 from ..core.errors import GHTError
 from ..core._validate import is_real
+from ..core.workers import _dask_client, _limit_threads, _worker_threads
 from .schema import DesignError
 
 
@@ -236,7 +239,7 @@ def unroll_step(
             needs such a plate.
         jobs: local worker processes for the faces (1: in this process); with ``scheduler``,
             the faces go to that ``dask.distributed`` cluster instead
-            (:func:`ght_cad.batch.map_step_faces`). The panels are identical to the serial ones;
+            (:func:`map_step_faces`). The panels are identical to the serial ones;
             those computed elsewhere carry no development map (``panel.map`` raises).
         scheduler: address of a Dask scheduler (``tcp://host:port``).
 
@@ -296,8 +299,6 @@ def unroll_step(
     if (jobs == 1 or len(chosen) < 2) and scheduler is None:
         results = [unroll_step_face(p, all_faces[k - 1], k, n, **{**fkw, "sheet": face_sheets[k]}) for k in chosen]
     else:
-        from ..batch import map_step_faces
-
         by_face: dict[int, Any] = {}
         for sh in dict.fromkeys(face_sheets.values()):  # the faces of one sheet together
             group = [k for k in chosen if face_sheets[k] == sh]
@@ -496,3 +497,123 @@ def _face_type_name(face: Any) -> str:
     t = BRepAdaptor_Surface(face).GetType()
     name = getattr(t, "name", str(t))
     return name.replace("GeomAbs_", "").lower()
+
+
+# faces of one STEP file in parallel (ght-cad unroll FILE.step --jobs / --scheduler)
+# ---------------------------------------------------------------------------------------------
+#: Faces of STEP files already read in this process, by (digest or path+mtime, unit). The caller
+#: fills it before forking its local workers, so they start with the faces in memory.
+_STEP_FACES: dict[tuple[str, str], list[Any]] = {}
+
+
+def _file_key(path: Path) -> str:
+    st = path.stat()
+    return f"{path.resolve()}:{st.st_size}:{st.st_mtime_ns}"
+
+
+def _portable(panels: list[Any]) -> list[Any]:
+    """The panels without what cannot leave the process (edge functions, development map over
+    an OCCT adaptor): their sampled outlines, marks, rulings and report are kept."""
+    for panel in panels:
+        panel.development = None
+        for loop in panel.loops:
+            for e in loop:
+                _ = e.xyz  # the 3-D samples travel, their function does not
+                e.flat_fn = e.xyz_fn = None
+    return panels
+
+
+def _step_faces_task(spec: dict[str, Any], data: bytes | None = None) -> list[tuple[Any, ...]]:
+    """Unroll some faces of one STEP file in a worker: per face ``("ok", panels, row)`` or
+    ``("error", exception)`` (the file is read once per process, :data:`_STEP_FACES`)."""
+    from ..cad.unroll_faces import shape_faces
+
+    key = (spec["key"], spec["unit"])
+    if key not in _STEP_FACES:
+        if data is not None:  # a Dask worker, maybe on another machine: the file came as bytes
+            with tempfile.TemporaryDirectory(prefix="ght-cad-step.") as tmp:
+                f = Path(tmp) / "input.step"
+                f.write_bytes(data)
+                shape, _, _ = _read_step_in(f, spec["unit"])
+        else:
+            shape, _, _ = _read_step_in(Path(spec["path"]), spec["unit"])
+        _STEP_FACES[key] = shape_faces(shape)
+    faces = _STEP_FACES[key]
+    out: list[tuple[Any, ...]] = []
+    for k in spec["faces"]:
+        try:
+            pans, row = unroll_step_face(Path(spec["path"]), faces[k - 1], k, spec["n"], **spec["fkw"])
+            out.append(("ok", _portable(pans), row))
+        except GHTError as exc:
+            out.append(("error", exc))
+    return out
+
+
+def map_step_faces(path: Path, all_faces: list[Any], chosen: Sequence[int], fkw: dict[str, Any], *,
+                   jobs: int | None = None, scheduler: str | None = None) -> list[tuple[list[Any], dict[str, Any]]]:
+    """:func:`unroll_step_face` of the ``chosen`` faces in parallel.
+
+    The faces are cut into about four chunks per worker, in face order. Local workers are forked
+    processes (``concurrent.futures``) that start with ``all_faces`` in memory; Dask workers get
+    the file's bytes once (``scatter``, broadcast) and read it once each. Results come back in
+    face order; the first face (in that order) that fails raises its error, as the serial loop
+    would.
+
+    Args:
+        path: the STEP file.
+        all_faces: its faces as read here (used by forked local workers).
+        chosen: 1-based face numbers.
+        fkw: ``best_effort``, ``tol_deg``, ``rulings``, ``unit``.
+        jobs: local processes (default: the machine's cores); ignored with ``scheduler``.
+        scheduler: Dask scheduler address.
+
+    Returns:
+        Per chosen face ``(panels, report row)``.
+
+    Raises:
+        GHTError: the first failing face's error, ``jobs < 1``, or an unreachable scheduler.
+    """
+    import hashlib
+
+    if jobs is None:
+        jobs = os.cpu_count() or 1
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise GHTError(f"jobs={jobs!r}; allowed: an integer >= 1")
+    chosen = list(chosen)
+    workers = jobs if scheduler is None else 8
+    size = max(1, -(-len(chosen) // (4 * workers)))
+    chunks = [chosen[i:i + size] for i in range(0, len(chosen), size)]
+    base = {"path": str(path), "unit": fkw["unit"], "n": len(all_faces), "fkw": dict(fkw)}
+    parts: list[list[tuple[Any, ...]]]
+    if scheduler is None:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        key = _file_key(Path(path))
+        _STEP_FACES[(key, fkw["unit"])] = all_faces
+        ctx = multiprocessing.get_context("fork" if sys.platform.startswith("linux") else None)
+        try:
+            workers = min(jobs, len(chunks))
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_limit_threads,
+                                     initargs=(_worker_threads(workers),)) as ex:
+                parts = list(ex.map(_step_faces_task, [{**base, "key": key, "faces": c} for c in chunks]))
+        finally:
+            _STEP_FACES.pop((key, fkw["unit"]), None)
+    else:
+        client = _dask_client(scheduler)
+        try:
+            data = Path(path).read_bytes()
+            key = hashlib.sha256(data).hexdigest()
+            remote = client.scatter(data, broadcast=True)
+            futs = [client.submit(_step_faces_task, {**base, "key": key, "faces": c}, remote, pure=False)
+                    for c in chunks]
+            parts = client.gather(futs)
+        finally:
+            client.close()
+    results = []
+    for part in parts:
+        for item in part:
+            if item[0] == "error":
+                raise item[1]
+            results.append((item[1], item[2]))
+    return results
