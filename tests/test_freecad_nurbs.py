@@ -21,10 +21,11 @@ CASES = ("rational_cylinder", "drilled_rational_cylinder", "tangent_dev_bspline"
 @pytest.fixture(scope="module")
 def fc_out(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("fc_nurbs")
-    text = run_fc_unittest("freecad.ght_workbench.tests.fc_nurbs", out, 8, timeout=300)
+    text = run_fc_unittest("freecad.ght_workbench.tests.fc_nurbs", out, 9, timeout=300)
     for name in ("test_rational_bspline_cylinder_reads_into_core", "test_periodic_bspline_surface_stays_on_freecad",
                  "test_plane_cylinder_cone_evaluated_in_numpy",
-                 "test_disagreeing_reading_falls_back_to_freecad", "test_flat_pattern_feature_uses_the_core_evaluator"):
+                 "test_disagreeing_reading_falls_back_to_freecad", "test_flat_pattern_feature_uses_the_core_evaluator",
+                 "test_face_reader_names_resolve_from_flat_pattern"):
         assert name in text, f"{name} did not run"
     return out
 

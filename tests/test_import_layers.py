@@ -67,8 +67,6 @@ ALLOWED_UPWARD = {
 KNOWN_CYCLES = [
     # unrolling: the ruled unroll, the sheet, the flat pattern, the face unroll and the panel joiner
     {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.join_panels"},
-    # FreeCAD workbench: the Flat pattern feature and the sheet-skin reader use each other
-    {"ght_workbench.flat_pattern", "ght_workbench.sheet_skin"},
 ]
 
 

@@ -17,7 +17,7 @@ faces are sorted into the sheet's two skins and its walls, as the OCP adapter do
   (tangent within 1e-3 degrees, else a sharp edge is refused), exactly two connected skins.
 
 The smaller skin (or the one holding the base face) becomes a :class:`ght_cad.blank.SheetSkin`
-whose faces are :func:`.flat_pattern.face_data` with every edge named ``E<k>`` by its index in
+whose faces are :func:`.face_reader.face_data` with every edge named ``E<k>`` by its index in
 the solid's ``Edges``; faces are numbered by their index in the whole shape's ``Faces`` (1-based,
 the ``FaceN`` names FreeCAD shows).
 """
@@ -33,7 +33,7 @@ import Part  # noqa: F401  (FreeCAD's geometry: the shapes passed in are Part sh
 
 from ght_cad.blank import DIST_TOL, BlankError, SheetSkin, SkinFace, classify_skin
 
-from .flat_pattern import face_data
+from .face_reader import face_data
 
 __all__ = ["sheet_skins", "shape_of_source"]
 

@@ -35,7 +35,7 @@ import numpy as np
 import FreeCAD as App
 import Part
 
-from freecad.ght_workbench import _base, flat_pattern
+from freecad.ght_workbench import _base, face_reader, flat_pattern
 from ght_cad.face_unroll import unroll_face_data
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
@@ -253,20 +253,20 @@ class NurbsAdapterTest(unittest.TestCase):
         same as the fast path's."""
         face = _rational_cylinder_face(hole=False)
         good = unroll_face_data(flat_pattern.face_data(face), **OPTS)
-        orig = flat_pattern.read_surface
+        orig = face_reader.read_surface  # where FreeCADSurface looks it up (issue 27 move)
 
         def bad(s):
             ns = orig(s)
             ns.cw[2, 1, :3] += 1e-9 * 100.0 * ns.cw[2, 1, 3]
             return type(ns)(ns.U, ns.V, ns.pu, ns.pv, ns.cw)
 
-        flat_pattern.read_surface = bad
+        face_reader.read_surface = bad
         try:
             surf = flat_pattern.FreeCADSurface(face)
             self.assertEqual(surf.path, "freecad")
             pat = unroll_face_data(flat_pattern.face_data(face), **OPTS)
         finally:
-            flat_pattern.read_surface = orig
+            face_reader.read_surface = orig
         self.assertEqual(flat_pattern.FreeCADSurface(face).path, "nurbs")
         self.assertLessEqual(_outline_distance(_outline(pat), _outline(good)), 1e-9 * _size(good))
 
@@ -283,6 +283,17 @@ class NurbsAdapterTest(unittest.TestCase):
             self.assertAlmostEqual(fp.Shape.Faces[0].Area / direct.area, 1.0, delta=1e-6)
         finally:
             App.closeDocument(doc.Name)
+
+    def test_face_reader_names_resolve_from_flat_pattern(self):
+        """The face reader moved from flat_pattern to face_reader (issue 27, the cycle flat_pattern <->
+        sheet_skin): every moved name is still an attribute of flat_pattern, the same object."""
+        from freecad.ght_workbench import sheet_skin
+
+        for name in ("face_data", "FreeCADSurface", "read_surface", "read_curve", "_Edge", "_CurveEval", "_placement",
+                     "_vec", "_KINDS"):
+            self.assertIs(getattr(flat_pattern, name), getattr(face_reader, name), name)
+        self.assertIs(sheet_skin.face_data, face_reader.face_data)
+        self.assertEqual(face_reader.face_data.__module__, face_reader.__name__)
 
 
 if __name__ == "__main__":
