@@ -90,7 +90,7 @@ _LAZY: dict[str, str] = {
 #: as an attribute of this package it is imported on first use, like the names of :data:`_LAZY`.
 _MOVED: dict[str, str] = {
     **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
-                                        "progress", "step_guard", "_kernel")},
+                                        "progress", "step_guard", "_kernel", "outdir")},
     **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
     **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
 }

@@ -1,7 +1,7 @@
 r"""``ght-cad approximate``: developable panels for a STEP face that is not developable (issue 24).
 
 Application layer: reads the face from a STEP file, runs :func:`ght_cad.approximate`, and writes
-one output folder (locked, staged and committed by :class:`ght_cad.outdir.OutputFolder`):
+one output folder (locked, staged and committed by :class:`ght_cad.core.outdir.OutputFolder`):
 
 * ``panels.step``: the panels as B-spline faces of degree 1 across the rulings, sewn into one
   shell (:func:`ght_cad.cad.approximate.panels_shell`);
@@ -71,7 +71,7 @@ def _json_default(o: Any) -> Any:
 def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str = "mm",
                   sheet: Any = None, target: Any = None) -> dict[str, Any]:
     """Write panels.step, flat.dxf, flat.svg, deviation.png, report.json and report.md into the
-    open :class:`ght_cad.outdir.OutputFolder` ``folder``; returns the report dict. With a sheet of
+    open :class:`ght_cad.core.outdir.OutputFolder` ``folder``; returns the report dict. With a sheet of
     T > 0 the STEP file holds one plate solid per panel and the flat patterns are the neutral
     surfaces (:func:`panel_plates`, :func:`panel_pattern`), ``side`` measured on the normal of the
     ``target`` (:func:`panel_sheets`; needed with a sheet)."""
@@ -110,7 +110,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     """``ght-cad approximate TARGET.step --tol T --out DIR``."""
     from .approximation import approximate
     from .cad.approximate import step_target
-    from .outdir import OutputFolder
+    from .core.outdir import OutputFolder
     from .sheet import make_sheet
 
     path = Path(args.target)

@@ -5,7 +5,7 @@ Every design goes through exactly the pipeline of ``ght-cad run``
 :class:`concurrent.futures.ProcessPoolExecutor`, or a ``dask.distributed`` worker on any machine)
 runs it into a private temporary folder and sends back the report and the bytes of every file;
 the calling process then writes them into ``DIR/<name>/`` through run's own staging
-(:class:`ght_cad.outdir.OutputFolder`: a locked target, a temporary folder beside it, moved in
+(:class:`ght_cad.core.outdir.OutputFolder`: a locked target, a temporary folder beside it, moved in
 only when complete), so local and remote runs write the same files in the same way and a worker that dies
 leaves nothing in ``DIR``. ``report.json`` and ``report.md`` are rewritten with ``out_dir`` naming
 the local folder. ``DIR/batch.json`` and ``DIR/batch.md`` (plus one ``sweep-<name>.png`` per
@@ -236,7 +236,7 @@ def _commit(target: Path, result: dict[str, Any]) -> None:
     import json
 
     from .design import FILE_NAMES, report_markdown
-    from .outdir import OutputFolder
+    from .core.outdir import OutputFolder
 
     report = dict(result["report"] or {})
     report["out_dir"] = str(target)
@@ -436,7 +436,7 @@ def run_batch(
         GHTError: no designs, ``jobs < 1``, ``chord_tol`` not > 0, ``out_dir`` is not a folder, an
             unreachable scheduler.
     """
-    from .outdir import StagedFiles
+    from .core.outdir import StagedFiles
     from .core.progress import Progress
 
     t0 = time.perf_counter()

@@ -194,7 +194,7 @@ def test_empty_out_is_refused(argv: list[str], tiny: Path, tmp_path: Path, capsy
 
 def test_empty_output_folder_refused_by_the_library(tmp_path: Path) -> None:
     from ght_cad.core.errors import GHTError
-    from ght_cad.outdir import OutputFolder, StagedFiles
+    from ght_cad.core.outdir import OutputFolder, StagedFiles
 
     with pytest.raises(GHTError, match="empty"):
         OutputFolder("")
@@ -207,7 +207,7 @@ def test_empty_output_folder_refused_by_the_library(tmp_path: Path) -> None:
 # ---------------------------------------------------------------------------------------------
 def test_without_fcntl_or_msvcrt_the_cli_says_so(tiny: Path, tmp_path: Path, capsys, monkeypatch) -> None:
     """A platform with neither lock call: exit 2 with one line saying so (not an ImportError, exit 1)."""
-    import ght_cad.outdir as od
+    import ght_cad.core.outdir as od
 
     monkeypatch.setattr(od, "fcntl", None)
     monkeypatch.setattr(od, "msvcrt", None)
@@ -217,10 +217,10 @@ def test_without_fcntl_or_msvcrt_the_cli_says_so(tiny: Path, tmp_path: Path, cap
 
 
 def test_outdir_imports_without_fcntl() -> None:
-    """``import ght_cad.outdir`` where ``fcntl`` does not exist (Windows) works."""
+    """``import ght_cad.core.outdir`` where ``fcntl`` does not exist (Windows) works."""
     import sys
 
-    code = "import sys; sys.modules['fcntl'] = None; import ght_cad.outdir as o; print(o.fcntl)"
+    code = "import sys; sys.modules['fcntl'] = None; import ght_cad.core.outdir as o; print(o.fcntl)"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and r.stdout.strip() == "None", r.stderr
 
@@ -245,7 +245,7 @@ class _FakeMsvcrt:
 def test_msvcrt_branch_locks(tiny: Path, tmp_path: Path, capsys, monkeypatch) -> None:
     """Without fcntl the msvcrt branch takes the locks (target and staging folder), and a second
     lock on the same target is refused as busy."""
-    import ght_cad.outdir as od
+    import ght_cad.core.outdir as od
 
     fake = _FakeMsvcrt()
     monkeypatch.setattr(od, "fcntl", None)

@@ -6,7 +6,7 @@ to a module. Each module has a layer, lowest first:
 
 =========  ====================================================================================
 core       ``ght_cad.core``: errors, validation, small vector kernels, quadrature, caches, atomic
-           files, progress, the STEP text guard, the kernel registry; and ``ght_cad.outdir``
+           files, output folders, progress, the STEP text guard, worker helpers, the kernel registry
 curves     ``ght_cad.curves``: seeds, basis, curves, continuity, composites, analysis, plotting
 surfaces   ``ght_cad.surfaces`` (planes, B-splines, NURBS, patches, ruled surfaces); developables,
            the loft, sheet, plate, unrolling, flat patterns
@@ -41,7 +41,7 @@ LAYERS = ("core", "curves", "surfaces", "optimize", "facade", "kernel", "app")
 
 _LAYER_OF = {
     # the layer packages of issue 27 are named after their layer; a few modules stay top-level
-    "core": ["core", "outdir"],
+    "core": ["core"],
     "curves": ["curves"],
     "surfaces": ["surfaces", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern",
                  "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],

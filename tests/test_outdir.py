@@ -1,4 +1,4 @@
-"""ght_cad.outdir: locks, staging folders that tell dead runs from live ones, manifests.
+"""ght_cad.core.outdir: locks, staging folders that tell dead runs from live ones, manifests.
 
 Other processes are real processes (``subprocess`` running a few lines of Python), killed with
 SIGKILL where a crash is the point: a flock must vanish with its process, and a later run must
@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from ght_cad.core.errors import GHTError
-from ght_cad.outdir import (
+from ght_cad.core.outdir import (
     MANIFEST_NAME,
     FolderBusy,
     OutputFolder,
@@ -49,7 +49,7 @@ def _wait_line(proc: subprocess.Popen, expect: str) -> str:
 
 HOLD = """
 import sys, time
-from ght_cad.outdir import OutputFolder
+from ght_cad.core.outdir import OutputFolder
 f = OutputFolder(sys.argv[1]).open()
 (f.path("model.step")).write_text("x")
 print("held", flush=True)
@@ -99,7 +99,7 @@ def test_wait_gets_the_folder_when_the_holder_finishes(tmp_path: Path) -> None:
     out = tmp_path / "out"
     holder = _python("""
         import sys, time
-        from ght_cad.outdir import OutputFolder
+        from ght_cad.core.outdir import OutputFolder
         with OutputFolder(sys.argv[1]) as f:
             f.path("first.txt").write_text("1")
             print("held", flush=True)
@@ -154,7 +154,7 @@ def test_dead_and_live_staging_folders(tmp_path: Path) -> None:
     # a run that was SIGKILLed after staging: lock free -> dead
     proc = _python("""
         import sys
-        from ght_cad.outdir import StagingDir
+        from ght_cad.core.outdir import StagingDir
         d = StagingDir(sys.argv[1], "out")
         print(d.path, flush=True)
         import time; time.sleep(60)

@@ -175,11 +175,11 @@ def _write_staged(outputs: Sequence[tuple[str, str | None, Callable[[Path], Any]
     """Write the requested outputs all or nothing; returns ``{kind: path}`` in the given order.
 
     Each ``(kind, target, writer)`` with a target calls ``writer(temporary path)``; the files are
-    staged beside their targets (:class:`ght_cad.outdir.StagedFiles`: locked targets, staging
+    staged beside their targets (:class:`ght_cad.core.outdir.StagedFiles`: locked targets, staging
     folders a later run can tell from a live one's) and moved into place only when every writer
     succeeded (a failure leaves no new file and every existing target as it was).
     """
-    from ..outdir import StagedFiles
+    from ..core.outdir import StagedFiles
 
     wanted = [(kind, Path(target), writer) for kind, target, writer in outputs if target]
     if not wanted:

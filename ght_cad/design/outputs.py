@@ -329,7 +329,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
     surface summary, curves and (with a surface) the ``flat_pattern`` entry of :func:`pattern_report`;
     ``.png``: rendered surface (or the curves when the design has no surface).
 
-    All or nothing (:class:`ght_cad.outdir.StagedFiles`): every target is locked against other
+    All or nothing (:class:`ght_cad.core.outdir.StagedFiles`): every target is locked against other
     ght-cad processes, every file is first written into a staging folder beside its target
     (which also proves the target's folder is writable) and the files are moved into place only
     when every one was written; a failure leaves every target as it was (existing files
@@ -363,7 +363,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
         for f in files:
             if f.suffix.lower() in (".dxf", ".svg"):
                 raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
-    from ..outdir import StagedFiles
+    from ..core.outdir import StagedFiles
 
     with StagedFiles(files) as stage:  # locked targets, staging folders with pid + lock
         out: dict[str, str] = {}

@@ -4,7 +4,7 @@ curves → surface → optimization → measures → B-rep + STEP → flat patte
 computed into a staging folder beside the output folder and moved in only when every step
 succeeded, so a failure leaves the output folder untouched. The folder handling (lock, staging
 folders a later run can tell from a live one's, the manifest of one design per folder) is
-:class:`ght_cad.outdir.OutputFolder`.
+:class:`ght_cad.core.outdir.OutputFolder`.
 """
 
 from __future__ import annotations
@@ -132,7 +132,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     ``report.md``. File names: ``model.step``, ``flat_pattern.dxf``, ``flat_pattern.svg``,
     ``report.json``, ``report.md``, ``<figure>.png``.
 
-    The output folder holds one design (:class:`ght_cad.outdir.OutputFolder`): it is locked for
+    The output folder holds one design (:class:`ght_cad.core.outdir.OutputFolder`): it is locked for
     the whole run (a second run on it waits with ``wait`` or is refused), everything is computed
     into a staging folder beside ``out_dir`` and moved in only when every step has succeeded (a
     new ``out_dir`` appears by one rename); then the files the previous run listed in its
@@ -159,7 +159,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     """
     import sys
 
-    from ..outdir import OutputFolder
+    from ..core.outdir import OutputFolder
     from ..core.progress import progress_enabled
 
     t_start = time.perf_counter()

@@ -19,7 +19,7 @@ from . import _ensure_core  # noqa: F401
 from ._base import BaseCommand, failed, failed_input, register_command
 from ght_cad.core.errors import GHTError
 from ght_cad.core.io import atomic_path, write_text_atomic
-from ght_cad.outdir import lock_target
+from ght_cad.core.outdir import lock_target
 
 __all__ = [
     "export_step",
@@ -101,7 +101,7 @@ def export_step(objects: Sequence[Any], path: str | os.PathLike, *, check: bool 
         GHTError: nothing to export, an object without shape, a stale shape (:func:`stale_reason`:
             its or an input's last recompute failed, or changes are pending), or an invalid shape
             (when ``check``).
-        FolderBusy: another process is writing ``path`` (its lock, :func:`ght_cad.outdir.lock_target`).
+        FolderBusy: another process is writing ``path`` (its lock, :func:`ght_cad.core.outdir.lock_target`).
         OSError: the write failed; the target file is then untouched and no partial file is left.
 
     Returns:

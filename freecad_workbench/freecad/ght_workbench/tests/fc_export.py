@@ -185,18 +185,18 @@ class NamedStepExportTest(RefusalAssertions, unittest.TestCase):
 
     def test_a_file_another_process_writes_is_refused(self):
         """Two writers of one file: the second export is refused naming the file and the holder's
-        pid (the lock of :mod:`ght_cad.outdir`, which a ``ght-cad`` process takes too), the file
+        pid (the lock of :mod:`ght_cad.core.outdir`, which a ``ght-cad`` process takes too), the file
         stays as it was; once the lock is gone the export works and leaves no lock file."""
         import subprocess
         import sys
 
-        from ght_cad.outdir import FolderBusy, lock_path_for
+        from ght_cad.core.outdir import FolderBusy, lock_path_for
 
         folder = tempfile.mkdtemp(prefix="busy_", dir=OUT)
         paths = {ext: os.path.join(folder, "part" + ext) for ext in (".step", ".dxf", ".svg")}
         export.export_step([self.box], paths[".step"])
         original = open(paths[".step"], "rb").read()
-        code = ("import sys, time\nfrom ght_cad.outdir import lock_target\n"
+        code = ("import sys, time\nfrom ght_cad.core.outdir import lock_target\n"
                 "locks = [lock_target(p) for p in sys.argv[1:]]\nprint('held', flush=True)\ntime.sleep(60)\n")
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
         # FreeCAD's own Python interpreter (sys.executable is freecadcmd there)
