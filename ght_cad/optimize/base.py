@@ -6,10 +6,12 @@ Moved from :mod:`ght_cad.optimize.optimizers` (issue 27; every name stays import
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import time
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterator, TypedDict
 
 import numpy as np
 
@@ -396,6 +398,24 @@ class _Run:
             return "iteration budget max_iter reached"
         return None
 
+    def drive(self, steps: Iterator[None]) -> OptimizeResult:
+        """Run a population update rule to its stop and return the result.
+
+        ``steps`` is a generator: it evaluates the initial population before its first ``yield``
+        and makes one iteration (update, clip, :meth:`evaluate`) before each further ``yield``.
+        After every ``yield`` the history is recorded and the stopping rules are checked
+        (:meth:`record`, iteration 0 = the initial population); ``nit`` counts the iterations.
+        """
+        next(steps)
+        msg = self.record(0)
+        nit = 0
+        while msg is None:
+            next(steps)
+            nit += 1
+            msg = self.record(nit)
+        steps.close()
+        return self.result(nit, msg)
+
     def result(self, nit: int, message: str) -> OptimizeResult:
         return OptimizeResult(
             x=self.best_x.copy(),
@@ -435,3 +455,63 @@ _COMMON_ARGS = """
         GHTError: bad bounds, budget, seed, population size, ``x0`` outside the bounds, or an
             objective returning the wrong shape.
 """
+
+
+class _Options(TypedDict, total=False):
+    """The keyword options every optimizer takes, documented in ``_COMMON_ARGS``; an optimizer is
+    written ``f(fun, bounds, *, <own options>, **options: Unpack[_Options])`` under
+    :func:`_common_interface`, which gives it these as explicit keyword parameters."""
+
+    pop_size: int
+    max_iter: int | None
+    max_nfev: int | None
+    tol: float
+    patience: int
+    target: float | None
+    seed: Any
+    callback: Callable[[OptimizerState], Any] | None
+    x0: Any
+
+
+#: Defaults of :class:`_Options`, in signature order (``pop_size``: see :func:`_common_interface`).
+_OPTION_DEFAULTS: dict[str, Any] = {"pop_size": 30, "max_iter": None, "max_nfev": None, "tol": 0.0, "patience": 10,
+                                    "target": None, "seed": None, "callback": None, "x0": None}
+
+
+def _common_interface(pop_size: int = 30, args_doc: str = _COMMON_ARGS
+                      ) -> Callable[[Callable[..., OptimizeResult]], Callable[..., OptimizeResult]]:
+    """Decorator for an optimizer ``f(fun, bounds, *, <own options>, **options: Unpack[_Options])``.
+
+    The public function has the explicit signature ``(fun, bounds, *, pop_size=<pop_size>,
+    max_iter=None, max_nfev=None, tol=0.0, patience=10, target=None, seed=None, callback=None,
+    x0=None, <own options>)`` (``inspect.signature``, ``help``), receives every common option
+    (its default where not given) in ``**options``, so the body passes them on to :class:`_Run`,
+    and has ``args_doc`` appended to its docstring. A wrong argument is a TypeError naming the
+    function, as for a plain function.
+    """
+    def annotation(name: str) -> Any:
+        a = _Options.__annotations__[name]
+        return getattr(a, "__forward_arg__", a)  # the text, as in a signature under postponed annotations
+
+    def decorate(f: Callable[..., OptimizeResult]) -> Callable[..., OptimizeResult]:
+        sig = inspect.signature(f)
+        own = [p for p in sig.parameters.values() if p.kind is not inspect.Parameter.VAR_KEYWORD]
+        common = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation(name),
+                                    default=pop_size if name == "pop_size" else default)
+                  for name, default in _OPTION_DEFAULTS.items()]
+        public = sig.replace(parameters=own[:2] + common + own[2:])
+
+        @functools.wraps(f)
+        def optimizer(*args: Any, **kwargs: Any) -> OptimizeResult:
+            try:
+                bound = public.bind(*args, **kwargs)
+            except TypeError as e:
+                raise TypeError(f"{f.__name__}() {e}") from None
+            bound.apply_defaults()
+            return f(*bound.args, **bound.kwargs)
+
+        optimizer.__signature__ = public  # type: ignore[attr-defined]
+        optimizer.__doc__ = (f.__doc__ or "") + args_doc
+        return optimizer
+
+    return decorate

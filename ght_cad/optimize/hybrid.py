@@ -7,14 +7,17 @@ Moved from :mod:`ght_cad.optimize.optimizers` (issue 27; every name stays import
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any, Callable, TYPE_CHECKING
 
 import numpy as np
 
 from ..core.errors import GHTError
-from .base import (_COMMON_ARGS, _FinishDone, _int_option, _Run, _Stop, DEFAULT_MAX_ITER, Objective, OptimizeResult,
-                   OptimizerState)
+from .base import (_COMMON_ARGS, _common_interface, _FinishDone, _int_option, _Options, _Run, _Stop, DEFAULT_MAX_ITER,
+                   Objective, OptimizeResult, OptimizerState)
 from .population import differential_evolution, gwo, igwo, pso
+
+if TYPE_CHECKING:
+    from typing import Unpack
 
 
 def _sobol(dim: int, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -98,23 +101,20 @@ def _next_start(pool_z: np.ndarray, pool_f: np.ndarray, avoid: list[np.ndarray],
     return None, math.inf
 
 
+@_common_interface(pop_size=32, args_doc=_COMMON_ARGS.replace(
+    "pop_size: number of agents (>= 4).",
+    "pop_size: Sobol' starts, or PSO/I-GWO agents (>= 4; default 32).").replace(
+    "max_iter: iteration budget (default 200 if ``max_nfev`` is not given either).",
+    "max_iter: L-BFGS-B iterations over all finishes (default 200 if ``max_nfev`` is not given either)."))
 def hybrid(
     fun: Objective,
     bounds: Any,
     *,
-    pop_size: int = 32,
-    max_iter: int | None = None,
-    max_nfev: int | None = None,
-    tol: float = 0.0,
-    patience: int = 10,
-    target: float | None = None,
-    seed: Any = None,
-    callback: Callable[[OptimizerState], Any] | None = None,
-    x0: Any = None,
     starts: str = "sobol",
     global_iter: int = 10,
     local_starts: int = 4,
     jac: Any = None,
+    **options: Unpack[_Options],
 ) -> OptimizeResult:
     r"""Space-filling starts, then bounded quasi-Newton finishes (spec section 8.1; the default method).
 
@@ -158,8 +158,8 @@ def hybrid(
     """
     from scipy import optimize as _so
 
-    run = _Run("hybrid", fun, bounds, pop_size=pop_size, max_iter=None, max_nfev=max_nfev,
-               per_agent=1, tol=tol, patience=patience, target=target, seed=seed, callback=callback, x0=x0)
+    max_iter, max_nfev, tol = options["max_iter"], options["max_nfev"], options["tol"]
+    run = _Run("hybrid", fun, bounds, per_agent=1, **{**options, "max_iter": None})
     starts_key = str(starts).lower().replace("-", "")
     if starts_key not in ("sobol", "pso", "igwo"):
         raise GHTError(f"starts={starts!r} is not allowed; use 'sobol', 'pso' or 'igwo'")
@@ -367,11 +367,6 @@ def hybrid(
     return res_
 
 
-hybrid.__doc__ = (hybrid.__doc__ or "") + _COMMON_ARGS.replace(
-    "pop_size: number of agents (>= 4).",
-    "pop_size: Sobol' starts, or PSO/I-GWO agents (>= 4; default 32).").replace(
-    "max_iter: iteration budget (default 200 if ``max_nfev`` is not given either).",
-    "max_iter: L-BFGS-B iterations over all finishes (default 200 if ``max_nfev`` is not given either).")
 #: Optimizers by name, for :func:`minimize`, the bench and the comparison table.
 METHODS: dict[str, Callable[..., OptimizeResult]] = {
     "hybrid": hybrid,

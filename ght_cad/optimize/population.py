@@ -7,33 +7,30 @@ the stopping rules and evaluation counts are stated in that module's docstring.
 from __future__ import annotations
 
 import inspect
+import itertools
 import math
-from typing import Any, Callable
+from typing import Any, Iterator, TYPE_CHECKING
 
 import numpy as np
 
 from ..core.errors import GHTError
-from .base import _COMMON_ARGS, _float_option, _Run, _Stop, Objective, OptimizeResult, OptimizerState
+from .base import _common_interface, _float_option, _Options, _Run, _Stop, Objective, OptimizeResult
+
+if TYPE_CHECKING:
+    from typing import Unpack
 
 
+@_common_interface()
 def pso(
     fun: Objective,
     bounds: Any,
     *,
-    pop_size: int = 30,
-    max_iter: int | None = None,
-    max_nfev: int | None = None,
-    tol: float = 0.0,
-    patience: int = 10,
-    target: float | None = None,
-    seed: Any = None,
-    callback: Callable[[OptimizerState], Any] | None = None,
-    x0: Any = None,
     w_start: float = 0.9,
     w_end: float = 0.4,
     c1: float = 2.0,
     c2: float = 2.0,
     v_max: float = 0.2,
+    **options: Unpack[_Options],
 ) -> OptimizeResult:
     """Particle swarm optimization (spec section 8).
 
@@ -42,39 +39,35 @@ def pso(
     ``w_start`` (0.9) at the first iteration to ``w_end`` (0.4) at the last; ``r1, r2 ~ U(0,1)``
     per component. Initial velocities are uniform in ``[-v_max (ub-lb), v_max (ub-lb)]``.
     """
-    run = _Run("pso", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               per_agent=1, tol=tol, patience=patience,
-               target=target, seed=seed, callback=callback, x0=x0)
+    run = _Run("pso", fun, bounds, per_agent=1, **options)
     rng, lb, ub = run.rng, run.lb, run.ub
     w_start, w_end = _float_option("w_start", w_start), _float_option("w_end", w_end)
     c1, c2 = _float_option("c1", c1), _float_option("c2", c2)
     vmax = _float_option("v_max", v_max, positive=True) * (ub - lb)
-    x = run.initial_population()
-    v = rng.uniform(-1.0, 1.0, x.shape) * vmax
-    fx = run.evaluate(x)
-    pbest, pf = x.copy(), fx.copy()
-    g = int(np.argmin(pf))
-    msg = run.record(0)
-    nit = 0
-    T = max(run.max_iter - 1, 1)
-    while msg is None:
-        w = w_start - (w_start - w_end) * nit / T
-        r1 = rng.random(x.shape)
-        r2 = rng.random(x.shape)
-        v = w * v + c1 * r1 * (pbest - x) + c2 * r2 * (pbest[g] - x)
-        np.clip(v, -vmax, vmax, out=v)
-        x = np.clip(x + v, lb, ub)
+
+    def steps() -> Iterator[None]:
+        x = run.initial_population()
+        v = rng.uniform(-1.0, 1.0, x.shape) * vmax
         fx = run.evaluate(x)
-        better = fx < pf
-        pbest[better] = x[better]
-        pf[better] = fx[better]
+        pbest, pf = x.copy(), fx.copy()
         g = int(np.argmin(pf))
-        nit += 1
-        msg = run.record(nit)
-    return run.result(nit, msg)
+        yield
+        T = max(run.max_iter - 1, 1)
+        for it in itertools.count():
+            w = w_start - (w_start - w_end) * it / T
+            r1 = rng.random(x.shape)
+            r2 = rng.random(x.shape)
+            v = w * v + c1 * r1 * (pbest - x) + c2 * r2 * (pbest[g] - x)
+            np.clip(v, -vmax, vmax, out=v)
+            x = np.clip(x + v, lb, ub)
+            fx = run.evaluate(x)
+            better = fx < pf
+            pbest[better] = x[better]
+            pf[better] = fx[better]
+            g = int(np.argmin(pf))
+            yield
 
-
-pso.__doc__ = (pso.__doc__ or "") + _COMMON_ARGS
+    return run.drive(steps())
 
 
 def _gwo_candidates(X: np.ndarray, leaders: np.ndarray, a: float, rng: np.random.Generator) -> np.ndarray:
@@ -93,51 +86,35 @@ def _gwo_candidates(X: np.ndarray, leaders: np.ndarray, a: float, rng: np.random
     return out
 
 
-def gwo(
-    fun: Objective,
-    bounds: Any,
-    *,
-    pop_size: int = 30,
-    max_iter: int | None = None,
-    max_nfev: int | None = None,
-    tol: float = 0.0,
-    patience: int = 10,
-    target: float | None = None,
-    seed: Any = None,
-    callback: Callable[[OptimizerState], Any] | None = None,
-    x0: Any = None,
-) -> OptimizeResult:
+@_common_interface()
+def gwo(fun: Objective, bounds: Any, **options: Unpack[_Options]) -> OptimizeResult:
     """Grey wolf optimizer (spec section 8).
 
     Leaders α, β, δ are the three best positions found so far; ``a = 2 - 2 it / max_iter``; for
     each leader ``A = 2a r1 - a``, ``C = 2 r2``, ``D = |C X_L - X|``, ``X_L* = X_L - A D``; every
     wolf moves to ``X_GWO = (X_α* + X_β* + X_δ*) / 3``, clipped to the box.
     """
-    run = _Run("gwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               per_agent=1, tol=tol, patience=patience,
-               target=target, seed=seed, callback=callback, x0=x0)
+    run = _Run("gwo", fun, bounds, per_agent=1, **options)
     rng, lb, ub = run.rng, run.lb, run.ub
-    X = run.initial_population()
-    fX = run.evaluate(X)
-    order = np.argsort(fX, kind="stable")[:3]
-    lead_x, lead_f = X[order].copy(), fX[order].copy()
-    msg = run.record(0)
-    nit = 0
-    T = max(run.max_iter, 1)
-    while msg is None:
-        a = 2.0 - 2.0 * nit / T
-        X = np.clip(_gwo_candidates(X, lead_x, a, rng), lb, ub)
+
+    def steps() -> Iterator[None]:
+        X = run.initial_population()
         fX = run.evaluate(X)
-        allf = np.concatenate([lead_f, fX])
-        allx = np.concatenate([lead_x, X])
-        order = np.argsort(allf, kind="stable")[:3]
-        lead_x, lead_f = allx[order].copy(), allf[order].copy()
-        nit += 1
-        msg = run.record(nit)
-    return run.result(nit, msg)
+        order = np.argsort(fX, kind="stable")[:3]
+        lead_x, lead_f = X[order].copy(), fX[order].copy()
+        yield
+        T = max(run.max_iter, 1)
+        for it in itertools.count():
+            a = 2.0 - 2.0 * it / T
+            X = np.clip(_gwo_candidates(X, lead_x, a, rng), lb, ub)
+            fX = run.evaluate(X)
+            allf = np.concatenate([lead_f, fX])
+            allx = np.concatenate([lead_x, X])
+            order = np.argsort(allf, kind="stable")[:3]
+            lead_x, lead_f = allx[order].copy(), allf[order].copy()
+            yield
 
-
-gwo.__doc__ = (gwo.__doc__ or "") + _COMMON_ARGS
+    return run.drive(steps())
 
 
 def _midpoint_bounds(Y: np.ndarray, X_old: np.ndarray, lb: np.ndarray, ub: np.ndarray) -> np.ndarray:
@@ -146,20 +123,8 @@ def _midpoint_bounds(Y: np.ndarray, X_old: np.ndarray, lb: np.ndarray, ub: np.nd
     return np.where(Y > ub, 0.5 * (X_old + ub), Y)
 
 
-def igwo(
-    fun: Objective,
-    bounds: Any,
-    *,
-    pop_size: int = 30,
-    max_iter: int | None = None,
-    max_nfev: int | None = None,
-    tol: float = 0.0,
-    patience: int = 10,
-    target: float | None = None,
-    seed: Any = None,
-    callback: Callable[[OptimizerState], Any] | None = None,
-    x0: Any = None,
-) -> OptimizeResult:
+@_common_interface()
+def igwo(fun: Objective, bounds: Any, **options: Unpack[_Options]) -> OptimizeResult:
     r"""Improved grey wolf optimizer with dimension-learning-based hunting (spec section 8).
 
     Per iteration, with α, β, δ the three best wolves of the population (each wolf holds the
@@ -175,75 +140,64 @@ def igwo(
     5. both candidate sets are evaluated (one call of 2·pop points: ``X_GWO`` and ``X_DLH``, never
        ``X_GWO`` twice); the better candidate replaces ``X_i`` only if it improves on it.
     """
-    run = _Run("igwo", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               per_agent=2, tol=tol,
-               patience=patience, target=target, seed=seed, callback=callback, x0=x0)
+    run = _Run("igwo", fun, bounds, per_agent=2, **options)
     rng, lb, ub = run.rng, run.lb, run.ub
     N, D = run.pop, run.dim
-    X = run.initial_population()
-    fX = run.evaluate(X)
-    msg = run.record(0)
-    nit = 0
-    T = max(run.max_iter, 1)
-    rows = np.arange(N)[:, None]
-    while msg is None:
-        a = 2.0 - 2.0 * nit / T
-        leaders = X[np.argsort(fX, kind="stable")[:3]]
-        Xg = _midpoint_bounds(_gwo_candidates(X, leaders, a, rng), X, lb, ub)
-        # dimension-learning-based hunting
-        radius = np.sqrt(np.sum((X - Xg) ** 2, axis=1))
-        u = rng.random((N, D))
-        nb = np.empty((N, D), dtype=np.intp)
-        # rows in chunks: memory O(chunk * N * D), never a pop x pop x dim array
-        chunk = max(1, min(N, (1 << 21) // max(N * D, 1)))
-        for r0 in range(0, N, chunk):
-            r1 = min(N, r0 + chunk)
-            diff = X[r0:r1, None, :] - X[None, :, :]
-            dist = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
-            mask = dist <= radius[r0:r1, None]
-            mask[np.arange(r1 - r0), np.arange(r0, r1)] = True  # a wolf is always its own neighbour
-            count = mask.sum(axis=1)
-            # k-th True entry of row i, k drawn uniformly per dimension: stable argsort puts True first
-            members = np.argsort(~mask, axis=1, kind="stable")
-            k = np.minimum((u[r0:r1] * count[:, None]).astype(np.intp), count[:, None] - 1)
-            nb[r0:r1] = members[rows[: r1 - r0], k]
-        rw = rng.permutation(N)  # one random wolf per i (a permutation, as in the reference code)
-        cols = np.arange(D)[None, :]
-        Xd = X + rng.random((N, D)) * (X[nb, cols] - X[rw])
-        Xd = _midpoint_bounds(Xd, X, lb, ub)
-        f_both = run.evaluate(np.concatenate([Xg, Xd]))
-        fg, fd = f_both[:N], f_both[N:]
-        use_g = fg < fd
-        cand = np.where(use_g[:, None], Xg, Xd)
-        fc = np.where(use_g, fg, fd)
-        better = fc < fX
-        X[better] = cand[better]
-        fX[better] = fc[better]
-        nit += 1
-        msg = run.record(nit)
-    return run.result(nit, msg)
+
+    def steps() -> Iterator[None]:
+        X = run.initial_population()
+        fX = run.evaluate(X)
+        yield
+        T = max(run.max_iter, 1)
+        rows = np.arange(N)[:, None]
+        for it in itertools.count():
+            a = 2.0 - 2.0 * it / T
+            leaders = X[np.argsort(fX, kind="stable")[:3]]
+            Xg = _midpoint_bounds(_gwo_candidates(X, leaders, a, rng), X, lb, ub)
+            # dimension-learning-based hunting
+            radius = np.sqrt(np.sum((X - Xg) ** 2, axis=1))
+            u = rng.random((N, D))
+            nb = np.empty((N, D), dtype=np.intp)
+            # rows in chunks: memory O(chunk * N * D), never a pop x pop x dim array
+            chunk = max(1, min(N, (1 << 21) // max(N * D, 1)))
+            for r0 in range(0, N, chunk):
+                r1 = min(N, r0 + chunk)
+                diff = X[r0:r1, None, :] - X[None, :, :]
+                dist = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+                mask = dist <= radius[r0:r1, None]
+                mask[np.arange(r1 - r0), np.arange(r0, r1)] = True  # a wolf is always its own neighbour
+                count = mask.sum(axis=1)
+                # k-th True entry of row i, k drawn uniformly per dimension: stable argsort puts True first
+                members = np.argsort(~mask, axis=1, kind="stable")
+                k = np.minimum((u[r0:r1] * count[:, None]).astype(np.intp), count[:, None] - 1)
+                nb[r0:r1] = members[rows[: r1 - r0], k]
+            rw = rng.permutation(N)  # one random wolf per i (a permutation, as in the reference code)
+            cols = np.arange(D)[None, :]
+            Xd = X + rng.random((N, D)) * (X[nb, cols] - X[rw])
+            Xd = _midpoint_bounds(Xd, X, lb, ub)
+            f_both = run.evaluate(np.concatenate([Xg, Xd]))
+            fg, fd = f_both[:N], f_both[N:]
+            use_g = fg < fd
+            cand = np.where(use_g[:, None], Xg, Xd)
+            fc = np.where(use_g, fg, fd)
+            better = fc < fX
+            X[better] = cand[better]
+            fX[better] = fc[better]
+            yield
+
+    return run.drive(steps())
 
 
-igwo.__doc__ = (igwo.__doc__ or "") + _COMMON_ARGS
-
-
+@_common_interface()
 def differential_evolution(
     fun: Objective,
     bounds: Any,
     *,
-    pop_size: int = 30,
-    max_iter: int | None = None,
-    max_nfev: int | None = None,
-    tol: float = 0.0,
-    patience: int = 10,
-    target: float | None = None,
-    seed: Any = None,
-    callback: Callable[[OptimizerState], Any] | None = None,
-    x0: Any = None,
     strategy: str = "best1bin",
     mutation: float | tuple[float, float] = (0.5, 1.0),
     recombination: float = 0.7,
     polish: bool = False,
+    **options: Unpack[_Options],
 ) -> OptimizeResult:
     """Baseline: ``scipy.optimize.differential_evolution`` with the same interface and result.
 
@@ -257,9 +211,7 @@ def differential_evolution(
     """
     from scipy import optimize as _so
 
-    run = _Run("de", fun, bounds, pop_size=pop_size, max_iter=max_iter, max_nfev=max_nfev,
-               per_agent=1, tol=tol, patience=patience,
-               target=target, seed=seed, callback=callback, x0=x0, min_pop=5)
+    run = _Run("de", fun, bounds, per_agent=1, min_pop=5, **options)
     init = run.initial_population()
     state = {"calls": 0, "msg": None}
 
@@ -319,6 +271,3 @@ def differential_evolution(
         run.hist_nfev.append(run.nfev)
         msg += "; L-BFGS-B polish"
     return run.result(nit, msg)
-
-
-differential_evolution.__doc__ = (differential_evolution.__doc__ or "") + _COMMON_ARGS
