@@ -35,30 +35,9 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tests"))
 
-
-def cone_design(name: str, h: float, k: float, z1: float, figures: str = '["flat_pattern"]') -> str:
-    """A quarter cone frustum design (apex height h, radius k (h - z), cut at z = 0 and z = z1)."""
-    return f"""name = "{name}"
-units = "mm"
-
-[surface]
-type = "planes"
-planes = [[{-k * h!r}, 1, 0, {k!r}], [{-k * h!r}, 1, 1, {k!r}], [{-k * h!r}, 0, 1, {k!r}]]
-boundary_planes = [[0, 0, 0, 1], [{-z1!r}, 0, 0, 1]]
-mu = 0.0
-nu = 0.0
-gamma = -1.0
-normalize = false
-
-[unroll]
-rulings = 8
-tol_deg = 0.001
-
-[outputs]
-files = ["step", "dxf", "svg", "json", "md"]
-figures = {figures}
-"""
+from cone_designs import cone_design  # noqa: E402  (shared with tests/test_batch.py)
 
 
 def many_faces_step(path: str | os.PathLike, n_faces: int) -> int:

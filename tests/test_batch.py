@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import os
 import signal
 import socket
@@ -25,6 +24,8 @@ import time
 from pathlib import Path
 
 import pytest
+
+from cone_designs import cone_area, cone_design
 
 from ght_cad.batch import run_batch
 from ght_cad.cli import main
@@ -37,33 +38,6 @@ FILES = ["flat_pattern.dxf", "flat_pattern.png", "flat_pattern.svg", "model.step
 CONES = [(800.0, 0.5, 400.0), (800.0, 0.25, 400.0), (600.0, 0.5, 300.0), (1000.0, 0.4, 250.0),
          (500.0, 1.0, 100.0), (900.0, 0.3, 600.0), (700.0, 0.6, 350.0), (1200.0, 0.2, 200.0),
          (400.0, 0.75, 150.0), (650.0, 0.45, 500.0), (850.0, 0.35, 425.0), (300.0, 1.5, 120.0)]
-
-
-def cone_design(name: str, h: float, k: float, z1: float) -> str:
-    return f"""name = "{name}"
-units = "mm"
-
-[surface]
-type = "planes"
-planes = [[{-k * h!r}, 1, 0, {k!r}], [{-k * h!r}, 1, 1, {k!r}], [{-k * h!r}, 0, 1, {k!r}]]
-boundary_planes = [[0, 0, 0, 1], [{-z1!r}, 0, 0, 1]]
-mu = 0.0
-nu = 0.0
-gamma = -1.0
-normalize = false
-
-[unroll]
-rulings = 8
-tol_deg = 0.001
-
-[outputs]
-files = ["step", "dxf", "svg", "json", "md"]
-figures = ["flat_pattern"]
-"""
-
-
-def cone_area(h: float, k: float, z1: float) -> float:
-    return math.pi / 4 * k * math.sqrt(1 + k * k) * (h * h - (h - z1) ** 2)
 
 
 @pytest.fixture(scope="module")
