@@ -8,14 +8,22 @@ one output folder (locked, staged and committed by :class:`ght_cad.core.outdir.O
 * ``flat.dxf`` / ``flat.svg``: every panel's flat pattern on one sheet, seams marked
   (:func:`ght_cad.unroll.unroll_composite`: matching marks ``E<k>`` on the two panels of a seam);
 * ``deviation.png``: the signed deviation of the panels from the target over its parameters;
-* ``report.json`` / ``report.md``: per panel max deviation out/in, θ_max, 3-D and flat area; the
-  panel count, the largest deviation and the files.
+* ``report.json`` / ``report.md``: per panel max deviation out/in, θ_max, 3-D and flat area and the
+  method it got (loft or dual); the method asked for (``--method``), the panel count, the largest
+  deviation and the files.
+
+Progress: the core's steps (direction chosen, each march, the dual fits, each attempt's deviation)
+are printed to stderr as they happen, as ``ght-cad run`` prints its steps: only when stderr is a
+terminal (or ``GHT_CAD_PROGRESS=1``; :func:`ght_cad.core.progress.progress_enabled`) and not with
+``--no-progress``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
+import time
 from pathlib import Path
 from typing import Any, Callable
 
@@ -24,6 +32,7 @@ import numpy as np
 from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
                                  plot_deviation, report_markdown)
 from .core.errors import GHTError
+from .design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
 __all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
            "panel_pattern", "panel_plates"]
@@ -46,8 +55,13 @@ def add_parser(sub: Any, common: Callable[[argparse.ArgumentParser], None], epil
     sp.add_argument("--tol", type=float, required=True, metavar="T", help="largest deviation, both ways (model units)")
     sp.add_argument("--out", required=True, metavar="DIR", help="output folder")
     sp.add_argument("--max-panels", type=int, default=64, metavar="N", help="largest panel count accepted (default 64)")
-    sp.add_argument("--direction", choices=("auto", "u", "v"), default="auto",
+    sp.add_argument("--direction", choices=APPROX_DIRECTIONS, default="auto",
                     help="parameter the rulings run along (default auto: least normal curvature)")
+    sp.add_argument("--method", choices=APPROX_METHODS, default="auto",
+                    help="how each strip is fitted: auto (default: per strip the closer of the rails loft and the "
+                         "dual fit of the target's tangent planes), loft (rails lofts only) or dual (the dual fit "
+                         "wherever it is usable)")
+    sp.add_argument("--no-progress", action="store_true", help="no progress lines on stderr even on a terminal")
     sp.add_argument("--face", type=int, default=1, metavar="N", help="face number, 1-based in file order (default 1)")
     sp.add_argument("--thickness", type=float, metavar="T",
                     help="sheet thickness: panels.step holds one plate solid per panel and the flat patterns are "
@@ -69,12 +83,13 @@ def _json_default(o: Any) -> Any:
 
 
 def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str = "mm",
-                  sheet: Any = None, target: Any = None) -> dict[str, Any]:
+                  sheet: Any = None, target: Any = None, method: str = "auto") -> dict[str, Any]:
     """Write panels.step, flat.dxf, flat.svg, deviation.png, report.json and report.md into the
     open :class:`ght_cad.core.outdir.OutputFolder` ``folder``; returns the report dict. With a sheet of
     T > 0 the STEP file holds one plate solid per panel and the flat patterns are the neutral
     surfaces (:func:`panel_plates`, :func:`panel_pattern`), ``side`` measured on the normal of the
-    ``target`` (:func:`panel_sheets`; needed with a sheet)."""
+    ``target`` (:func:`panel_sheets`; needed with a sheet); ``method``: the one asked for, recorded
+    in the report."""
     from .cad.approximate import panels_shell
     from .cad.occ import write_step
     from .core.io import atomic_write
@@ -91,7 +106,7 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     pattern.export_dxf(folder.path("flat.dxf"))
     pattern.export_svg(folder.path("flat.svg"))
     plot_deviation(result, folder.path("deviation.png"), title=None)
-    report = approximation_report(result, pattern, name=name)
+    report = approximation_report(result, pattern, name=name, method=method)
     if sheet is not None:
         report["sheet"] = sheet.as_dict()
         if not sheet.is_zero:
@@ -106,11 +121,27 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     return report
 
 
+def _progress_lines(args: argparse.Namespace) -> Callable[[str], None] | None:
+    """The core's ``progress`` callback: each line to stderr with the elapsed time, ``ght-cad run``'s
+    convention (a terminal or ``GHT_CAD_PROGRESS=1``, not ``--no-progress``); None otherwise."""
+    from .core.progress import progress_enabled
+
+    if getattr(args, "no_progress", False) or not progress_enabled():
+        return None
+    t0 = time.perf_counter()
+
+    def say(line: str) -> None:
+        sys.stderr.write(f"approximate: {line.strip()} ({time.perf_counter() - t0:.1f} s)\n")
+        sys.stderr.flush()
+
+    return say
+
+
 def cmd_approximate(args: argparse.Namespace) -> int:
     """``ght-cad approximate TARGET.step --tol T --out DIR``."""
-    from .approximation import approximate
     from .cad.approximate import step_target
     from .core.outdir import OutputFolder
+    from .design.approximate import run_approximation
     from .sheet import make_sheet
 
     path = Path(args.target)
@@ -123,13 +154,15 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     try:
         sheet = make_sheet(args.thickness, args.k_factor, din_k_factor=args.din_k_factor, side=args.side or "normal")
         target = step_target(path, args.face - 1)
-        result = approximate(target, args.tol, max_panels=args.max_panels, direction=args.direction)
+        result = run_approximation(target, args.tol, max_panels=args.max_panels, direction=args.direction,
+                                   method=args.method, progress=_progress_lines(args))
     except GHTError as exc:
-        raise GHTError(f"{path}: {exc}") from None
+        raise GHTError(f"{path}: {' '.join(str(exc).split())}") from None
     with OutputFolder(args.out) as folder:
-        report = write_outputs(result, folder, name=path.stem, sheet=sheet, target=target)
+        report = write_outputs(result, folder, name=path.stem, sheet=sheet, target=target, method=args.method)
         folder.commit()
-    summary = {"command": "approximate", "target": str(path), "panels": report["panels"], "tol": report["tol"],
+    summary = {"command": "approximate", "target": str(path), "method": args.method, "panels": report["panels"],
+               "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}
     if getattr(args, "json", False):
         from .commands.common import dumps

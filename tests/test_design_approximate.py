@@ -67,6 +67,8 @@ BAD = [
     (_variant(max_panels=100001), "surfaces[0].max_panels", r"\[1, 256\]"),
     (_variant(max_panels=1.5), "surfaces[0].max_panels", "integer"),
     (_variant(direction="w"), "surfaces[0].direction", "auto, u, v"),
+    (_variant(method="fast"), "surfaces[0].method", "auto, loft, dual"),
+    (_variant(method=1), "surfaces[0].method", "expected a string"),
     (_variant(foo=1), "surfaces[0].foo", "allowed keys in surfaces"),
     (_variant(target=None), "surfaces[0].target", "missing"),
     (_variant(target=3), "surfaces[0].target", "expected a table"),
@@ -362,3 +364,36 @@ def test_sheet_side_is_measured_on_the_target_normal() -> None:
             n = np.cross(g.derivative([uu], [vv], 1, 0)[0], g.derivative([uu], [vv], 0, 1)[0])
             n /= np.linalg.norm(n)
             assert abs(float((P - g.evaluate([uu], [vv])[0]) @ n) - sign * T) <= 1e-3 * T, (side, fu, fv)
+
+
+def test_method_key_parsed_validated_and_passed_through(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``method`` of an approximate surface: the choices of ``APPROX_METHODS`` (default auto; also
+    the message of a bad value lists them), kept by ``to_dict``, passed to ``ght_cad.approximate``
+    and recorded in the report: a developable GHT cylinder target with ``method = "loft"`` gives
+    one loft panel within 1e-6 of the size, ``surface.approximation.method`` = "loft"."""
+    from ght_cad.design.schema.constants import APPROX_METHODS
+
+    assert parse_design(BASE, "d.toml").surface.method == "auto"
+    for m in APPROX_METHODS:
+        spec = parse_design(_variant(method=m), "d.toml").surface
+        assert spec.method == m and parse_design(_variant(method=m), "d.toml").to_dict()["surface"]["method"] == m
+    with pytest.raises(DesignError) as exc:
+        parse_design(_variant(method="fast"), "d.toml")
+    assert str(exc.value).startswith("d.toml: key 'surfaces[0].method'") and ", ".join(APPROX_METHODS) in str(exc.value)
+    # the key does not leak into other surface types' plain-data form
+    planes = {"surface": {"type": "planes", "planes": [[0, 0, 0, 1], [-1, 0, 1, 1], [-2, 1, 0, 1]],
+                          "boundary_planes": [[0, 1, 0, 0], [-1, 1, 0, 0]], "normalize": False}}
+    assert "method" not in parse_design(planes, "p.toml").to_dict()["surface"]
+    # through the build: the method reaches the core and the report
+    net = [[[600.0 * i, 400.0 * j, [0.0, 80.0, 0.0][j]] for j in range(3)] for i in range(3)]
+    d = _target(poles=None, knots_u=None, knots_v=None, degree_u=None, degree_v=None, control_points=net)
+    d["surfaces"][0]["method"] = "loft"
+    path = tmp_path / "cyl.toml"
+    path.write_text(_toml(d))
+    assert main(["surface", str(path), "--json"]) == 0
+    ap = json.loads(capsys.readouterr().out)["surface"]["approximation"]
+    assert ap["method"] == "loft" and [p["method"] for p in ap["panel_report"]] == ["loft"] * ap["panels"]
+    assert ap["panels"] == 1 and ap["max_deviation"] <= 1e-6 * ap["size"]
+    from ght_cad.design.approximate import report_markdown
+
+    assert "- method: loft (per strip: 1 loft)" in report_markdown(ap)

@@ -5,7 +5,9 @@ the cap is approximated twice): a spherical cap (R 1000 mm, polar angle 0..60°)
 in at most 14 panels, the deviation measured by FreeCAD's ``distToShape`` both ways within 1 mm
 (+1 % for OCCT's extrema accuracy); its flat pattern; save/reopen and a new Tolerance changing
 PanelCount; a cone face of a PartDesign Body in one panel; a B-spline dome imported from STEP
-within 1 mm; refusals naming the property. Here: the printed figures, and
+within 1 mm; the Direction and Method properties (the core's choices) driving a small dome's panels
+(Method loft, Direction u then v) with the progress indicator fed, the Report view clean;
+refusals naming the property. Here: the printed figures, and
 the flat pattern's DXF read back with ezdxf (one closed outline per panel).
 """
 
@@ -24,7 +26,7 @@ _NUM = r"([\deE.+-]+)"
 
 
 def test_developable_approximation_inside_freecadcmd(tmp_path: Path) -> None:
-    out = run_fc_unittest("freecad.ght_workbench.tests.fc_approximation", tmp_path, min_tests=4, timeout=900)
+    out = run_fc_unittest("freecad.ght_workbench.tests.fc_approximation", tmp_path, min_tests=5, timeout=900)
     flat = out.replace("\t", "\n").replace("\r", "\n")
     cap = re.search(rf"cap tol 1: (\d+) panels, MaxDeviation {_NUM}, measured target->shell {_NUM} shell->target {_NUM}", flat)
     assert cap, out[-3000:]
@@ -35,6 +37,8 @@ def test_developable_approximation_inside_freecadcmd(tmp_path: Path) -> None:
     cone = re.search(rf"cone: 1 panel, MaxDeviation {_NUM}, measured {_NUM} \(size {_NUM}\)", flat)
     assert cone and float(cone.group(2)) <= 1e-6 * float(cone.group(3)), out[-3000:]
 
+    small = re.search(r"small dome tol 1: loft along u (\d+) panels; loft along v (\d+) panels", flat)
+    assert small and int(small.group(1)) >= 1 and int(small.group(2)) >= 1, out[-3000:]
     dome = re.search(rf"dome tol 1: (\d+) panels, MaxDeviation {_NUM}, measured target->shell {_NUM} shell->target {_NUM}", flat)
     assert dome and max(float(dome.group(3)), float(dome.group(4))) <= 1.01, out[-3000:]
 

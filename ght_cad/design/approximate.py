@@ -4,8 +4,9 @@ The target of ``[[surfaces]] type = "approximate"`` (``[surfaces.target]``, :cla
 is a face of a STEP file (path relative to the design file, 1-based face number, as ``ght-cad
 approximate --face``), a GHT patch ``S(u, v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P_ij``
 (:class:`ght_cad.surfaces.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.surfaces.nurbs.NurbsSurface`). It is
-covered by :func:`ght_cad.approximate` with the surface's ``tol``, ``max_panels`` and ``direction``:
-the same call ``ght-cad approximate`` (:mod:`ght_cad.approximate_cli`) makes, and both write their
+covered by :func:`ght_cad.approximate` with the surface's ``tol``, ``max_panels``, ``direction`` and
+``method`` (:func:`run_approximation`): the same call ``ght-cad approximate``
+(:mod:`ght_cad.approximate_cli`) makes, and both write their
 outputs through the functions of this module: the panels sewn into one shell
 (:func:`ght_cad.cad.approximate.panels_shell`), their flat patterns on one sheet with seam marks
 (:func:`panel_pattern`), the deviation map (:func:`plot_deviation`), the per-panel report
@@ -21,25 +22,27 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from ..core.errors import GHTError
 from .schema import DesignError, SurfaceSpec
 
-__all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "is_approximation", "plot_deviation",
+__all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "run_approximation", "is_approximation",
+           "plot_deviation",
            "report_markdown", "approximation_report", "panel_sheets", "panel_pattern", "panel_plates"]
 
 
 class ApproximatedSurface:
     """The built ``approximate`` surface of a design: the :class:`~ght_cad.approximation.ApproximationResult`
     and its panels' exact developables (``parts``: a :class:`~ght_cad.loft.DevelopableLoft` per strip,
-    a :class:`~ght_cad.approximation.ConeStrip` where a seam is one point)."""
+    a :class:`~ght_cad.approximation.ConeStrip` where a seam is one point) and the ``method`` asked for."""
 
-    def __init__(self, result: Any, target: Any) -> None:
+    def __init__(self, result: Any, target: Any, method: str = "auto") -> None:
         self.result = result
         self.target = target
+        self.method = method
         self.parts = [p.exact if p.exact is not None else p.surface for p in result.panels]
 
     def part_sheets(self, sheet: Any) -> list[Any] | None:
@@ -133,20 +136,91 @@ def _check_regular(tgt: Any, source: str, key: str) -> None:
 
 
 def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
-    """:func:`ght_cad.approximate` of the surface's target with its ``tol``, ``max_panels`` and
-    ``direction`` (the call ``ght-cad approximate`` makes).
+    """:func:`run_approximation` of the surface's target with its ``tol``, ``max_panels``,
+    ``direction`` and ``method`` (the call ``ght-cad approximate`` makes).
 
     Raises:
         DesignError: a bad target (:func:`approximation_target`).
         GHTError: no approximation within ``tol`` with ``max_panels`` panels (the message names the
             best deviation reached; the caller adds the file and key).
     """
-    from ..approximation import approximate
-
     tgt = approximation_target(spec, source)
     with np.errstate(all="ignore"):
-        result = approximate(tgt, spec.tol, direction=spec.direction, max_panels=spec.max_panels)
-    return ApproximatedSurface(result, tgt)
+        result = run_approximation(tgt, spec.tol, direction=spec.direction, max_panels=spec.max_panels,
+                                   method=spec.method)
+    return ApproximatedSurface(result, tgt, spec.method)
+
+
+#: how many times :func:`run_approximation` doubles ``tol`` looking for the best deviation within
+#: ``max_panels`` when the march alone needs more strips, and how many bisection steps follow
+BEST_DEVIATION_TRIES = (6, 3)
+
+
+def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_panels: int = 64,
+                      method: str = "auto", progress: Callable[[str], None] | None = None) -> Any:
+    r""":func:`ght_cad.approximate` as the front ends (``ght-cad approximate``, design files, the
+    FreeCAD feature) call it, with one guarantee more on failure: the message names the best
+    deviation reached with at most ``max_panels`` panels.
+
+    The core names it when some march fitted in ``max_panels`` strips but missed ``tol``; when the
+    very first march already needs more strips (the target curves too much for ``tol``), the core
+    has none to name. Then the tolerance is raised until an approximation with at most
+    ``max_panels`` panels succeeds: doubled, ``t_k = 2^k tol`` (k = 1 .. 6), then 3 bisection steps
+    on ``log t`` between the last failing and the first succeeding value (``t = sqrt(t_lo t_hi)``);
+    the smallest largest deviation (both ways) of the successful runs is the best deviation reached,
+    an upper bound of what ``max_panels`` panels can do (within 2^(1/8) ≈ 9 % in ``t`` of the
+    smallest tolerance the march meets with them). Up to 9 more runs of the core, on failure only.
+
+    Raises:
+        GHTError: bad arguments (the core's message), or no approximation within ``tol``: one line
+            ``... best deviation reached D with N panels ...`` (or that none was reached up to
+            ``2^6 tol``).
+    """
+    from ..approximation import approximate
+
+    kw = dict(direction=direction, max_panels=max_panels, method=method)
+    try:
+        return approximate(target, tol, progress=progress, **kw)
+    except GHTError as exc:
+        msg = " ".join(str(exc).split())
+        if "best deviation reached" in msg or "the march needed more than" not in msg:
+            raise
+    say = progress or (lambda s: None)
+    best: tuple[float, int, float] | None = None
+
+    def attempt(t: float) -> bool:
+        nonlocal best
+        say(f"tol={tol:g} needs more than {max_panels} panels; looking for the best deviation at tol={t:.4g}")
+        try:
+            res = approximate(target, t, **kw)
+        except GHTError:
+            return False
+        if best is None or res.max_deviation < best[0]:
+            best = (float(res.max_deviation), len(res.panels), t)
+        return True
+
+    doublings, bisections = BEST_DEVIATION_TRIES
+    lo, hi = float(tol), None
+    for k in range(1, doublings + 1):
+        if attempt(tol * 2.0 ** k):
+            hi = tol * 2.0 ** k
+            break
+        lo = tol * 2.0 ** k
+    if hi is not None:
+        for _ in range(bisections):
+            mid = math.sqrt(lo * hi)
+            if attempt(mid):
+                hi = mid
+            else:
+                lo = mid
+    if best is None:
+        raise GHTError(f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels; "
+                       f"best deviation reached: none with at most {max_panels} panels up to "
+                       f"tol={tol * 2.0 ** doublings:g}; raise max_panels")
+    d, n, t = best
+    raise GHTError(f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels "
+                   f"(the march needed more strips); best deviation reached {d:.6g} with {n} panels (a run at "
+                   f"tol={t:.4g}); raise max_panels or tol")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -180,8 +254,11 @@ def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = 
 
 def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
     """The report as a Markdown table (``heading``: the title's level, ``"##"`` inside a design's report)."""
+    methods = [p.get("method", "loft") for p in report["panel_report"]]
+    mix = ", ".join(f"{methods.count(m)} {m}" for m in ("dual", "loft") if m in methods)
     lines = [f"{heading} Developable approximation: {report.get('name', 'target')}", "",
              f"- panels: {report['panels']} (rulings along {report['direction']})",
+             f"- method: {report.get('method', 'auto')} (per strip: {mix})",
              f"- tolerance: {report['tol']:g}; largest deviation: {report['max_deviation']:.6g}",
              f"- total area: {report['total_area']:.6g}", "",
              "| panel | max out | max in | theta_max (deg) | area | flat area |",
@@ -195,12 +272,15 @@ def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
     return "\n".join(lines) + "\n"
 
 
-def approximation_report(result: Any, pattern: Any = None, *, name: str = "target") -> dict[str, Any]:
+def approximation_report(result: Any, pattern: Any = None, *, name: str = "target",
+                         method: str = "auto") -> dict[str, Any]:
     """The report of an approximation (``report.json`` of ``ght-cad approximate``, ``surface.approximation``
-    of a design's ``approximate`` surface): :meth:`ApproximationResult.as_dict` with the name and,
-    given the flat ``pattern``, every panel's flat area and label."""
+    of a design's ``approximate`` surface): :meth:`ApproximationResult.as_dict` with the name, the
+    ``method`` asked for (each panel's ``method`` says what it got) and, given the flat ``pattern``,
+    every panel's flat area and label."""
     report = result.as_dict()
     report["name"] = name
+    report["method"] = method
     if pattern is not None:
         for p, fp in zip(report["panel_report"], pattern.panels):
             p["flat_area"] = float(fp.area_flat)

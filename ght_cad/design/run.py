@@ -307,7 +307,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 from .approximate import approximation_report
 
                 report["surface"]["approximation"] = approximation_report(built.surface.result, pattern,
-                                                                          name=design.name)
+                                                                          name=design.name, method=built.surface.method)
                 report["surface"]["approximation"].pop("info", None)
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]), chord_tol=chord_tol)

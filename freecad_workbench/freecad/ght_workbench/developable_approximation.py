@@ -21,6 +21,18 @@ module only adapts FreeCAD to it and back:
   (:func:`.convert.face_from_data`) joined into one shell along their seams at 1e-6 of the target
   size (:func:`panel_shell`: adjacent panels are lofted from the same seam curve).
 
+Properties Direction and Method are enumerations of what the core accepts, read from the core
+(``ght_cad.approximation.DIRECTIONS``: the design files' ``APPROX_DIRECTIONS`` and ``ght-cad
+approximate --direction`` are the same list; the workbench, a kernel-layer module, reads the core's
+rather than the application's, tests/test_import_layers.py) when a feature is made or a document
+opened, so a direction the core learns later is offered in old documents too. During a recompute the core's progress lines drive FreeCAD's
+``Base.ProgressIndicator`` (the status bar's busy bar in the GUI, one step per line; each line also
+goes to the log, ``Console.PrintLog``: the Report view with "Log messages" on); headless the
+indicator is left out (:data:`SHOW_PROGRESS`): FreeCAD's console sequencer would print its text
+among the Report lines. FreeCAD 0.20 lets only the outermost sequencer draw: in a document
+recompute that is the document's own "Recompute..." (one step per object) and the indicator is
+silent; it shows when the feature is recomputed alone (``obj.recompute()``, "Recompute object").
+
 Per-panel outputs are listed in the order of the Shape's faces (``PanelDeviations[i]`` is
 ``Face{i+1}``). :meth:`DevelopableApproximationFeature.surface` gives the panels' exact
 developables in that order, so the *Flat pattern* feature (Source = this feature) unrolls all
@@ -48,9 +60,23 @@ from .convert import face_from_data
 __all__ = ["DevelopableApproximationFeature", "face_target", "target_face",
            "make_developable_approximation", "flat_patterns_of", "panel_shell", "DIRECTIONS", "METHODS", "OUTPUTS"]
 
-DIRECTIONS = ["auto", "u", "v"]
+
+
+def _core_choices(name: str, default: tuple[str, ...]) -> list[str]:
+    """``ght_cad.approximation.<name>`` (the choices the core accepts), ``default`` for a core
+    without that constant."""
+    import ght_cad.approximation as core
+
+    return list(getattr(core, name, default))
+
+
+#: the parameter the rulings run along: the choices the core accepts (``ght_cad.approximation.DIRECTIONS``)
+DIRECTIONS = _core_choices("DIRECTIONS", ("auto", "u", "v"))
 #: how each strip is fitted (ght_cad.approximate's ``method``): the closer of both, the rails loft, the dual fit
-METHODS = ["auto", "loft", "dual"]
+METHODS = _core_choices("METHODS", ("auto", "loft", "dual"))
+#: drive ``FreeCAD.Base.ProgressIndicator`` during a recompute: None = only with the GUI up (headless,
+#: FreeCAD's console sequencer prints the text and percentages to stdout), True = always, False = never
+SHOW_PROGRESS: bool | None = None
 OUTPUTS = ("PanelCount", "MaxDeviation", "PanelDeviations", "PanelMaxOut", "PanelMaxIn", "PanelThetaMax", "PanelAreas",
            "PanelMethods", "DirectionUsed", "Report")
 
@@ -222,9 +248,6 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.Tolerance = 1.0
         obj.addProperty("App::PropertyInteger", "MaxPanels", "Approximation", "Largest panel count accepted (>= 1); more needed: the feature fails naming the best deviation")
         obj.MaxPanels = 64
-        obj.addProperty("App::PropertyEnumeration", "Direction", "Approximation", "Parameter of the target the rulings run along: auto (least normal curvature), u or v")
-        obj.Direction = DIRECTIONS
-        obj.Direction = "auto"
         self._method_properties(obj)
         obj.addProperty("App::PropertyInteger", "PanelCount", "Result", "Number of developable panels (faces of the shell)")
         obj.addProperty("App::PropertyFloat", "MaxDeviation", "Result", "Largest deviation of a panel from the target, both ways (the core's measure)")
@@ -239,13 +262,26 @@ class DevelopableApproximationFeature(FeatureProxy):
 
     @staticmethod
     def _method_properties(obj: Any) -> None:
-        """Method and PanelMethods (added to documents saved before they existed: Method "loft",
-        what those documents were computed with)."""
+        """Direction, Method and PanelMethods, their choices the core's (:data:`DIRECTIONS`,
+        :data:`METHODS`): added to documents saved before they existed (Method "loft", what those
+        documents were computed with), and an enumeration saved with fewer choices than the core has
+        now gets the new ones, its value kept."""
+        if "Direction" not in obj.PropertiesList:
+            obj.addProperty("App::PropertyEnumeration", "Direction", "Approximation", "Parameter of the target the rulings run "
+                            f"along: {', '.join(DIRECTIONS)} (auto: least normal curvature)")
+            obj.Direction = DIRECTIONS
+            obj.Direction = "auto"
         if "Method" not in obj.PropertiesList:
             obj.addProperty("App::PropertyEnumeration", "Method", "Approximation", "Per strip: auto (the closer of the rails loft "
                             "and the dual fit of the target's tangent planes, spec 10.1), loft or dual")
             obj.Method = METHODS
             obj.Method = "auto" if "PanelCount" not in obj.PropertiesList else "loft"
+        for name, choices in (("Direction", DIRECTIONS), ("Method", METHODS)):
+            if list(obj.getEnumerationsOfProperty(name) or []) != choices:
+                value = str(getattr(obj, name))
+                setattr(obj, name, list(choices))
+                if value in choices:
+                    setattr(obj, name, value)
         if "PanelMethods" not in obj.PropertiesList:
             obj.addProperty("App::PropertyStringList", "PanelMethods", "Result", "Per panel: loft or dual (how its seams were found)")
 
@@ -292,9 +328,11 @@ class DevelopableApproximationFeature(FeatureProxy):
             raise GHTError(f"{obj.Label}.MaxPanels={max_panels} is not allowed; it must be an integer >= 1")
         target = face_target(face, f"{obj.Target[0].Label}.{(obj.Target[1] or ['Face1'])[0]}")
         try:
-            res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels, method=str(obj.Method))
+            with _RecomputeProgress(f"{obj.Label}: developable approximation") as say:
+                res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels,
+                                  method=str(obj.Method), progress=say)
         except GHTError as exc:  # name the feature's properties, not the core's arguments
-            raise GHTError(f"{exc} (properties Tolerance, MaxPanels)") from None
+            raise GHTError(f"{' '.join(str(exc).split())} (properties Tolerance, MaxPanels)") from None
         return res, target.path
 
     def compute(self, obj: Any) -> None:
@@ -315,10 +353,58 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.PanelMethods = [str(getattr(p, "method", "loft")) for p in panels]
         obj.DirectionUsed = res.direction
         obj.Report = (f"{len(panels)} developable panel{'s' if len(panels) != 1 else ''} within {res.max_deviation:.4g} (Tolerance {res.tol:g}), rulings along "
-                      f"{res.direction} ({obj.PanelMethods.count('loft')} loft, {obj.PanelMethods.count('dual')} dual), target "
+                      f"{res.direction}, Method {obj.Method} ({obj.PanelMethods.count('loft')} loft, {obj.PanelMethods.count('dual')} dual), target "
                       f"evaluated by {path}, {res.info.get('seconds', 0.0):.1f} s")
         obj.Shape = shape
         self._exact = [_exact(p) for p in panels]  # not saved (FeatureProxy.__getstate__): see surface
+
+
+class _RecomputeProgress:
+    """Context manager giving the core's ``progress`` callback: every line goes to the log
+    (``Console.PrintLog``, "<text>: <line>") and, when :data:`SHOW_PROGRESS` says so, advances a
+    ``FreeCAD.Base.ProgressIndicator`` started with ``text`` and 0 steps (a busy bar: the core's
+    line count is not known ahead). The indicator is stopped on the way out whatever happens; one
+    that cannot be made or fed (an older FreeCAD, no sequencer) is dropped. The user aborting it in
+    the GUI (Esc) gives a :class:`GHTError` (one Report line, the feature in the error state)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.indicator: Any = None
+        self.lines = 0
+
+    def __enter__(self) -> Any:
+        show = bool(App.GuiUp) if SHOW_PROGRESS is None else SHOW_PROGRESS
+        if show:
+            try:
+                self.indicator = App.Base.ProgressIndicator()
+                self.indicator.start(self.text, 0)
+            except Exception:  # noqa: BLE001 - no indicator: the log lines only
+                self.indicator = None
+        return self.say
+
+    def say(self, line: str) -> None:
+        self.lines += 1
+        App.Console.PrintLog(f"{self.text}: {' '.join(str(line).split())}\n")
+        if self.indicator is None:
+            return
+        try:
+            self.indicator.next()
+        except BaseException as exc:  # noqa: BLE001 - FreeCAD's abort (Esc) is not an Exception
+            self.stop()
+            if isinstance(exc, Exception) and "abort" not in str(exc).lower():
+                return  # the indicator broke: go on without it
+            raise GHTError(f"{self.text}: cancelled by the user") from None
+
+    def stop(self) -> None:
+        if self.indicator is not None:
+            try:
+                self.indicator.stop()
+            except Exception:  # noqa: BLE001 - stopped already
+                pass
+            self.indicator = None
+
+    def __exit__(self, *exc: Any) -> None:
+        self.stop()
 
 
 def _exact(panel: Any) -> Any:
@@ -362,7 +448,8 @@ def make_developable_approximation(
         target: ``(object, "FaceN")``, or an object whose shape is one face.
         tolerance: largest deviation both ways (model units, > 0).
         max_panels: largest panel count accepted.
-        direction: ``"auto"``, ``"u"`` or ``"v"``: the parameter the rulings run along.
+        direction: one of :data:`DIRECTIONS` (the core's: ``"auto"``, ``"u"``, ``"v"``, ...): the
+            parameter the rulings run along.
         method: ``"auto"``, ``"loft"`` or ``"dual"`` (:data:`METHODS`): how each strip is fitted.
         flat_pattern: also make the *Flat pattern* of all panels (a child in the tree,
             :func:`flat_patterns_of`).

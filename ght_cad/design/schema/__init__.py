@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 # The moved names (issue 27), all importable from here.
-from .constants import (APPROX_DIRECTIONS, CONTINUITIES, FIGURE_NAMES, FIGURE_OUTPUTS, FILE_NAMES,
+from .constants import (APPROX_DIRECTIONS, APPROX_METHODS, CONTINUITIES, FIGURE_NAMES, FIGURE_OUTPUTS, FILE_NAMES,
                         FILE_OUTPUTS, MAX_APPROX_PANELS, MAX_DESIGN_COORDINATE, MAX_ROWS,
                         MAX_TARGET_DEGREE, MAX_UNROLL_GRID, METHODS, PANELS_CHOICES,
                         PLANE_OBJECTIVES, RAIL_ORIENTATIONS, RAILS_OBJECTIVES, SHAPE_NAMES,
@@ -111,7 +111,8 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     approx = [s for s in surfaces if s.type == "approximate"]
     if approx and len(surfaces) > 1:
         raise ck.fail(f"{approx[0].key}.type", f"\"approximate\" covers its target with panels of its own and must be "
-                      f"the design's only surface (this design has {len(surfaces)}); allowed: one [[surfaces]] entry "
+                      f"the design's only surface (this design has {len(surfaces)}: a design's surfaces are sewn into one shell "
+                      "along shared rails, and the panels' outer seams lie off the target); allowed: one [[surfaces]] entry "
                       "(or [surface]) of type \"approximate\", or other surface types together")
 
     # optimize

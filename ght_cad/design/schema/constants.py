@@ -37,6 +37,12 @@ SURFACE_TYPES = ("planes", "curves", "rails", "composite", "approximate")
 APPROX_DIRECTIONS = ("auto", "u", "v")
 
 
+#: how each strip of an ``approximate`` surface is fitted (:func:`ght_cad.approximate` ``method``):
+#: ``auto`` the closer of the rails loft and the dual fit of the tangent planes (spec 10.1),
+#: ``loft`` the rails loft only, ``dual`` the dual fit wherever it is usable
+APPROX_METHODS = ("auto", "loft", "dual")
+
+
 #: largest ``max_panels`` of an ``approximate`` surface (each panel is a developable loft)
 MAX_APPROX_PANELS = 256
 

@@ -84,11 +84,13 @@ class SurfaceSpec:
     #: ``thickness``, ``k_factor``, ``side``; None: the design's sheet as it is)
     sheet: dict[str, Any] | None = None
     #: ``type = "approximate"``: the target (:class:`TargetSpec`), the tolerance (both ways, in the
-    #: design's unit), the largest panel count and the parameter the rulings run along
+    #: design's unit), the largest panel count, the parameter the rulings run along and how each
+    #: strip is fitted (``auto``, ``loft`` or ``dual``: :func:`ght_cad.approximate` ``method``)
     target: "TargetSpec | None" = None
     tol: float = 0.0
     max_panels: int = 64
     direction: str = "auto"
+    method: str = "auto"
 
 
 @dataclass
@@ -209,7 +211,7 @@ class Design:
         for sd in [d["surface"] or {}] + d["surfaces"]:
             sd.pop("key", None)
             if sd.get("type") != "approximate":  # the keys of an approximate surface only
-                for k in ("target", "tol", "max_panels", "direction"):
+                for k in ("target", "tol", "max_panels", "direction", "method"):
                     sd.pop(k, None)
             if sd.get("sheet", 0) is None:  # no per-surface sheet overrides: as before
                 sd.pop("sheet")

@@ -8,12 +8,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .constants import APPROX_DIRECTIONS, MAX_APPROX_PANELS, MAX_ROWS, MAX_TARGET_DEGREE
+from .constants import APPROX_DIRECTIONS, APPROX_METHODS, MAX_APPROX_PANELS, MAX_ROWS, MAX_TARGET_DEGREE
 from .specs import SurfaceSpec, TargetSpec
 from .checker import _Checker, _short, _tname
 
 
-_APPROX_KEYS = ("type", "target", "tol", "max_panels", "direction")
+_APPROX_KEYS = ("type", "target", "tol", "max_panels", "direction", "method")
 
 
 #: the keys of ``[surfaces.target]`` by kind of target (the kind is told by its first key)
@@ -29,14 +29,17 @@ _TARGET_FIRST = {"step": "step", "ght": "control_points", "nurbs": "poles"}
 
 def _parse_approximate(ck: _Checker, st: dict, path: str, extra: tuple[str, ...] = ()) -> SurfaceSpec:
     """``type = "approximate"`` at ``path``: ``tol`` (> 0), ``max_panels`` (1..256), ``direction``
-    (auto|u|v) and the ``[<path>.target]`` table (:func:`_parse_target`)."""
+    (:data:`APPROX_DIRECTIONS`), ``method`` (:data:`APPROX_METHODS`, default ``auto``) and the
+    ``[<path>.target]`` table (:func:`_parse_target`)."""
     ck.keys(st, path, _APPROX_KEYS + extra)
     tol = ck.number(st, "tol", path, required=True, lo=0.0, lo_open=True,
                     allowed="a length > 0 (largest deviation both ways, in the design's unit)")
     max_panels = ck.integer(st, "max_panels", path, 64, lo=1, hi=MAX_APPROX_PANELS)
     direction = ck.string(st, "direction", path, "auto", choices=APPROX_DIRECTIONS)
+    method = ck.string(st, "method", path, "auto", choices=APPROX_METHODS)
     target = _parse_target(ck, st, f"{path}.target")
-    return SurfaceSpec("approximate", target=target, tol=tol, max_panels=max_panels, direction=direction)
+    return SurfaceSpec("approximate", target=target, tol=tol, max_panels=max_panels, direction=direction,
+                       method=method)
 
 
 def _parse_target(ck: _Checker, st: dict, tpath: str) -> TargetSpec:

@@ -9,6 +9,9 @@ Flat pattern child holds one face per panel with the shell's area; the document 
 (not Touched, nothing in the Report view); save/reopen keeps it working, and a new Tolerance (4 mm)
 changes PanelCount. The lateral face of a cone (a PartDesign Body's face) gives one panel within
 1e-6 of its size; a B-spline dome imported from STEP is covered within Tolerance (open strips).
+Direction and Method are enumerations of the core's choices and reach it (a small dome with Method
+loft along u, then v: every panel a loft, DirectionUsed as asked, recorded in Report), with the
+``Base.ProgressIndicator`` fed by the core's progress lines and nothing in the Report view.
 Refusals (bad Tolerance, MaxPanels, unset Target, a tolerance the panel count cannot meet) are one
 line each naming the property.
 
@@ -28,7 +31,7 @@ import FreeCAD as App
 import Part
 
 from freecad.ght_workbench import _base, developable_approximation as da, export
-from freecad.ght_workbench.tests.refusal import RefusalAssertions, console_output
+from freecad.ght_workbench.tests.refusal import RefusalAssertions, console_lines, console_output
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_approx_")
 #: margin of the independent deviation measurement over Tolerance (OCCT extrema accuracy only)
@@ -192,6 +195,57 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assert_recompute_clean(self.doc, obj, fp)
         print(f"dome tol 1: {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}, measured target->shell {out:.4f} "
               f"shell->target {back:.4f}")
+
+    def test_direction_and_method_properties_drive_the_result_with_progress(self):
+        # Direction and Method offer exactly what the core accepts (ght_cad.approximation.DIRECTIONS, read
+        # at run time); Method "loft" and a given Direction reach the core: every panel a loft,
+        # DirectionUsed the one asked for, recorded in Report; recomputes print nothing in the
+        # Report view, also with the progress indicator driven (as in the GUI)
+        import ght_cad.approximation as core
+
+        pts = [[App.Vector(x, y, (x * x + y * y) / 4000) for y in range(-200, 201, 100)] for x in range(-200, 201, 100)]
+        srf = Part.BSplineSurface()
+        srf.interpolate(pts)
+        dome = self.doc.addObject("Part::Feature", "SmallDome")
+        dome.Shape = srf.toShape()
+        self.doc.recompute()
+        obj = da.make_developable_approximation((dome, "Face1"), 1.0, method="loft", direction="u", doc=self.doc)
+        self.assertEqual(list(obj.getEnumerationsOfProperty("Direction")), list(getattr(core, "DIRECTIONS", ("auto", "u", "v"))))
+        self.assertEqual(list(obj.getEnumerationsOfProperty("Method")), ["auto", "loft", "dual"])
+        self.assertFalse(_base.failed(obj), obj.getStatusString())
+        self.assertEqual((obj.Method, obj.Direction, obj.DirectionUsed), ("loft", "u", "u"))
+        self.assertEqual(set(obj.PanelMethods), {"loft"})
+        self.assertIn("Method loft", obj.Report)
+        self.assert_panels(obj)
+        self.assertLessEqual(obj.MaxDeviation, 1.0)
+        loft_u = obj.PanelCount
+        obj.Direction = "v"
+        # FreeCAD.Base.ProgressIndicator fed by the core's lines, headless too; the feature recomputed
+        # alone (a document recompute runs its own sequencer, which FreeCAD 0.20 lets no nested one drive)
+        da.SHOW_PROGRESS = True
+        try:
+            _, text = console_output(obj.recompute)
+        finally:
+            da.SHOW_PROGRESS = None
+        self.assertFalse(_base.failed(obj), obj.getStatusString())
+        self.assertEqual(obj.DirectionUsed, "v")
+        self.assertIn(f"{obj.Label}: developable approximation...", text)  # the console sequencer's start line
+        self.assert_no_traceback(text)
+        lines = [ln for ln in console_lines(text) if not ln.startswith(f"{obj.Label}: developable approximation")]
+        self.assertEqual(lines, [], text)  # nothing else: no error in the Report view
+        self.assert_panels(obj)
+        # headless without the indicator: the recompute prints nothing at all
+        obj.Method = "auto"
+        self.assert_recompute_clean(self.doc, obj)
+        self.assertLessEqual(set(obj.PanelMethods), {"loft", "dual"})
+        self.assertIn("Method auto", obj.Report)
+        # a document saved when the core had fewer directions gets the new ones on opening, its value kept
+        obj.Direction = ["auto", "u"]
+        obj.Direction = "u"
+        obj.Proxy.restored(obj)
+        self.assertEqual(list(obj.getEnumerationsOfProperty("Direction")), da.DIRECTIONS)
+        self.assertEqual(obj.Direction, "u")
+        print(f"small dome tol 1: loft along u {loft_u} panels; loft along v {obj.PanelCount} panels")
 
     def test_refusals_name_the_property(self):
         cone = self.doc.addObject("Part::Cone", "Cone")
