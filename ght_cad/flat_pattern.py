@@ -33,6 +33,7 @@ from .pattern.io import png as _png_io
 from .pattern.io import svg as _svg_io
 from .pattern.io.dxf import _dxf_ascii, arcs_to_rational_quadratic  # noqa: F401
 from .pattern.io.svg import SVG_STROKE_MM, SVG_UNITS, svg_arc_path  # noqa: F401
+from .pattern.forming import FormingRow, forming_table_text, plot_roll_chart
 from .pattern.layout import (MARK_FRACTIONS, _interp_polyline, _polyline_param, _sagitta3, _shared_edge_candidates,
                              layout_panels, mark_shared_edges, shared_edge_pairs)  # noqa: F401
 from .pattern.model import (_MM_PER_UNIT, _ROMBERG_ACCEPT, _ROMBERG_N, CHORD_TOL_MM, INSUNITS, BoundaryEdge,
@@ -158,9 +159,8 @@ class FlatPattern:
         return None
 
     def forming_table(self) -> str:
-        """Plain-text forming tables (one per panel unrolled with a thickness; :mod:`ght_cad.sheet`)."""
-        from .sheet import FormingRow, forming_table_text
-
+        """Plain-text forming tables (one per panel unrolled with a thickness; :mod:`ght_cad.sheet`,
+        :func:`ght_cad.pattern.forming.forming_table_text`)."""
         out = []
         for p in self.panels:
             sh = p.info.get("sheet")
@@ -171,9 +171,7 @@ class FlatPattern:
         return "\n\n".join(out)
 
     def plot_roll_chart(self, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
-        """Roll-bending chart PNG (:func:`ght_cad.sheet.plot_roll_chart`)."""
-        from .sheet import plot_roll_chart
-
+        """Roll-bending chart PNG (:func:`ght_cad.pattern.forming.plot_roll_chart`)."""
         plot_roll_chart(self, path, dpi=dpi, title=title)
         return Path(path)
 

@@ -39,3 +39,17 @@ def test_importing_batch_does_not_load_the_design_package() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert json.loads(out.stdout) == [False, True, "ght_cad.design.step_input"]
+
+
+def test_sheet_forming_names_resolve_from_sheet() -> None:
+    """Cycle flat_pattern -> sheet -> flat_pattern: the forming rows' presentation (row, table text,
+    roll chart) moved to ``ght_cad.pattern.forming``; the sheet reads the pattern model and the face
+    pieces (``ght_cad.pattern.model``, ``ght_cad.faces``) directly."""
+    import ght_cad.pattern.forming as forming
+    import ght_cad.sheet as sheet
+    from ght_cad.sheet import FormingRow, forming_table_text, plot_roll_chart  # noqa: F401 - the old import works
+
+    for name in ("FormingRow", "forming_table_text", "plot_roll_chart", "_fmt_r"):
+        assert getattr(sheet, name) is getattr(forming, name), name
+    assert {"FormingRow", "forming_table_text", "plot_roll_chart"} <= set(sheet.__all__)
+    assert FormingRow.__module__ == "ght_cad.pattern.forming"

@@ -65,8 +65,8 @@ ALLOWED_UPWARD = {
 
 #: The import cycles (strongly connected components) of today, function-local imports counted.
 KNOWN_CYCLES = [
-    # unrolling: the ruled unroll, the sheet, the flat pattern, the face unroll and the panel joiner
-    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.flat_pattern", "ght_cad.face_unroll", "ght_cad.join_panels"},
+    # unrolling: the ruled unroll, the sheet and the panel joiner
+    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.join_panels"},
 ]
 
 
