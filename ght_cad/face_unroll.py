@@ -39,8 +39,8 @@ from .core._vec import norm as _norm
 from .core._vec import stack as _stack
 from .flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _unit_samples, measure_panel
 from .surfaces.ruled import _theta_parameters
-from .unroll import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes, metric_angles,
-                     metric_stencil)
+from .ruled_development import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes,
+                                metric_angles, metric_stencil)
 # Moved to ght_cad.faces (issue 27); every name stays importable from here.
 from .faces.adapter import (analytic_jet, Bounds, EdgeData, FaceData, jets_agree, RULED_KINDS, surface_jet,
                             SurfaceAdapter, U_FREE_DENSITY_KINDS)  # noqa: F401

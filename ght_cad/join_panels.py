@@ -42,6 +42,7 @@ import numpy as np
 
 from .flat_pattern import (BoundaryEdge, FlatPanel, _polyline_param, _sagitta3, _shoelace, measure_panel,
                            shared_edge_pairs)
+from .ruled_development import RULED_EDGE_UV
 
 __all__ = ["join_panels", "ruled_conormals", "JoinedDevelopment", "rigid_motion_onto", "outline_self_overlap"]
 
@@ -62,8 +63,6 @@ def ruled_conormals(surface: Any) -> Conormals:
     Returns:
         ``f(edge_name, t) -> (n, 3)`` unit vectors, or None for an edge name it does not know.
     """
-    from .unroll import RULED_EDGE_UV
-
     inward = {"a": ("v", 1.0), "ruling u=1": ("u", -1.0), "b": ("v", -1.0), "ruling u=0": ("u", 1.0)}
 
     def conormal(name: str, t: np.ndarray) -> np.ndarray | None:

@@ -49,6 +49,7 @@ from .faces.ruled_face import FaceRuledSurface
 from .pattern.forming import FormingRow, _fmt_r, forming_table_text, plot_roll_chart  # noqa: F401 - moved there (issue 27)
 from .pattern.model import _inside, romberg_length
 from .surfaces.ruled import SINGULAR_NORMAL_TOL, RuledSurface
+from .ruled_development import _smooth_pieces, unroll_ruled_surface
 
 __all__ = [
     "SIDES",
@@ -744,7 +745,7 @@ def unroll_ruled_sheet(surface: RuledSurface, sheet: Sheet, *, label: str = "P1"
     r"""Flat pattern of the neutral offset ``S + δ n`` of a ruled surface (module doc).
 
     Checks the offset (:func:`check_offset`), unrolls :class:`OffsetRuledSurface` by
-    :func:`ght_cad.unroll.unroll_ruled`, and puts into ``panel.info["sheet"]`` the sheet, the
+    :func:`ght_cad.ruled_development.unroll_ruled_surface`, and puts into ``panel.info["sheet"]`` the sheet, the
     inside/neutral/outside lengths of the four boundary edges (``Σ_k ∫_{u_k}^{u_{k+1}} |a' + t n'| du``
     by adaptive Gauss–Legendre on every smooth piece between the surface's ``breakpoints``,
     ``t = 0, δ, σT``; rulings keep their length), the forming rows of the bend
@@ -754,11 +755,10 @@ def unroll_ruled_sheet(surface: RuledSurface, sheet: Sheet, *, label: str = "P1"
         SheetError: the thickness is beyond a bending radius (:func:`check_offset`).
     """
     from .curves.curve import integrate
-    from .unroll import _smooth_pieces, unroll_ruled
 
     rmin = check_offset(surface, sheet, f"surface {label!r}")
     off = OffsetRuledSurface(surface, sheet.neutral_offset)
-    pat = unroll_ruled(off, label=label, breakpoints=off.breakpoints, **kwargs)
+    pat = unroll_ruled_surface(off, label=label, breakpoints=off.breakpoints, **kwargs)
     panel = pat.panels[0]
 
     def edge_len(which: str, t: float) -> float:

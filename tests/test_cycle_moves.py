@@ -53,3 +53,40 @@ def test_sheet_forming_names_resolve_from_sheet() -> None:
         assert getattr(sheet, name) is getattr(forming, name), name
     assert {"FormingRow", "forming_table_text", "plot_roll_chart"} <= set(sheet.__all__)
     assert FormingRow.__module__ == "ght_cad.pattern.forming"
+
+
+def test_ruled_development_names_resolve_from_unroll() -> None:
+    """Cycles unroll <-> sheet and unroll <-> join_panels: the development of one ruled surface moved
+    from ``ght_cad.unroll`` to ``ght_cad.ruled_development``; ``ght_cad.unroll`` gives every moved name."""
+    import ght_cad.ruled_development as rd
+    import ght_cad.unroll as un
+    from ght_cad.unroll import RuledDevelopment, _smooth_pieces, metric_angles, ruled_area  # noqa: F401 - old imports
+
+    moved = ["DEFAULT_TOL_DEG", "RULED_EDGE_UV", "RuledDevelopment", "_PanelSeries", "_check_developable", "_chebint",
+             "_clenshaw", "_coefficients", "_cheb_rows_of", "_fd5", "_frame", "_initial_edges", "_metric_samples",
+             "_panel_nodes", "_ruled_edges", "_smooth_pieces", "broadcast_uv", "first_nodes", "metric_angles",
+             "metric_stencil", "ruled_area", "_N", "_K", "_X", "_V", "_VI", "_INT", "_ONES", "_EDGES0"]
+    for name in moved:
+        assert getattr(un, name) is getattr(rd, name), name
+    assert set(un.__all__) == {"unroll", "unroll_composite", "unroll_ruled", "ruled_area", "RuledDevelopment",
+                               "DEFAULT_TOL_DEG"}
+    assert callable(un) and un.unroll_ruled.__module__ == "ght_cad.unroll"
+
+
+def test_unroll_ruled_without_a_sheet_is_the_ruled_development() -> None:
+    """``unroll_ruled`` without a sheet (or with a zero thickness) gives exactly ``unroll_ruled_surface``'s
+    pattern: the same outline polylines, bit for bit, on a cone frustum."""
+    import numpy as np
+
+    from ght_cad import GHTCurve
+    from ght_cad.ruled_development import unroll_ruled_surface
+    from ght_cad.sheet import make_sheet
+    from ght_cad.surfaces.ruled import CurvePairRuledSurface
+    from ght_cad.unroll import unroll_ruled
+
+    surf = CurvePairRuledSurface(GHTCurve([(1, 0, 0), (1, 1, 0), (0, 1, 0)], gamma=-1),
+                                 GHTCurve([(2, 0, 3), (2, 2, 3), (0, 2, 3)], gamma=-1))
+    ref = unroll_ruled_surface(surf, rulings=4, samples=33).panels[0].loop_polylines()
+    for sheet in (None, make_sheet(0.0)):
+        got = unroll_ruled(surf, rulings=4, samples=33, sheet=sheet).panels[0].loop_polylines()
+        assert len(got) == len(ref) and all(np.array_equal(g, r) for g, r in zip(got, ref))

@@ -43,8 +43,8 @@ _LAYER_OF = {
     # the layer packages of issue 27 are named after their layer; a few modules stay top-level
     "core": ["core"],
     "curves": ["curves"],
-    "surfaces": ["surfaces", "developable", "loft", "sheet", "plate", "unroll", "face_unroll", "flat_pattern",
-                 "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],
+    "surfaces": ["surfaces", "developable", "loft", "sheet", "plate", "unroll", "ruled_development", "face_unroll",
+                 "flat_pattern", "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],
     "kernel": ["cad"],
@@ -64,10 +64,7 @@ ALLOWED_UPWARD = {
 }
 
 #: The import cycles (strongly connected components) of today, function-local imports counted.
-KNOWN_CYCLES = [
-    # unrolling: the ruled unroll, the sheet and the panel joiner
-    {"ght_cad.unroll", "ght_cad.sheet", "ght_cad.join_panels"},
-]
+KNOWN_CYCLES: list[set[str]] = []
 
 
 # -- reading the imports ---------------------------------------------------------------------------
