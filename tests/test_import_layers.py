@@ -20,11 +20,19 @@ A module is in the layer of its first package below ``ght_cad`` (:data:`_LAYER_O
 path of a moved module (``ght_cad.curve``, a shim that is the module ``ght_cad.curves.curve``) is
 in the layer of the module it stands for, so importing it is never an upward import.
 
-An import may go to the same or a lower layer. The imports that go UP today and the import
-cycles of today are listed below as explicit allow-lists: a new upward import or a new cycle fails
-this test, and so does an entry that no longer exists (remove it: the list only shrinks). The
-package moves of issue 27 are to empty both lists; this module is then renamed to test the
-sub-packages' order instead.
+An import may go to the same or a lower layer. The imports that go UP today are listed below as an
+explicit allow-list (:data:`ALLOWED_UPWARD`, the kernel hook only): a new upward import fails this
+test, and so does an entry that no longer exists (remove it: the list only shrinks).
+
+No import cycle is allowed at all, function-local imports included (:func:`test_no_import_cycle`;
+the kernel hook is not an edge of it). The failure names every cycle's modules and, for each of
+them, one of its imports of another module of the cycle with ``file:line``. Break a cycle the way
+the three cycles of before were broken (issue 27): move what both sides use into a module below
+both and import it back where it was (the STEP input's parallel faces into
+``ght_cad.design.step_input`` and the worker helpers into ``ght_cad.core.workers``; the FreeCAD face
+reader into ``ght_workbench.face_reader``; the forming rows' presentation into
+``ght_cad.pattern.forming`` and the development of one ruled surface into
+``ght_cad.ruled_development``), not by hiding the import (``importlib``, strings).
 """
 
 from __future__ import annotations
@@ -63,8 +71,6 @@ ALLOWED_UPWARD = {
     KERNEL_HOOK,
 }
 
-#: The import cycles (strongly connected components) of today, function-local imports counted.
-KNOWN_CYCLES: list[set[str]] = []
 
 
 # -- reading the imports ---------------------------------------------------------------------------
@@ -279,12 +285,58 @@ def test_the_kernel_hook_is_one_import_in_load_kernel() -> None:
         f"ght_cad._kernel must import ght_cad.cad once, in load_kernel; found at lines {[n.lineno for n in hooks]}")
 
 
-def test_no_new_import_cycle(graph: dict[str, set[str]]) -> None:
-    found = cycles(without_kernel_hook(graph))
-    new = [sorted(c) for c in found if not any(c <= k for k in KNOWN_CYCLES)]
-    assert not new, f"new import cycles (function-local imports count): {new}"
-    gone = [sorted(k) for k in KNOWN_CYCLES if not any(k <= c for c in found)]
-    assert not gone, f"these known cycles are gone or smaller, update KNOWN_CYCLES: {gone}"
+def import_sites(module: str, targets: set[str], mods: dict[str, tuple[Path, bool]] | None = None) -> list[tuple[str, int]]:
+    """The imports in ``module``'s file that import a module of ``targets``: ``(imported, line)``,
+    by line (function-local ones included, the kernel hook left out as in the cycle check)."""
+    mods = modules() if mods is None else mods
+    path, is_pkg = mods[module]
+    if module == KERNEL_HOOK[0]:
+        targets = targets - {KERNEL_HOOK[1]}
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            out += [(t, node.lineno) for t in sorted(imports_of(ast.unparse(node), module, is_pkg, set(mods)) & targets)]
+    return sorted(out, key=lambda s: (s[1], s[0]))
+
+
+def describe_cycle(comp: set[str], mods: dict[str, tuple[Path, bool]] | None = None, root: Path = ROOT) -> str:
+    """A cycle for its failure message: its modules, and per module one import of another module of
+    the cycle (the first in the file) with ``file:line``."""
+    mods = modules() if mods is None else mods
+    lines = [f"cycle of {len(comp)} modules: {', '.join(sorted(comp))}"]
+    for m in sorted(comp):
+        target, line = import_sites(m, comp - {m}, mods)[0]
+        path = mods[m][0]
+        where = path.relative_to(root) if path.is_relative_to(root) else path
+        lines.append(f"  {m} imports {target} at {where}:{line}")
+    return "\n".join(lines)
+
+
+def test_cycle_message_names_modules_and_import_lines(tmp_path: Path) -> None:
+    """Made-up package: a imports b at the top, b imports a inside a function; c is outside the cycle."""
+    pkg = tmp_path / "ght_cad"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("import math\nfrom .c import x\nfrom .b import y\n")
+    (pkg / "b.py").write_text("def f():\n    from . import a\n    return a\n")
+    (pkg / "c.py").write_text("x = 1\n")
+    mods = {f"ght_cad.{n}": (pkg / f"{n}.py", False) for n in "abc"} | {"ght_cad": (pkg / "__init__.py", True)}
+    graph = {m: imports_of(f.read_text(), m, p, set(mods)) for m, (f, p) in mods.items()}
+    (comp,) = cycles(graph)
+    assert comp == {"ght_cad.a", "ght_cad.b"}
+    assert describe_cycle(comp, mods, tmp_path).splitlines() == [
+        "cycle of 2 modules: ght_cad.a, ght_cad.b",
+        f"  ght_cad.a imports ght_cad.b at {Path('ght_cad/a.py')}:3",
+        f"  ght_cad.b imports ght_cad.a at {Path('ght_cad/b.py')}:2",
+    ]
+
+
+def test_no_import_cycle(graph: dict[str, set[str]]) -> None:
+    """No import cycle at all, function-local imports included (module doc: how to break one)."""
+    found = sorted(sorted(c) for c in cycles(without_kernel_hook(graph)))
+    assert not found, (
+        "import cycles (function-local imports count; move what both sides use into a module below both, "
+        "see tests/test_import_layers.py):\n" + "\n".join(describe_cycle(set(c)) for c in found))
 
 
 def test_the_freecad_workbench_never_imports_the_ocp_adapters(graph: dict[str, set[str]]) -> None:
