@@ -65,6 +65,19 @@ def run_cli(design_text: str, tmp_path: Path, out: Path, capsys: pytest.CaptureF
     return rc, err, path
 
 
+def run_refused(design_text: str, tmp_path: Path, out: Path, capsys: pytest.CaptureFixture) -> tuple[str, Path]:
+    """``ght-cad run`` of a design that must be refused: exit 2, one line on stderr, ``out`` untouched
+    (same names, bytes and mtimes) and no temporary folder left; returns that line and the design path."""
+    before = snapshot(out)
+    rc, err, path = run_cli(design_text, tmp_path, out, capsys)
+    assert rc == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert snapshot(out) == before
+    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+    return lines[0], path
+
+
 def edit(old: str, new: str) -> str:
     assert old in GOOD
     return GOOD.replace(old, new)
@@ -88,22 +101,9 @@ BROKEN = {
 }
 
 
-@pytest.mark.parametrize("case", list(BROKEN))
-def test_broken_design_one_line_exit_2_untouched(case: str, tmp_path: Path, out_dir: Path, capsys) -> None:
-    text, key, allowed = BROKEN[case]
-    before = snapshot(out_dir)
-    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert str(path) in lines[0] and f"'{key}'" in lines[0] and allowed in lines[0], lines[0]
-    assert snapshot(out_dir) == before
-    assert not list(tmp_path.glob(".*ght-cad-tmp"))
-
-
 def test_invalid_toml_is_one_line(tmp_path: Path, out_dir: Path, capsys) -> None:
-    rc, err, path = run_cli('name = "x\n[surface', tmp_path, out_dir, capsys)
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err and "TOML" in err
+    line, path = run_refused('name = "x\n[surface', tmp_path, out_dir, capsys)
+    assert str(path) in line and "TOML" in line, line
 
 
 def test_missing_design_file(tmp_path: Path, capsys) -> None:
@@ -121,11 +121,8 @@ def test_new_out_folder_not_created_on_error(tmp_path: Path, capsys) -> None:
 def test_degenerate_geometry_exit_2_untouched(tmp_path: Path, out_dir: Path, capsys) -> None:
     """Valid schema, impossible geometry (two equal neighbouring planes): found while computing."""
     text = edit("[[-4, 1, 0, 0.5], [-4, 1, 1, 0.5], [-4, 0, 1, 0.5]]", "[[-4, 1, 0, 0.5], [-4, 1, 0, 0.5], [-4, 0, 1, 0.5]]")
-    before = snapshot(out_dir)
-    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and str(path) in err and "'surface'" in err
-    assert snapshot(out_dir) == before
-    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+    line, path = run_refused(text, tmp_path, out_dir, capsys)
+    assert str(path) in line and "'surface'" in line, line
 
 
 def test_failure_after_files_were_written_leaves_out_untouched(tmp_path: Path, out_dir: Path, monkeypatch) -> None:
@@ -246,11 +243,8 @@ def test_shape_parameter_range_is_exactly_the_box(key: str, value: float) -> Non
 def test_impossible_join_names_the_join(tmp_path: Path, out_dir: Path, capsys) -> None:
     """C3 cannot be imposed on a degree-2 second segment (its c_3 is zero): exit 2, joins[0] named."""
     text = edit('continuity = "G1"', 'continuity = "C3"')
-    before = snapshot(out_dir)
-    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2 and len(err.strip().splitlines()) == 1
-    assert str(path) in err and "'joins[0]'" in err
-    assert snapshot(out_dir) == before
+    line, path = run_refused(text, tmp_path, out_dir, capsys)
+    assert str(path) in line and "'joins[0]'" in line, line
 
 
 # ---------------------------------------------------------------------------------------------
@@ -387,27 +381,23 @@ BROKEN_STRIPS = {
 }
 
 
-@pytest.mark.parametrize("case", list(BROKEN_STRIPS))
-def test_broken_multi_strip_design_exit_2_untouched(case: str, tmp_path: Path, out_dir: Path, capsys) -> None:
-    text, key, allowed = BROKEN_STRIPS[case]
-    before = snapshot(out_dir)
-    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert str(path) in lines[0] and f"'{key}'" in lines[0] and allowed in lines[0], lines[0]
-    assert snapshot(out_dir) == before
-    assert not list(tmp_path.glob(".*ght-cad-tmp"))
+#: Every broken design: (design text, the key its error names, the allowed values it states);
+#: the multi-strip ones prefixed "strips: ".
+ALL_BROKEN = {**BROKEN, **{f"strips: {case}": v for case, v in BROKEN_STRIPS.items()}}
+
+
+@pytest.mark.parametrize("case", list(ALL_BROKEN))
+def test_broken_design_one_line_exit_2_untouched(case: str, tmp_path: Path, out_dir: Path, capsys) -> None:
+    text, key, allowed = ALL_BROKEN[case]
+    line, path = run_refused(text, tmp_path, out_dir, capsys)
+    assert str(path) in line and f"'{key}'" in line and allowed in line, line
 
 
 def test_unsolvable_strip_join_names_the_segment(tmp_path: Path, out_dir: Path, capsys) -> None:
     """Geometry that fails while computing (second strip's free planes parallel to each other)."""
     text = strips_edit("  [-0.927967, -0.872004, 0.317383, 0.372662],\n", "  [-0.941433, -0.721179, 0.605141, 0.3372],\n")
-    before = snapshot(out_dir)
-    rc, err, path = run_cli(text, tmp_path, out_dir, capsys)
-    assert rc == 2 and len(err.strip().splitlines()) == 1, err
-    assert f"{path}: key 'surface.segments[1]' (second-quarter)" in err
-    assert snapshot(out_dir) == before
+    line, path = run_refused(text, tmp_path, out_dir, capsys)
+    assert f"{path}: key 'surface.segments[1]' (second-quarter)" in line, line
 
 
 def test_step_declares_the_design_units(tmp_path) -> None:
