@@ -56,7 +56,8 @@ def add_parser(sub: Any, common: Callable[[argparse.ArgumentParser], None], epil
     sp.add_argument("--out", required=True, metavar="DIR", help="output folder")
     sp.add_argument("--max-panels", type=int, default=64, metavar="N", help="largest panel count accepted (default 64)")
     sp.add_argument("--direction", choices=APPROX_DIRECTIONS, default="auto",
-                    help="parameter the rulings run along (default auto: least normal curvature)")
+                    help="parameter the rulings run along, or diagonal/antidiagonal: seams along the isolines of "
+                         "u+v / u-v of the normalized parameter box (default auto: fewest strips estimated)")
     sp.add_argument("--method", choices=APPROX_METHODS, default="auto",
                     help="how each strip is fitted: auto (default: per strip the closer of the rails loft and the "
                          "dual fit of the target's tangent planes), loft (rails lofts only) or dual (the dual fit "

@@ -13,6 +13,17 @@ both ways it gives ``κ w² / 16``), where ``y`` is the parameter the rulings ru
 the other one. For a spherical cap given in longitude/latitude this gives conical bands between
 latitude circles with rulings along the meridians.
 
+The estimate used is its conjugate form (maths 10.2, :func:`_estimate`): the rulings follow the
+direction ``r = L_xy S_x - L_xx S_y`` conjugate to the seams (``L`` the second fundamental form in
+the strip coordinates), which gives ``N ≈ max_x ∫ sqrt(|det II| / (16 tol |L_xx|)) dy`` (the
+formula above where ``L_xy = 0``; infinite where the seams are asymptotic lines, ``L_xx = 0``).
+Besides u and v it ranks **diagonal strips** (``direction="diagonal"``/``"antidiagonal"``,
+:class:`_DiagonalFrame`): seams along the isolines of ``u_n + v_n`` (``u_n - v_n``) of the
+normalized parameter box, cones at the two corners where they shrink to points, a seam forced on
+the box's other diagonal. ``"auto"`` takes them only where they beat the better of u and v by the
+factor :data:`DIAGONAL_GAIN` (the saddle ``z = x y / L`` in its own parameters: u, v 88 strips,
+diagonals 5.5), never on a target closed along a parameter.
+
 Algorithm (all kernel-free, numpy/scipy):
 
 1. **March**: from ``y = 0``, the next seam is the largest ``y1`` whose strip, with both seams on
@@ -68,15 +79,20 @@ from ..core.errors import GHTError
 
 # The moved names (issue 27), all importable from here.
 from .target import as_target, _ght_jet, _JET, _ruled_jet, SurfaceTarget  # noqa: F401
-from .frame import _Frame, _unit  # noqa: F401
+from .frame import _DiagonalFrame, _Frame, _unit, make_frame, STRIP_DIRECTIONS, strip_uv  # noqa: F401
 from .seams import (BSplineRuled, _det, _match, _ruling_deviation, _Rulings, _Seam, SeamCurve,
                     _strip_rulings, _W)  # noqa: F401
 from .result import ApproximationResult, ConeStrip, Panel  # noqa: F401
-from .splitting import _estimate, _greedy, _march, _offsets, _strip_range  # noqa: F401
+from .splitting import (_choose_direction, _estimate, _estimate_curvature, _greedy, _march, _march_piece, _offsets,
+                        _strip_range, DIAGONAL_GAIN, DIAGONAL_MIN_STRIPS)  # noqa: F401
 from .fitting import _build_panel, _choose_methods, _dual_seams, _strip_dev  # noqa: F401
 from .deviation import _measure_panel, _project_panel, _strip_grid  # noqa: F401
 
+#: the accepted ``direction`` values of :func:`approximate`
+DIRECTIONS = ("auto",) + STRIP_DIRECTIONS
+
 __all__ = [
+    "DIRECTIONS",
     "SurfaceTarget",
     "as_target",
     "approximate",
@@ -120,8 +136,10 @@ def approximate(
     Args:
         target: GHTSurface, NurbsSurface, RuledSurface, :class:`SurfaceTarget` or a CAD face.
         tol: largest allowed deviation (both ways, model units).
-        direction: ``"auto"``, ``"u"`` or ``"v"``: the parameter the rulings run along (the seams
-            are isolines of the other one).
+        direction: one of :data:`DIRECTIONS`: ``"u"`` or ``"v"``: the parameter the rulings run
+            along (the seams are isolines of the other one); ``"diagonal"``/``"antidiagonal"``:
+            seams along the isolines of ``u_n + v_n`` / ``u_n - v_n`` of the normalized parameter
+            box (maths 10.2); ``"auto"``: by the conjugate strip estimate (:func:`_choose_direction`).
         max_panels: largest panel count accepted.
         offset_degree: Chebyshev degree of the seam offsets δ_j(t) (0: constant).
         offset_iterations: fixed-point iterations of the offsets.
@@ -140,7 +158,9 @@ def approximate(
 
     Raises:
         GHTError: bad arguments, or no approximation within ``tol`` with at most ``max_panels``
-            panels (the message names the best deviation reached and its panel count).
+            panels (the message names the best deviation reached and its panel count, or "none"
+            when no developable joins the seams, e.g. asymptotic seams: NotDevelopableError of the
+            loft is caught there).
     """
     _check_number("tol", tol, 0.0)
     if not tol > 0:
@@ -149,8 +169,8 @@ def approximate(
     _check_number("offset_degree", offset_degree, 0, integer=True)
     _check_number("offset_iterations", offset_iterations, 0, integer=True)
     _check_number("safety", safety, 0.05)
-    if direction not in ("auto", "u", "v"):
-        raise GHTError(f"direction={direction!r} is not allowed; use 'auto', 'u' or 'v'")
+    if direction not in DIRECTIONS:
+        raise GHTError(f"direction={direction!r} is not allowed; use one of " + ", ".join(repr(d) for d in DIRECTIONS))
     if method not in ("auto", "loft", "dual"):
         raise GHTError(f"method={method!r} is not allowed; use 'auto', 'loft' or 'dual'")
     _check_number("optimizer_budget", optimizer_budget, 1, integer=True)
@@ -166,16 +186,16 @@ def approximate(
     tgt = as_target(target)
     info: dict[str, Any] = {"target": tgt.name, "bounds": list(tgt.bounds)}
     if direction == "auto":
-        est = {d: _estimate(_Frame(tgt, d), tol) for d in ("u", "v")}
-        direction = min(est, key=lambda d: est[d])
+        direction, est = _choose_direction(tgt, tol)
         info["estimate"] = est
-        say(f"direction: rulings along {direction} (estimated strips {est})")
-    frame = _Frame(tgt, direction)
+        say(f"direction: {direction} (estimated strips {est})")
+    frame = make_frame(tgt, direction)
     tol = float(tol)
     best: tuple[float, int] | None = None
     f = float(safety)
     history = []
     panels: list[Panel] = []
+    refused: str | None = None
     for attempt in range(8):
         ys = _march(frame, tol, f, max_panels, min_width=1e-6)
         n = len(ys) - 1
@@ -224,8 +244,9 @@ def approximate(
                     panels.append(Panel(surf, A.y, B.y, out, inn, max(out, inn), float(th) if math.isfinite(th) else 0.0,
                                         exact=exact, method="dual" if ch[i] else "loft", choice=dict(choice[i])))
                     maps.append(mp)
-            except GHTError as exc:
+            except (GHTError, FloatingPointError) as exc:  # NotDevelopableError included: a refused mix
                 say(f"  mix refused: {exc}")
+                refused = f"{type(exc).__name__}: {exc}"
                 continue
             w = max(p.max_deviation for p in panels)
             if best_mix is None or w < best_mix[0]:
@@ -250,6 +271,13 @@ def approximate(
         panels = []
     info["history"] = history
     if not panels or max(p.max_deviation for p in panels) > tol or len(panels) > max_panels:
+        if best is None and refused is not None:
+            first = refused.splitlines()[0] if refused else ""
+            raise GHTError(
+                f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels; "
+                f"best deviation reached: none (no developable panel joins the seams along direction={direction!r}; "
+                f"last refusal: {first[:300]}); try another direction ({', '.join(STRIP_DIRECTIONS)}) or raise tol"
+            )
         if best is None:
             raise GHTError(
                 f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels: "

@@ -51,7 +51,8 @@ class Panel:
     Attributes:
         surface: the panel as exported: :class:`BSplineRuled` (B-spline face data of degree 1 across,
             fitted to 1e-7 of the size to ``exact``).
-        y0, y1: the seams' positions across the strips (0..1 over the target's parameter range).
+        y0, y1: the seams' positions across the strips (0..1 over the target's parameter range;
+            :func:`ght_cad.approximation.strip_uv` gives their (u, v)).
         max_out, max_in: largest deviation of the panel outside / inside the target (along the
             target's normal, both ways: panel -> target and target -> panel), lengths >= 0.
         max_deviation: ``max(max_out, max_in)``.
@@ -91,7 +92,10 @@ class ApproximationResult:
     Attributes:
         panels: the panels in seam order.
         tol: the tolerance asked for.
-        direction: the parameter the rulings run along ("u" or "v").
+        direction: the strip direction: the parameter the rulings run along (``"u"``, ``"v"``) or
+            ``"diagonal"``/``"antidiagonal"`` (seams along the isolines of ``u_n ± v_n``; ``y0``,
+            ``y1`` of the panels and ``seams[i]["y"]`` are then ``(u_n ± v_n) / 2``, shifted to [0, 1]
+            for ``-``: :func:`ght_cad.approximation.strip_uv` maps them to (u, v)).
         size: bounding-box diagonal of the target.
         max_deviation: largest panel deviation (both ways).
         deviation_map: ``{"xyz": (n, 3), "uv": (n, 2), "d": (n,)}`` target samples with the signed

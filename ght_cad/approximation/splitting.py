@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .frame import _Frame
+from .frame import _Frame, make_frame
+from .target import SurfaceTarget
 from .seams import _ruling_deviation, _Seam, _strip_rulings
 
 
@@ -16,7 +17,43 @@ from .seams import _ruling_deviation, _Seam, _strip_rulings
 # direction estimate
 # ----------------------------------------------------------------------------------------------
 def _estimate(frame: _Frame, tol: float, n: int = 33) -> float:
-    r"""``max_x ∫ sqrt(|κ_n(S_y)| / (16 tol)) |S_y| dy`` on an n × n grid (trapezoid rule)."""
+    r"""Strips needed across the frame (maths 10.2): ``max_x ∫_0^1 f(x, y) dy`` with
+
+        f = sqrt(|det II| / (16 tol |L_xx|)),   det II = L_xx L_yy - L_xy²,
+
+    ``L_xx = S_xx·n``, ``L_xy = S_xy·n``, ``L_yy = S_yy·n`` the second fundamental form in the
+    frame's (x, y). The rulings of a strip between seams along x follow the conjugate direction
+    ``r = L_xy S_x - L_xx S_y`` (``II(S_x, r) = 0``): across a strip of width dy a ruling has length
+    ``|r| dy / |L_xx|`` and normal curvature ``κ_r = L_xx det II / |r|²``, so its sagitta split both
+    ways is ``κ_r ℓ² / 16 = det II dy² / (16 L_xx)``; ``<= tol`` gives f strips per unit y. With
+    ``L_xy = 0`` it is ``sqrt(|L_yy| / (16 tol))``, the normal curvature along the rulings; on a
+    developable (``det II = 0``) it is 0; seams along asymptotic lines (``L_xx = 0``) would need
+    rulings along the seams: ``|L_xx|`` is floored at ``1e-3 (|L_xx| + 2 |L_xy| + |L_yy|)`` so f
+    stays finite there but large (about 16 times the diagonal value on the saddle ``z = x y / L``
+    in its own parameters). Below that floor f² is at least ``|L_yy| / (16 tol)``: seams along the
+    rulings of a developable (``L_xx = L_xy = 0``, every direction conjugate) bound planar strips
+    whose sagitta is ``L_yy dy² / 8`` (a cylinder cut along its axis). Midpoint rule in y on
+    ``n - 1`` rows (no row on a point seam), n columns in x."""
+    x = np.linspace(0, 1, n)
+    y = (np.arange(n - 1) + 0.5) / (n - 1)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    j = frame.jet(X.ravel(), Y.ravel(), 2)
+    nrm = frame.normal(X.ravel(), Y.ravel(), j[:3])
+    lxx, lyy, lxy = (np.sum(j[k] * nrm, 1) for k in (3, 4, 5))
+    det = np.abs(lxx * lyy - lxy * lxy)
+    floor = 1e-3 * (np.abs(lxx) + 2 * np.abs(lxy) + np.abs(lyy))
+    f2 = det / np.maximum(np.maximum(np.abs(lxx), floor), 1e-300)
+    # seams along a ruling of a developable (L_xx = L_xy = 0): every direction is conjugate, the
+    # strip between two such seams is planar and deviates by L_yy dy² / 8
+    f2 = np.where(np.abs(lxx) < floor, np.maximum(f2, np.abs(lyy)), f2)
+    f = np.sqrt(f2 / (16 * tol)).reshape(n, n - 1)
+    return float(np.max(np.sum(f, axis=1) / (n - 1)))
+
+
+def _estimate_curvature(frame: _Frame, tol: float, n: int = 33) -> float:
+    r"""The estimate before the conjugate one (kept for comparison in reports and tests):
+    ``max_x ∫ sqrt(|κ_n(S_y)| / (16 tol)) |S_y| dy`` on an n × n grid (trapezoid rule): the normal
+    curvature along the parameter the rulings run along."""
     x = np.linspace(0, 1, n)
     X, Y = np.meshgrid(x, x, indexing="ij")
     j = frame.jet(X.ravel(), Y.ravel(), 2)
@@ -27,6 +64,34 @@ def _estimate(frame: _Frame, tol: float, n: int = 33) -> float:
     f = (np.sqrt(kappa / (16 * tol)) * L).reshape(n, n)
     integral = 0.5 * np.sum((f[:, 1:] + f[:, :-1]) * np.diff(x), axis=1)
     return float(np.max(integral))
+
+
+#: the diagonal strips are chosen only when their estimate is this many times below the better of u
+#: and v (the u/v strips follow the target's own isolines: exact end seams, no corner cones)
+DIAGONAL_GAIN = 2.0
+#: ... and only when u/v need more than this many strips by the estimate
+DIAGONAL_MIN_STRIPS = 1.0
+
+
+def _choose_direction(target: SurfaceTarget, tol: float) -> tuple[str, dict[str, float]]:
+    r"""``direction="auto"``: the strip direction of least :func:`_estimate` among ``"u"`` and ``"v"``;
+    ``"diagonal"``/``"antidiagonal"`` instead only where the better of them needs fewer strips by the
+    factor :data:`DIAGONAL_GAIN` (and u/v more than :data:`DIAGONAL_MIN_STRIPS`), never on a target
+    closed along a parameter (a full turn: the diagonal seams would cross its seam line). Returns
+    the direction and the estimates computed."""
+    frames = {d: make_frame(target, d) for d in ("u", "v")}
+    est = {d: _estimate(f, tol) for d, f in frames.items()}
+    est = {d: (e if np.isfinite(e) else np.inf) for d, e in est.items()}
+    best = min(est, key=lambda d: est[d])
+    if any(f.closed_x for f in frames.values()) or not est[best] > DIAGONAL_MIN_STRIPS:
+        return best, est
+    for d in ("diagonal", "antidiagonal"):
+        e = _estimate(make_frame(target, d), tol)
+        est[d] = e if np.isfinite(e) else np.inf
+    diag = min(("diagonal", "antidiagonal"), key=lambda d: est[d])
+    if est[diag] * DIAGONAL_GAIN < est[best]:
+        best = diag
+    return best, est
 
 
 # ----------------------------------------------------------------------------------------------
@@ -40,16 +105,30 @@ def _strip_range(frame: _Frame, A: _Seam, B: _Seam, n: int = 49) -> tuple[float,
 def _march(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float) -> list[float]:
     """Seam positions 0 = y_0 < ... < y_N = 1 by the greedy march (module doc, step 1), balanced:
     the smallest range limit that still gives N strips (bisection, 6 steps), so the last strip is
-    not a narrow remainder."""
+    not a narrow remainder. The frame's :meth:`~_Frame.breaks` (the diagonal frame's y = 1/2) are
+    seams: each piece between them is marched on its own."""
+    cuts = [0.0, *frame.breaks(), 1.0]
+    ys = [0.0]
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        left = max_panels - (len(ys) - 1)
+        if left < 1:
+            return ys + [b]
+        ys += _march_piece(frame, tol, f, left, min_width, a, b)[1:]
+    return ys
+
+
+def _march_piece(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float, y_start: float,
+                 y_end: float) -> list[float]:
+    """:func:`_march` from ``y_start`` to ``y_end``."""
     limit = 2 * tol * f
-    ys = _greedy(frame, limit, max_panels, min_width)
+    ys = _greedy(frame, limit, max_panels, min_width, y_start, y_end)
     n = len(ys) - 1
     if n <= 1 or n > max_panels:
         return ys
     lo, hi = limit * ((n - 1) / n) ** 2 * 0.9, limit
     for _ in range(6):
         mid = 0.5 * (lo + hi)
-        cand = _greedy(frame, mid, n, min_width)
+        cand = _greedy(frame, mid, n, min_width, y_start, y_end)
         if len(cand) - 1 <= n:
             hi, ys = mid, cand
         else:
@@ -57,10 +136,12 @@ def _march(frame: _Frame, tol: float, f: float, max_panels: int, min_width: floa
     return ys
 
 
-def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float) -> list[float]:
-    """The greedy march with the deviation range ``limit`` (stops after ``max_panels + 1`` strips)."""
-    ys = [0.0]
-    while ys[-1] < 1.0:
+def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float, y_start: float = 0.0,
+            y_end: float = 1.0) -> list[float]:
+    """The greedy march with the deviation range ``limit`` from ``y_start`` to ``y_end`` (stops
+    after ``max_panels + 1`` strips)."""
+    ys = [y_start]
+    while ys[-1] < y_end:
         y0 = ys[-1]
         A = _Seam(frame, y0)
 
@@ -68,18 +149,18 @@ def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float) -> l
             lo, hi = _strip_range(frame, A, _Seam(frame, y1))
             return hi - lo <= limit
 
-        if ok(1.0):
-            ys.append(1.0)
+        if ok(y_end):
+            ys.append(y_end)
             break
-        lo_y, hi_y = y0, 1.0
-        while hi_y - lo_y > max(1e-3 * (1.0 - y0), 1e-9):
+        lo_y, hi_y = y0, y_end
+        while hi_y - lo_y > max(1e-3 * (y_end - y0), 1e-9):
             mid = 0.5 * (lo_y + hi_y)
             if ok(mid):
                 lo_y = mid
             else:
                 hi_y = mid
         nxt = max(lo_y, y0 + min_width)
-        ys.append(min(nxt, 1.0))
+        ys.append(min(nxt, y_end))
         if len(ys) - 1 > max_panels:
             break
     return ys

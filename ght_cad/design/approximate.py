@@ -239,13 +239,11 @@ def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = 
     sc = ax.scatter(uv[:, 0], uv[:, 1], c=d, s=6, cmap="coolwarm", vmin=-lim, vmax=lim)
     fig.colorbar(sc, ax=ax, label="deviation (panel - target, along the normal)")
     u0, u1, v0, v1 = result.info.get("bounds", (uv[:, 0].min(), uv[:, 0].max(), uv[:, 1].min(), uv[:, 1].max()))
-    for s in result.seams:
-        if result.direction == "v":
-            y = v0 + s["y"] * (v1 - v0)
-            ax.plot([u0, u1], [y, y], "k-", lw=0.6)
-        else:
-            x = u0 + s["y"] * (u1 - u0)
-            ax.plot([x, x], [v0, v1], "k-", lw=0.6)
+    from ..approximation.frame import strip_uv
+
+    for s in result.seams:  # every seam is a segment in (u, v), a point at a box corner
+        su, sv = strip_uv(result.direction, (u0, u1, v0, v1), np.array([0.0, 1.0]), np.full(2, s["y"]))
+        ax.plot(su, sv, "k-", lw=0.6)
     ax.set_xlabel("u")
     ax.set_ylabel("v")
     ax.set_title(title or f"{len(result.panels)} panels, max deviation {result.max_deviation:.4g} (tol {result.tol:g})")
@@ -291,21 +289,21 @@ def approximation_report(result: Any, pattern: Any = None, *, name: str = "targe
 def panel_sheets(result: Any, target: Any, sheet: Any) -> list[Any] | None:
     r"""Per panel the sheet whose ``side`` is measured on the TARGET's normal ``n = S_u × S_v / |..|``
     (None without a sheet or with T = 0). A panel's own normal ``X_u × X_v`` (``X = a + v (b - a)``)
-    can point the other way: the strips run along the target's u or v (``direction``), and a cone
+    can point the other way: the strips run along the target's u, v or a diagonal (``direction``), and a cone
     panel with its apex on the strip's first seam has its rail as ``a``; where
     ``n · (X_u × X_v) < 0`` at the panel's middle (``u = v = 1/2``, the target at the middle of its
     strip) the panel gets :meth:`ght_cad.sheet.Sheet.flipped`, so ``side = "normal"`` puts the
     material of every panel on the target's normal side."""
     if sheet is None or sheet.is_zero:
         return None
+    from ..approximation.frame import strip_uv
+
     u0, u1, v0, v1 = target.bounds
     out = []
     for p in result.panels:
         part = p.exact if p.exact is not None else p.surface
-        y = 0.5 * (p.y0 + p.y1)
-        u, v = (u0 + (u1 - u0) * y, v0 + 0.5 * (v1 - v0)) if result.direction == "u" else \
-            (u0 + 0.5 * (u1 - u0), v0 + (v1 - v0) * y)
-        _, Su, Sv = target.jet(np.array([u]), np.array([v]), 1)
+        u, v = strip_uv(result.direction, target.bounds, np.array([0.5]), np.array([0.5 * (p.y0 + p.y1)]))
+        _, Su, Sv = target.jet(u, v, 1)
         a, b = part.a(np.array([0.5])), part.b(np.array([0.5]))
         xu = 0.5 * (part.a(np.array([0.5]), 1) + part.b(np.array([0.5]), 1))
         sign = float(np.dot(np.cross(Su[0] * (u1 - u0), Sv[0] * (v1 - v0)), np.cross(xu[0], b[0] - a[0])))

@@ -33,8 +33,9 @@ RAILS_OBJECTIVES = ("fan_share", "fairness", "regression", "weighted")
 SURFACE_TYPES = ("planes", "curves", "rails", "composite", "approximate")
 
 
-#: the parameter the rulings of an ``approximate`` surface run along (:func:`ght_cad.approximate`)
-APPROX_DIRECTIONS = ("auto", "u", "v")
+#: the strips of an ``approximate`` surface: the parameter the rulings run along, or seams along the
+#: diagonals of the parameter box (= :data:`ght_cad.approximation.DIRECTIONS`)
+APPROX_DIRECTIONS = ("auto", "u", "v", "diagonal", "antidiagonal")
 
 
 #: how each strip of an ``approximate`` surface is fitted (:func:`ght_cad.approximate` ``method``):
