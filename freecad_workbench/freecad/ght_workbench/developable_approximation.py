@@ -70,7 +70,8 @@ def _core_choices(name: str, default: tuple[str, ...]) -> list[str]:
     return list(getattr(core, name, default))
 
 
-#: the parameter the rulings run along: the choices the core accepts (``ght_cad.approximation.DIRECTIONS``)
+#: the parameter the rulings run along (u, v) or seams along the isolines of u+v / u-v of the parameter box
+#: (diagonal, antidiagonal): the choices the core accepts (``ght_cad.approximation.DIRECTIONS``)
 DIRECTIONS = _core_choices("DIRECTIONS", ("auto", "u", "v"))
 #: how each strip is fitted (ght_cad.approximate's ``method``): the closer of both, the rails loft, the dual fit
 METHODS = _core_choices("METHODS", ("auto", "loft", "dual"))
@@ -256,7 +257,7 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.addProperty("App::PropertyFloatList", "PanelMaxIn", "Result", "Per panel: largest deviation inside the target")
         obj.addProperty("App::PropertyFloatList", "PanelThetaMax", "Result", "Per panel: developability θ_max in degrees (round-off expected)")
         obj.addProperty("App::PropertyFloatList", "PanelAreas", "Result", "Per panel: 3-D area")
-        obj.addProperty("App::PropertyString", "DirectionUsed", "Result", "The parameter the rulings run along (u or v)")
+        obj.addProperty("App::PropertyString", "DirectionUsed", "Result", "The strip direction used (u, v, diagonal or antidiagonal)")
         obj.addProperty("App::PropertyString", "Report", "Result", "Summary of the approximation")
         self.restored(obj)
 
