@@ -159,7 +159,7 @@ def test_inline_targets_evaluate_the_patch_and_degenerate_nets_are_refused() -> 
 def test_run_refusals_exit_2_with_one_line(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     # a bad value, and a STEP target that does not exist (found at build time): exit 2, one line,
     # naming the file and the key; nothing written
-    for data, key in ((_variant(direction="diagonal"), "surfaces[0].direction"),
+    for data, key in ((_variant(direction="sideways"), "surfaces[0].direction"),
                       ({**copy.deepcopy(BASE), "surfaces": [{"type": "approximate", "tol": 1.0,
                                                              "target": {"step": "missing.step"}}]},
                        "surfaces[0].target.step")):
