@@ -11,7 +11,7 @@ import pytest
 
 from ght_cad.approximation import (DIRECTIONS, SurfaceTarget, _choose_direction, _DiagonalFrame, _estimate,
                                    _estimate_curvature, _march, approximate, make_frame, strip_uv)
-from ght_cad.errors import GHTError
+from ght_cad.core.errors import GHTError
 
 L = 2000.0
 
@@ -199,7 +199,7 @@ def test_direction_values_everywhere():
 
 def test_no_developable_between_the_seams_is_a_ght_error(monkeypatch):
     import ght_cad.approximation as A
-    from ght_cad.errors import NotDevelopableError
+    from ght_cad.core.errors import NotDevelopableError
 
     def refuse(frame, a, b):
         raise NotDevelopableError("F has no zero between the rails")
