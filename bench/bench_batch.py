@@ -121,7 +121,7 @@ def _peaks_mb() -> tuple[float, float]:
 
 def case_faces(step: str, jobs: int) -> dict[str, Any]:
     """One measurement in this process: unroll_step of a STEP file (imports done before the clock)."""
-    import ght_cad.batch  # noqa: F401 - the modules the workers fork with
+    import ght_cad.app.batch  # noqa: F401 - the modules the workers fork with
     from ght_cad.design import unroll_step
 
     unroll_step(Path(step), faces=[1])  # loads OCP, scipy and the unroll code
@@ -137,7 +137,7 @@ def case_faces(step: str, jobs: int) -> dict[str, Any]:
 
 def case_sweep(n: int, jobs: int) -> dict[str, Any]:
     """One measurement in this process: a sweep of n variants through run_batch (modules preloaded)."""
-    from ght_cad.batch import preload_run_modules, run_batch
+    from ght_cad.app.batch import preload_run_modules, run_batch
 
     preload_run_modules()
     base = _start_peak()
@@ -182,7 +182,7 @@ def _load() -> str:
 
 def bench_jobs(n_designs: int) -> float:
     """Best-of-two wall times of run_batch with jobs 1 and 2 on the same designs; returns the ratio."""
-    from ght_cad.batch import preload_run_modules, run_batch
+    from ght_cad.app.batch import preload_run_modules, run_batch
 
     load0 = _load()
     with tempfile.TemporaryDirectory() as tmp:

@@ -93,6 +93,7 @@ _MOVED: dict[str, str] = {
                                         "progress", "step_guard", "_kernel", "outdir")},
     **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
     **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
+    **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
 }
 
 _lazy_name = lazy_getattr(__name__, _LAZY, globals())

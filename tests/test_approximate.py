@@ -247,7 +247,7 @@ def test_hull_side():
 @pytest.mark.slow
 def test_cli_approximate(tmp_path):
     from ght_cad.cad.occ import write_step
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     step = write_step(cap_face(), tmp_path / "cap.step")
     out = tmp_path / "out"

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "design_approximate_facade.toml"
 
@@ -32,7 +32,7 @@ def _poles() -> np.ndarray:
 
 def _facade_step(tmp_path: Path) -> Path:
     pytest.importorskip("OCP")
-    from ght_cad.bspline import BSplineSurfaceData
+    from ght_cad.surfaces.bspline import BSplineSurfaceData
     from ght_cad.cad.occ import make_face, write_step
 
     k = np.array([0.0, 0, 0, 1, 1, 1])
@@ -42,7 +42,7 @@ def _facade_step(tmp_path: Path) -> Path:
 def test_choices_come_from_the_design_constants(capsys: pytest.CaptureFixture) -> None:
     """--direction and --method offer exactly APPROX_DIRECTIONS / APPROX_METHODS (what design files
     and the FreeCAD feature offer); a bad one: exit 2, one line naming the option and the choices."""
-    from ght_cad.cli import build_parser
+    from ght_cad.app.cli import build_parser
     from ght_cad.design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
     sub = next(a for a in build_parser()._actions if a.dest == "command").choices["approximate"]

@@ -27,8 +27,8 @@ import pytest
 
 from cone_designs import cone_area, cone_design
 
-from ght_cad.batch import run_batch
-from ght_cad.cli import main
+from ght_cad.app.batch import run_batch
+from ght_cad.app.cli import main
 
 pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]  # process pools and dask clusters
 
@@ -154,7 +154,7 @@ def test_batch_local_worker_killed(designs, tmp_path):
     out = tmp_path / "out"
     tmpdir = tmp_path / "tmp"
     tmpdir.mkdir()
-    proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
+    proc = subprocess.Popen([sys.executable, "-m", "ght_cad.app.cli", "batch", *map(str, good), "--out", str(out),
                              "--jobs", "2", "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "TMPDIR": str(tmpdir)})
     index, pid = _running_marker(tmpdir)
@@ -169,7 +169,7 @@ def test_batch_local_worker_killed(designs, tmp_path):
     assert not list(tmpdir.glob("ght-cad-batch*"))  # markers and workers' folders (the killed one's too) removed
 
 
-from ght_cad.batch import run_task  # noqa: E402 - the real one (the test below patches the module's)
+from ght_cad.app.batch import run_task  # noqa: E402 - the real one (the test below patches the module's)
 
 
 def crash_on_cone_03(task):
@@ -184,7 +184,7 @@ def crash_on_cone_03(task):
 def test_batch_local_design_that_always_kills_its_worker(designs, tmp_path, monkeypatch):
     """A design whose worker dies every time: reported failed after MAX_ATTEMPTS deaths, the design
     running beside it (terminated by the pool) is run again without counting, all others exact."""
-    import ght_cad.batch as gb
+    import ght_cad.app.batch as gb
 
     paths, areas = designs
     good = [p for p in paths if p.stem != "broken"][:5]
@@ -304,7 +304,7 @@ def test_batch_dask_worker_killed(designs, dask_cluster, tmp_path):
     out = tmp_path / "out"
     with Client(address, timeout="30s") as client:
         victim = next(a for a, pid in client.run(os.getpid).items() if pid == procs[1].pid)
-        proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
+        proc = subprocess.Popen([sys.executable, "-m", "ght_cad.app.cli", "batch", *map(str, good), "--out", str(out),
                                  "--scheduler", address, "--no-progress"], stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True)
         held = _kill_running_worker(client, victim, procs[1])
@@ -327,7 +327,7 @@ def test_batch_dask_worker_killed_no_retry(designs, tmp_path):
     with start_cluster(tmp_path, {"DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}) as (address, procs):
         with Client(address, timeout="30s") as client:
             victim = next(a for a, pid in client.run(os.getpid).items() if pid == procs[1].pid)
-            proc = subprocess.Popen([sys.executable, "-m", "ght_cad.cli", "batch", *map(str, good), "--out", str(out),
+            proc = subprocess.Popen([sys.executable, "-m", "ght_cad.app.cli", "batch", *map(str, good), "--out", str(out),
                                      "--scheduler", address, "--no-progress"], stdout=subprocess.PIPE,
                                     stderr=subprocess.PIPE, text=True)
             seen = _kill_running_worker(client, victim, procs[1])
@@ -410,7 +410,7 @@ def test_batch_sweep_of_a_plated_two_surface_design(tmp_path):
 
 
 def test_sweep_expansion_grid_zip_and_errors():
-    from ght_cad.sweep import SweepError, expand_sweep
+    from ght_cad.app.sweep import SweepError, expand_sweep
 
     base = {"name": "d", "surface": {"gamma": -1.0, "planes": [[1, 2, 3, 4]]}, "unroll": {"rulings": 12}}
     sw = expand_sweep({**base, "sweep": {"surface.gamma": [-1, 0], "unroll.rulings": {"start": 8, "stop": 16, "step": 4}}})
@@ -434,7 +434,7 @@ def test_sweep_expansion_grid_zip_and_errors():
 def test_pattern_error_is_the_largest_relative_error_not_the_angle() -> None:
     """``pattern_error`` is the pattern's relative ``max``; ``angle_deg`` (degrees, the metric
     check's difference residual, e.g. 3e-9 on a sheet's neutral surface) is not a relative error."""
-    from ght_cad.batch import _figures
+    from ght_cad.app.batch import _figures
 
     errors = {"boundary_length": 1.2e-16, "ruling_length": 2.5e-16, "area": 1.8e-16, "angle_deg": 3.1e-9, "max": 2.5e-16}
     assert _figures({"flat_pattern": {"errors": errors}})["pattern_error"] == 2.5e-16

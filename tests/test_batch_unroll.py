@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 from ght_cad.design import unroll_step
 from ght_cad.core.errors import NotDevelopableError
 

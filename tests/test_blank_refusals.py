@@ -22,7 +22,7 @@ from sheet_parts import crossed_flanges, spherical_shell, square_bar  # noqa: E4
 import ght_cad  # noqa: E402
 from ght_cad.blank import BlankError  # noqa: E402
 from ght_cad.cad.occ import write_step  # noqa: E402
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 
 pytestmark = pytest.mark.slow  # booleans of build123d solids, STEP round trips (~5-20 s each on a loaded machine)
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 from ght_cad.core.errors import GHTError
 
 from dxf_read import dxf_outline_areas, outline_bulges, outline_entities, outline_vertices, svg_outline_areas
@@ -130,7 +130,7 @@ def test_bad_chord_tol_option_is_refused(command: str, value: str, tmp_path: Pat
 
 def test_run_batch_refuses_a_bad_chord_tol(tmp_path: Path) -> None:
     """The API: ``run_batch(chord_tol=...)`` not > 0 or not finite raises GHTError naming it."""
-    from ght_cad.batch import run_batch
+    from ght_cad.app.batch import run_batch
 
     design = hopper_design(tmp_path / "h.toml")
     for bad in (0.0, -1.0, math.nan, math.inf):

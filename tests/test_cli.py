@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.cli import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, build_parser, main
+from ght_cad.app.cli import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, build_parser, main
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 COMMANDS = ["demo", "run", "curve", "surface", "optimize", "unroll", "export", "plot-basis", "batch", "approximate"]
@@ -41,7 +41,7 @@ def cone(tmp_path: Path) -> Path:
 def test_help_of_every_command_is_fast_and_light() -> None:
     """`--help` does not import matplotlib, scipy or a CAD kernel."""
     code = (
-        "import sys\nfrom ght_cad.cli import main\n"
+        "import sys\nfrom ght_cad.app.cli import main\n"
         f"for c in {COMMANDS!r}:\n"
         "    try:\n        main([c, '--help'])\n    except SystemExit as e:\n        assert e.code == 0, (c, e.code)\n"
         "heavy = [m for m in ('matplotlib', 'scipy', 'OCP', 'build123d', 'cadquery') if m in sys.modules]\n"
@@ -320,7 +320,7 @@ def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
     from pathlib import Path
 
     import ght_cad.design as design_mod
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     duct = Path(__file__).resolve().parents[1] / "examples" / "design_duct.toml"
     dxf, svg, png = tmp_path / "p.dxf", tmp_path / "p.svg", tmp_path / "p.png"
@@ -341,7 +341,7 @@ def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
 
 @pytest.fixture
 def python_sigint_handler():
-    """Python's own Ctrl-C handler during the test (the one :func:`ght_cad.cli._watch_sigint` wraps),
+    """Python's own Ctrl-C handler during the test (the one :func:`ght_cad.app.cli._watch_sigint` wraps),
     the inherited one restored after: a pytest started in the background by a non-interactive shell
     (``pytest &``) inherits SIGINT ignored, which the CLI rightly keeps ignored (the test below then
     failed with exit 1: the kill never arrived)."""
@@ -359,7 +359,7 @@ def test_ctrl_c_that_surfaces_as_another_error_still_exits_130(monkeypatch, caps
     import os
     import signal
 
-    from ght_cad import cli
+    from ght_cad.app import cli
 
     def interrupted_import(args):
         try:

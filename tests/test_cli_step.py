@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 from ght_cad.surfaces.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face, write_step
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 from ght_cad.design import unroll_step
 from ght_cad.developable import CompositeDevelopable, developable_from_planes, join_developable
 
@@ -223,11 +223,11 @@ def test_full_sphere_is_refused_even_with_best_effort(tmp_path: Path, capsys) ->
 
 
 def _cli_json(argv: list[str]) -> tuple[int, dict, str]:
-    """Run ``python -m ght_cad.cli ARGV --json`` in a subprocess; stdout must be exactly one JSON object."""
+    """Run ``python -m ght_cad.app.cli ARGV --json`` in a subprocess; stdout must be exactly one JSON object."""
     import subprocess
     import sys
 
-    proc = subprocess.run([sys.executable, "-m", "ght_cad.cli", *argv, "--json"], capture_output=True, text=True,
+    proc = subprocess.run([sys.executable, "-m", "ght_cad.app.cli", *argv, "--json"], capture_output=True, text=True,
                           timeout=300)
     obj, end = json.JSONDecoder().raw_decode(proc.stdout.lstrip())
     assert not proc.stdout.lstrip()[end:].strip(), f"more than one JSON object on stdout: {proc.stdout!r}"

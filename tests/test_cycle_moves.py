@@ -18,10 +18,10 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_batch_step_names_resolve_from_batch() -> None:
     """Cycle batch -> design -> design.step_input -> batch: the parallel STEP unroll moved into
     ``ght_cad.design.step_input``, the worker helpers into ``ght_cad.core.workers``."""
-    import ght_cad.batch as batch
+    import ght_cad.app.batch as batch
     import ght_cad.design.step_input as step_input
     import ght_cad.core.workers as workers
-    from ght_cad.batch import map_step_faces
+    from ght_cad.app.batch import map_step_faces
 
     assert map_step_faces is step_input.map_step_faces is batch.map_step_faces
     assert "map_step_faces" in batch.__all__
@@ -30,9 +30,9 @@ def test_batch_step_names_resolve_from_batch() -> None:
 
 
 def test_importing_batch_does_not_load_the_design_package() -> None:
-    """``ght_cad.batch`` gives ``map_step_faces`` on first use only (the design package stays unloaded)."""
+    """``ght_cad.app.batch`` gives ``map_step_faces`` on first use only (the design package stays unloaded)."""
     code = (
-        "import sys, json, ght_cad.batch as b\n"
+        "import sys, json, ght_cad.app.batch as b\n"
         "before = 'ght_cad.design' in sys.modules\n"
         "f = b.map_step_faces\n"
         "print(json.dumps([before, 'ght_cad.design.step_input' in sys.modules, f.__module__]))\n"

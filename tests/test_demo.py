@@ -46,7 +46,7 @@ def png_size(path: Path) -> tuple[int, int]:
 def demo(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, subprocess.CompletedProcess]:
     out = tmp_path_factory.mktemp("demo") / "demo-out"
     proc = subprocess.run(
-        [sys.executable, "-m", "ght_cad.cli", "demo", "--out", str(out), "--json"],
+        [sys.executable, "-m", "ght_cad.app.cli", "demo", "--out", str(out), "--json"],
         capture_output=True, text=True, timeout=600,
     )
     assert proc.returncode == 0, proc.stderr
@@ -147,7 +147,7 @@ def test_report_developability_matches_recomputation(demo) -> None:
 def test_report_optimization_is_consistent(demo) -> None:
     from ght_cad import GHTCurve
     from ght_cad.design import dual_curve_objectives, parse_design_text
-    from ght_cad.demo import default_design_text
+    from ght_cad.app.demo import default_design_text
     from ght_cad.surfaces.planes import normalize_planes
 
     _, report, _ = demo

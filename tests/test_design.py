@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 from ght_cad.design import DesignError, load_design, parse_design, parse_design_text, run_design
 
 # a small valid design: the exact quarter cone of the spec, no optimization (fast)
@@ -210,7 +210,7 @@ def test_example_designs_validate(name: str) -> None:
 
 
 def test_embedded_default_design_validates() -> None:
-    from ght_cad.demo import default_design_text
+    from ght_cad.app.demo import default_design_text
 
     d = parse_design_text(default_design_text(), "<embedded>")
     assert d.surface.type == "planes" and d.optimize is not None and len(d.joins) == 1

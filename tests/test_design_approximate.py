@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ght_cad.design import DesignError, load_design, parse_design
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 
 try:
     import tomllib

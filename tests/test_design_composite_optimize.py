@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 from ght_cad.design import (
     DesignError,
     build_surface,

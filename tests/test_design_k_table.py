@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from ght_cad.blank import K_TABLES
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 DUCT = (Path(__file__).parent.parent / "examples" / "design_duct.toml").read_text().split("[outputs]")[0]
 RHO = 200.0 * math.sqrt(5.0) / 2.0  # smallest bending radius of the cone

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("build123d")
 
-from ght_cad.cli import main
+from ght_cad.app.cli import main
 from ght_cad.design import DesignError, build_curves, load_design, optimize_design, parse_design_text
 
 from dxf_read import dxf_outline_areas

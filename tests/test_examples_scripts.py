@@ -83,7 +83,7 @@ def test_design_duct_closed_form(tmp_path: Path) -> None:
     """The duct design is an exact quarter cone frustum: its pattern is an annular sector."""
     import ezdxf
 
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     out = tmp_path / "duct"
     assert main(["run", str(EXAMPLES / "design_duct.toml"), "--out", str(out), "--no-progress"]) == 0
@@ -111,7 +111,7 @@ def test_design_duct_closed_form(tmp_path: Path) -> None:
 
 
 def test_design_hull_plate_optimizes_developability(tmp_path: Path) -> None:
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     out = tmp_path / "hull"
     assert main(["run", str(EXAMPLES / "design_hull_plate_quasi.toml"), "--out", str(out), "--no-progress"]) == 0

@@ -42,7 +42,7 @@ def _design(tmp: Path, name: str, figures: list[str]) -> Path:
 
 
 def _cmd(design: Path, out: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "ght_cad.cli", "run", str(design), "--out", str(out), "--no-progress", *extra]
+    return [sys.executable, "-m", "ght_cad.app.cli", "run", str(design), "--out", str(out), "--no-progress", *extra]
 
 
 def _env() -> dict[str, str]:

@@ -409,7 +409,7 @@ def test_cli_chord_tol(hopper_pattern: FlatPattern, tmp_path, capsys) -> None:
     """``ght-cad unroll DESIGN --dxf --svg --chord-tol 0.1`` (and ``export``) writes the outline of that tolerance
     (the vertices of :meth:`FlatPattern.outline_arcs`); ``--chord-tol 0`` is refused (exit 2, one
     line naming the option)."""
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     from dxf_read import outline_entities
 

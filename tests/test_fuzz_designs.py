@@ -1,5 +1,5 @@
 """Permanent fuzz test (issue 26): mutated example design files and a mutated STEP file through the
-command line, in this process (:func:`ght_cad.cli.main`, stdout/stderr captured).
+command line, in this process (:func:`ght_cad.app.cli.main`, stdout/stderr captured).
 
 Every case must give exit 0 with valid output, or exit 2 with ONE line on stderr naming the file and
 (for a design that parses as TOML) the key -- never a traceback, exit 1, a hang or partial output.
@@ -48,7 +48,7 @@ import pytest
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 try:
     import tomllib

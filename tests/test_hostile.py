@@ -3,7 +3,7 @@ file system works and leaves nothing behind, a read-only ``--out`` is refused wi
 without ``fcntl``, hostile STEP files give exit 2 in seconds, degenerate geometry is refused at
 construction.
 
-The ``ght-cad`` runs here call :func:`ght_cad.cli.main` in this process (a curves-only design whose
+The ``ght-cad`` runs here call :func:`ght_cad.app.cli.main` in this process (a curves-only design whose
 outputs are ``report.json`` and ``report.md``: ~0.1 s a run).
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 TINY = """
 [[curves]]

@@ -13,7 +13,7 @@ surfaces   ``ght_cad.surfaces`` (planes, B-splines, NURBS, patches, ruled surfac
 optimize   ``ght_cad.optimize`` (optimizers, problems, Pareto, pipeline)
 facade     the package ``ght_cad`` itself (its ``__init__`` re-exports)
 kernel     CAD adapters: ``ght_cad.cad`` (OCP/build123d/cadquery), the FreeCAD workbench
-app        CLI, design files, batch, sweeps, demo
+app        ``ght_cad.app`` (CLI, batch, sweeps, demo, STEP unfold); command handlers, design files
 =========  ====================================================================================
 
 A module is in the layer of its first package below ``ght_cad`` (:data:`_LAYER_OF`). The old
@@ -56,7 +56,7 @@ _LAYER_OF = {
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],
     "kernel": ["cad"],
-    "app": ["cli", "commands", "design", "batch", "sweep", "demo", "approximate_cli", "unfold_step"],
+    "app": ["app", "commands", "design", "approximate_cli"],
 }
 
 #: The core's one way to the kernel layer: ``ght_cad.core._kernel.load_kernel`` imports ``ght_cad.cad``,

@@ -36,7 +36,7 @@ figures = ["flat_pattern"]
 
 def _core_only(argv: list[str], cwd: Path, blocked: str = "OCP,build123d,cadquery") -> subprocess.CompletedProcess:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(BLOCKER), str(ROOT)]), GHT_BLOCK_MODULES=blocked)
-    return subprocess.run([sys.executable, "-m", "ght_cad.cli", *argv], cwd=cwd, env=env, capture_output=True,
+    return subprocess.run([sys.executable, "-m", "ght_cad.app.cli", *argv], cwd=cwd, env=env, capture_output=True,
                           text=True, timeout=300)
 
 
@@ -87,7 +87,7 @@ def test_core_only_kernel_commands_exit_2_naming_the_extra(tmp_path: Path, argv:
 
 def test_step_product_is_named_after_the_design(tmp_path: Path) -> None:
     pytest.importorskip("build123d")  # a design run's B-rep
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
     from ght_cad.cad.occ import read_step_products
 
     design = tmp_path / "cone.toml"
@@ -233,7 +233,7 @@ def test_core_and_run_in_debian_freecad_python(tmp_path: Path) -> None:
     env["PYTHONPATH"] = str(ROOT)
     design = tmp_path / "cone.toml"
     design.write_text(CONE.format(files='"dxf", "svg", "json"'))
-    res = subprocess.run([py, "-s", "-m", "ght_cad.cli", "run", str(design), "--out", str(tmp_path / "out"), "--no-progress"],
+    res = subprocess.run([py, "-s", "-m", "ght_cad.app.cli", "run", str(design), "--out", str(tmp_path / "out"), "--no-progress"],
                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert res.returncode == 0, res.stderr[-2000:]
     for name in ("flat_pattern.dxf", "flat_pattern.svg", "report.json"):
@@ -241,6 +241,6 @@ def test_core_and_run_in_debian_freecad_python(tmp_path: Path) -> None:
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert "skipped" in report["brep"] and report["flat_pattern"]["area"] > 0
     design.write_text(CONE.format(files='"step", "dxf"'))
-    res = subprocess.run([py, "-s", "-m", "ght_cad.cli", "run", str(design), "--out", str(tmp_path / "out2")],
+    res = subprocess.run([py, "-s", "-m", "ght_cad.app.cli", "run", str(design), "--out", str(tmp_path / "out2")],
                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert res.returncode == 2 and "pip install 'ght_cad[build123d]'" in res.stderr, res.stderr

@@ -78,3 +78,22 @@ def test_monkeypatching_the_old_path_patches_the_moved_module(monkeypatch: pytes
     from ght_cad.errors import GHTError as OldGHTError
 
     assert OldGHTError is GHTError
+
+
+def test_python_m_old_cli_path_still_runs_the_command_line() -> None:
+    """``python -m ght_cad.cli`` (the shim run as ``__main__``) runs ``main`` as before the move."""
+    if ght_cad._MOVED.get("cli") is None:
+        pytest.skip("ght_cad.cli has not moved")
+    for module in ("ght_cad.cli", ght_cad._MOVED["cli"]):
+        out = subprocess.run([sys.executable, "-m", module, "--version"], capture_output=True, text=True, cwd=ROOT)
+        assert out.returncode == 0 and out.stdout.strip() == f"ght-cad {ght_cad.__version__}", (module, out)
+
+
+def test_console_entry_point_names_the_moved_cli() -> None:
+    """pyproject's ``ght-cad`` entry point names the module that defines ``main``."""
+    import tomllib
+
+    target = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["scripts"]["ght-cad"]
+    module, _, function = target.partition(":")
+    main = getattr(importlib.import_module(module), function)
+    assert callable(main) and main.__module__ == module, target

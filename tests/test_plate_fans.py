@@ -343,7 +343,7 @@ def _hull_design(tmp_path: Path, side: str, swap: bool = False) -> Path:
 @pytest.mark.slow
 @pytest.mark.parametrize("side, swap", [("normal", False), ("reverse", True)])
 def test_run_hull_plate_with_fans(tmp_path, capsys, side: str, swap: bool) -> None:
-    from ght_cad.cli import EXIT_OK, main
+    from ght_cad.app.cli import EXIT_OK, main
 
     design = _hull_design(tmp_path, side, swap)
     text = design.read_text()
@@ -364,7 +364,7 @@ def test_run_hull_plate_with_fans(tmp_path, capsys, side: str, swap: bool) -> No
 
 
 def test_run_hull_plate_on_the_concave_side_is_refused(tmp_path, capsys) -> None:
-    from ght_cad.cli import EXIT_USAGE, main
+    from ght_cad.app.cli import EXIT_USAGE, main
 
     out = tmp_path / "out"
     rc = main(["run", str(_hull_design(tmp_path, "reverse")), "--out", str(out)])

@@ -202,7 +202,7 @@ def test_pointed_plate_step_names_and_readers(tmp_path) -> None:
 # -- the design run --------------------------------------------------------------------------------
 @pytest.mark.slow
 def test_run_bow_plate_with_a_sheet(tmp_path, capsys) -> None:
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     out = tmp_path / "out"
     assert main(["run", str(BOW_TOML), "--out", str(out)]) == 0
@@ -222,7 +222,7 @@ def test_run_plated_skiff_with_a_pointed_side_panel(tmp_path, capsys) -> None:
     """Two surfaces, the side loft pointed at the bow, one [sheet] (examples/design_skiff_plated.toml):
     the shell orientation asks the pointed loft for a, a', a'' on parameters near and far from the
     corner in turn (cached derivative lists of different lengths once broke the split: IndexError)."""
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     out = tmp_path / "out"
     path = Path(__file__).resolve().parents[1] / "examples" / "design_skiff_plated.toml"
@@ -246,7 +246,7 @@ def test_unroll_step_of_a_plain_pointed_loft(tmp_path, capsys) -> None:
     zero ruling (θ_max 4.4° there refused the face before); the face unrolls with the fit's
     distortion (errors max <= 1e-7, measured 5e-9), the ruling lengths measured against a floor
     of 1e-6 of the longest ruling."""
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     text = (Path(__file__).resolve().parents[1] / "examples" / "design_skiff_plated.toml").read_text()
     start = text.index("\n[sheet]\n")

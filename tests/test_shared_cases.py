@@ -2,7 +2,7 @@
 each gives exit 0 with valid output, or exit 2 with ONE line on stderr naming the file and the key and
 no warning before it. Skipped only when that folder is absent (a checkout without the shared cases).
 
-Each file is run through :func:`ght_cad.cli.main` in this process (stdout/stderr captured; Python
+Each file is run through :func:`ght_cad.app.cli.main` in this process (stdout/stderr captured; Python
 warnings recorded as errors would be, so a numpy RuntimeWarning before the line fails the test).
 """
 
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 CASES = Path(__file__).resolve().parents[1] / ".." / "shared" / "cases" / "design-files"
 FILES = sorted(CASES.glob("*.toml")) if CASES.is_dir() else []

@@ -15,7 +15,7 @@ import ezdxf  # noqa: E402
 
 from ght_cad.cad.occ import write_step  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_solid, write_plate_step  # noqa: E402
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 from ght_cad.sheet import Sheet  # noqa: E402
 
 R, H, T, K = 240.0, 100.0, 4.0, 0.42
@@ -94,7 +94,7 @@ def test_bad_sheet_values_exit_2_and_write_nothing(files, capsys, tmp_path, opts
 
 
 def test_sheet_flags_on_a_design_file_are_refused(capsys, tmp_path) -> None:
-    from ght_cad.demo import default_design_text
+    from ght_cad.app.demo import default_design_text
 
     p = tmp_path / "d.toml"
     p.write_text(default_design_text())

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 R, H, T, K = 240.0, 100.0, 4.0, 0.42
 

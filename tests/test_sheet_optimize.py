@@ -17,7 +17,7 @@ import pytest
 
 pytest.importorskip("build123d")
 
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 from ght_cad.design import (SHEET_MARGIN, build_curves, build_surface, check_sheet, optimize_design,  # noqa: E402
                             parse_design_text, sheet_parts, thickness_factor)
 from ght_cad.design.optimize import _SheetGuard, _objective_fn, _value_and_grad_fn, composite_objective  # noqa: E402

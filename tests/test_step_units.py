@@ -57,7 +57,7 @@ def test_design_step_declares_the_design_units_and_reads_back_at_true_size(tmp_p
     import json
     from pathlib import Path
 
-    from ght_cad.cli import main
+    from ght_cad.app.cli import main
 
     root = Path(__file__).resolve().parents[1]
     design = (root / "examples" / "design_duct.toml").read_text().replace('units = "mm"', 'units = "ft"')

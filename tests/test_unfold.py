@@ -21,7 +21,7 @@ from sheet_parts import Profile, bracket, profile_solid, u_channel, z_profile  #
 import ght_cad  # noqa: E402
 from ght_cad.blank import K_TABLES, BlankError, k_factor_table  # noqa: E402
 from ght_cad.cad.occ import write_step  # noqa: E402
-from ght_cad.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
+from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 
 K = 0.42
 HOLE = [(1, 30.0, 10.0)]  # a 10 mm hole in the U-channel's base

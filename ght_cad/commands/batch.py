@@ -1,6 +1,6 @@
 """``ght-cad batch``: many design files, one output folder each.
 
-Moved from :mod:`ght_cad.cli` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from .common import _chord_tol, dumps, EXIT_OK, PROG, UsageError
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
-    """``ght-cad batch``: :func:`ght_cad.batch.run_batch`; exit 0 all ok, 2 any bad input, 1 any failed."""
-    from ..batch import run_batch
+    """``ght-cad batch``: :func:`ght_cad.app.batch.run_batch`; exit 0 all ok, 2 any bad input, 1 any failed."""
+    from ..app.batch import run_batch
 
     if args.jobs is not None and args.scheduler:
         raise UsageError("--jobs and --scheduler exclude each other: --jobs runs local processes, "

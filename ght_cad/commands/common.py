@@ -1,7 +1,7 @@
 """What the ``ght-cad`` subcommands share: exit codes, the usage error, JSON output, argument
 parsers for points and paths, staged output files and the report text.
 
-Moved from :mod:`ght_cad.cli` (issue 27; every name stays importable from there). :mod:`ght_cad.batch`
+Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there). :mod:`ght_cad.app.batch`
 and :mod:`ght_cad.approximate_cli` take :func:`dumps` from here (not from the CLI that runs them).
 """
 

@@ -1,6 +1,6 @@
 """``ght-cad demo``, ``run``, ``surface`` and ``optimize``: the design-file commands.
 
-Moved from :mod:`ght_cad.cli` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ def _load(args: argparse.Namespace) -> Any:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    """``ght-cad demo``: :func:`ght_cad.demo.run_demo` into ``--out``."""
-    from ..demo import run_demo
+    """``ght-cad demo``: :func:`ght_cad.app.demo.run_demo` into ``--out``."""
+    from ..app.demo import run_demo
 
     report = run_demo(args.out, progress=not args.no_progress, quick=args.quick, chord_tol=_chord_tol(args),
                       **_wait_args(args))

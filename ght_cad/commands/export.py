@@ -1,6 +1,6 @@
 """``ght-cad export``.
 
-Moved from :mod:`ght_cad.cli` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

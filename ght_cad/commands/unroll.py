@@ -1,6 +1,6 @@
 """``ght-cad unroll``: a design's surfaces, or the faces and sheet solids of a STEP file, to flat patterns.
 
-Moved from :mod:`ght_cad.cli` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ def _unroll_step(args: argparse.Namespace) -> int:
                                  ("--bend-lines", args.bend_lines), ("--allow-split", args.allow_split or None),
                                  ("--plate-step", args.plate_step)) if v is not None]
     if not args.face and not args.best_effort and args.jobs is None and not args.scheduler:
-        from ..unfold_step import unfold_step
+        from ..app.unfold_step import unfold_step
 
         blanks = unfold_step(args.design, units=args.units, thickness=args.thickness, k_factor=args.k_factor,
                              din_k_factor=args.din_k_factor, k_factor_table=args.k_factor_table,
@@ -170,7 +170,7 @@ def _unroll_step(args: argparse.Namespace) -> int:
 
 
 def _emit_blanks(args: argparse.Namespace, res: Any) -> int:
-    """Report and files of ``ght-cad unroll`` on sheet solids (:func:`ght_cad.unfold_step.unfold_step`)."""
+    """Report and files of ``ght-cad unroll`` on sheet solids (:func:`ght_cad.app.unfold_step.unfold_step`)."""
     if args.side is not None:
         raise UsageError("--side does not apply to a sheet solid (its material side is the solid's own)")
     unf = res.unfolded

@@ -55,9 +55,9 @@ def parse_design(data: dict[str, Any], source: str = "<design>") -> Design:
     ck = _Checker(source)
     if not isinstance(data, dict):
         raise DesignError(f"{source}: the document must be a TOML table")
-    if isinstance(data.get("sweep"), dict):  # expanded into variants by ght-cad batch (ght_cad.sweep)
+    if isinstance(data.get("sweep"), dict):  # expanded into variants by ght-cad batch (ght_cad.app.sweep)
         raise ck.fail("sweep", f"a [sweep] table is expanded into variants by 'ght-cad batch {source} --out DIR' "
-                               "(ght_cad.sweep.expand_sweep); allowed here: a design without [sweep]")
+                               "(ght_cad.app.sweep.expand_sweep); allowed here: a design without [sweep]")
     ck.keys(data, "", _TOP_KEYS)
     default_name = Path(source).stem if not source.startswith("<") else "design"
     name = ck.string(data, "name", "", default_name or "design")
