@@ -198,7 +198,7 @@ def test_degree_3000_evaluates_without_overflow() -> None:
     partition of unity (1e-11) and interpolation, and matches the direct path where both work."""
     import importlib
 
-    B, C = importlib.import_module("ght_cad.basis"), importlib.import_module("ght_cad.curves.curve")
+    B, C = importlib.import_module("ght_cad.curves.basis"), importlib.import_module("ght_cad.curves.curve")
 
     n = 3000
     x = np.linspace(0.0, 1.0, n)

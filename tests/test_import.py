@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_core_import_does_not_load_cad_or_plotting() -> None:
     code = (
-        "import sys, json, ght_cad, ght_cad.basis, ght_cad.curves.curve, ght_cad.surfaces.ruled, ght_cad.surfaces.bspline; "
+        "import sys, json, ght_cad, ght_cad.curves.basis, ght_cad.curves.curve, ght_cad.surfaces.ruled, ght_cad.surfaces.bspline; "
         "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
