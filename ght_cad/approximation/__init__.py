@@ -188,7 +188,8 @@ def approximate(
     if direction == "auto":
         direction, est = _choose_direction(tgt, tol)
         info["estimate"] = est
-        say(f"direction: {direction} (estimated strips {est})")
+        what = f"rulings along {direction}" if direction in ("u", "v") else f"seams along the {direction} of the box"
+        say(f"direction: {what} (estimated strips " + ", ".join(f"{k} {v:.3g}" for k, v in est.items()) + ")")
     frame = make_frame(tgt, direction)
     tol = float(tol)
     best: tuple[float, int] | None = None

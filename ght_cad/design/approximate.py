@@ -250,12 +250,17 @@ def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = 
     return _save(fig, path)
 
 
+def _direction_text(direction: str) -> str:
+    """``rulings along u`` / ``v``, ``seams along the diagonal`` / ``antidiagonal`` (of the parameter box)."""
+    return f"rulings along {direction}" if direction in ("u", "v") else f"seams along the {direction} of the (u, v) box"
+
+
 def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
     """The report as a Markdown table (``heading``: the title's level, ``"##"`` inside a design's report)."""
     methods = [p.get("method", "loft") for p in report["panel_report"]]
     mix = ", ".join(f"{methods.count(m)} {m}" for m in ("dual", "loft") if m in methods)
     lines = [f"{heading} Developable approximation: {report.get('name', 'target')}", "",
-             f"- panels: {report['panels']} (rulings along {report['direction']})",
+             f"- panels: {report['panels']} ({_direction_text(report['direction'])})",
              f"- method: {report.get('method', 'auto')} (per strip: {mix})",
              f"- tolerance: {report['tol']:g}; largest deviation: {report['max_deviation']:.6g}",
              f"- total area: {report['total_area']:.6g}", "",
