@@ -45,9 +45,9 @@ def targets() -> dict[str, object]:
 
 def baseline_count(target: object, direction: str, tol: float, start: int) -> int:
     """Smallest N of equally spaced on-target isoline strips whose deviation is <= tol."""
-    from ght_cad.approximation import _Frame, _Seam, _strip_range
+    from ght_cad.approximation import _Seam, _strip_range, make_frame
 
-    fr = _Frame(target, direction)
+    fr = make_frame(target, direction)
 
     def ok(n: int) -> bool:
         ys = np.linspace(0.0, 1.0, n + 1)

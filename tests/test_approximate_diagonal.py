@@ -153,7 +153,9 @@ def test_conjugate_estimate_saddle_and_cap():
         assert est[d] >= 10 * est["diagonal"], est
     # the curvature-only estimate sees (almost) nothing along u and v: why the saddle failed before
     assert _estimate_curvature(make_frame(sad, "u"), tol) <= 1e-6
-    assert _choose_direction(sad, tol)[0] in ("diagonal", "antidiagonal")
+    # both diagonals tie on the symmetric saddle: "diagonal", whatever the rounding
+    assert abs(est["diagonal"] - est["antidiagonal"]) <= 1e-9 * est["diagonal"]
+    assert all(_choose_direction(sad, t)[0] == "diagonal" for t in (0.5, 1.0, 2.0, 4.0))
     # the cap in longitude/latitude (principal lines, L_xy = 0): the conjugate estimate is the
     # curvature one (1 % for the two quadratures), rulings along the meridians, no diagonals tried
     cap = sphere_cap_target()
@@ -211,3 +213,11 @@ def test_no_developable_between_the_seams_is_a_ght_error(monkeypatch):
     msg = str(err.value)
     assert "best deviation reached: none" in msg and "NotDevelopableError: F has no zero" in msg
     assert "max_panels=4" in msg and "tol=5" in msg
+
+
+def test_plain_frame_refuses_the_diagonal_directions():
+    from ght_cad.approximation import _Frame
+
+    with pytest.raises(ValueError, match="make_frame"):
+        _Frame(saddle_target(), "diagonal")
+    assert type(make_frame(saddle_target(), "u")) is _Frame

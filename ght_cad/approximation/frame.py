@@ -83,6 +83,9 @@ class _Frame:
     run along (``"v"``: x = u, y = v; ``"u"``: x = v, y = u)."""
 
     def __init__(self, target: SurfaceTarget, direction: str) -> None:
+        if direction not in ("u", "v") and not isinstance(self, _DiagonalFrame):
+            raise ValueError(f"_Frame(direction={direction!r}) is not allowed; use 'u' or 'v', or make_frame() "
+                             f"for any of {STRIP_DIRECTIONS}")
         self.t = target
         self.direction = direction
         u0, u1, v0, v1 = target.bounds

@@ -88,7 +88,8 @@ def _choose_direction(target: SurfaceTarget, tol: float) -> tuple[str, dict[str,
     for d in ("diagonal", "antidiagonal"):
         e = _estimate(make_frame(target, d), tol)
         est[d] = e if np.isfinite(e) else np.inf
-    diag = min(("diagonal", "antidiagonal"), key=lambda d: est[d])
+    # "diagonal" unless "antidiagonal" is clearly better (a symmetric target ties up to rounding)
+    diag = "antidiagonal" if est["antidiagonal"] < est["diagonal"] * (1 - 1e-6) else "diagonal"
     if est[diag] * DIAGONAL_GAIN < est[best]:
         best = diag
     return best, est
