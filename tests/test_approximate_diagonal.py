@@ -221,3 +221,58 @@ def test_plain_frame_refuses_the_diagonal_directions():
     with pytest.raises(ValueError, match="make_frame"):
         _Frame(saddle_target(), "diagonal")
     assert type(make_frame(saddle_target(), "u")) is _Frame
+
+
+@pytest.mark.slow
+def test_small_saddle_end_to_end_without_a_kernel(tmp_path):
+    """A 300 mm saddle z = x y / L in its own parameters at tol 0.5 (measured: 4 panels, 0.461,
+    ~8 s): diagonal strips, cones at the two corners, seams shared, the sheets of the panels on the
+    target's normal side, the deviation plot."""
+    from ght_cad.approximation import ConeStrip
+    from ght_cad.design.approximate import panel_sheets, plot_deviation
+    from ght_cad.sheet import Sheet
+
+    def jet(u, v, order):
+        return saddle_target()._jet(u, v, order)
+
+    tgt = SurfaceTarget(jet, (-150.0, 150.0, -150.0, 150.0), "small saddle")
+    res = approximate(tgt, 0.5)
+    assert res.direction == "diagonal" and 2 <= len(res.panels) <= 6
+    assert res.max_deviation <= 0.5
+    assert isinstance(res.panels[0].exact, ConeStrip) and isinstance(res.panels[-1].exact, ConeStrip)
+    assert any(abs(p.y1 - 0.5) <= 1e-12 for p in res.panels)
+    # every cone apex is its box corner: (-150, -150) and (150, 150) (up to the seam offsets, < tol)
+    for p, corner in ((res.panels[0], (-150.0, -150.0)), (res.panels[-1], (150.0, 150.0))):
+        apex = p.exact.b(np.array([0.5]))[0]
+        assert np.hypot(apex[0] - corner[0], apex[1] - corner[1]) <= 0.5
+    # neighbours share their seam: a rail of each exported face, to 1e-6 of the size (points of one
+    # projected onto the other by Gauss-Newton from the nearest of 4001 samples)
+    lam = np.linspace(0, 1, 41)
+    dense = np.linspace(0, 1, 4001)
+
+    def gap(P, rail):
+        C = rail(dense)
+        t = dense[np.argmin(np.linalg.norm(C[None, :, :] - P[:, None, :], axis=2), axis=1)]
+        for _ in range(6):
+            c, c1 = rail(t), rail(t, 1)
+            t = np.clip(t - np.sum((c - P) * c1, 1) / np.maximum(np.sum(c1 * c1, 1), 1e-300), 0, 1)  # apex: c1 = 0
+        return float(np.max(np.linalg.norm(rail(t) - P, axis=1)))
+
+    for p, q in zip(res.panels[:-1], res.panels[1:]):
+        best = min(gap(ra(lam), rb) for ra in (p.surface.a, p.surface.b) for rb in (q.surface.a, q.surface.b))
+        assert best <= 1e-6 * res.size, best
+    # the sheets: material on the target's normal side at every sampled point of every panel
+    sheets = panel_sheets(res, tgt, Sheet(2.0))
+    for p, sh in zip(res.panels, sheets):
+        part = p.exact
+        for lm in (0.2, 0.5, 0.8):
+            la = np.array([lm])
+            a, b = part.a(la)[0], part.b(la)[0]
+            for w in (0.25, 0.75):
+                X = a + w * (b - a)
+                Xl = part.a(la, 1)[0] + w * (part.b(la, 1)[0] - part.a(la, 1)[0])
+                n_panel = np.cross(Xl, b - a)
+                n_target = np.array([-X[1] / L, -X[0] / L, 1.0])
+                assert (n_panel @ n_target > 0) == (sh.side == "normal")
+    png = plot_deviation(res, tmp_path / "dev.png")
+    assert png.stat().st_size > 1000

@@ -117,6 +117,9 @@ def test_two_surfaces_and_ght_target_and_deviation_figure() -> None:
                 gamma_u=0.5)
     spec = parse_design(d, "d.toml").surface
     assert spec.target.kind == "ght" and spec.target.shape["gamma_u"] == 0.5
+    # every strip direction of the core is a value of the key (the diagonals: issue 24's saddle)
+    for direction in ("auto", "u", "v", "diagonal", "antidiagonal"):
+        assert parse_design(_variant(direction=direction), "d.toml").surface.direction == direction
     with pytest.raises(DesignError, match=r"key 'surfaces\[0\].target.mu_v'.*\[-1, 1\]"):
         parse_design(_target(poles=None, knots_u=None, knots_v=None, degree_u=None, degree_v=None,
                              control_points=GHT_NET, mu_v=2.0), "d.toml")
