@@ -6,6 +6,8 @@ on the target. Moved from ``ght_cad/approximation.py`` (issue 27); every name is
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from .frame import _Frame, make_frame
@@ -103,6 +105,40 @@ def _strip_range(frame: _Frame, A: _Seam, B: _Seam, n: int = 49) -> tuple[float,
     return float(d.min()), float(d.max())
 
 
+#: per frame: the seams on the target (``_Seam(frame, y)``) and the strip ranges between two of them
+#: that the march has built, by ``y`` and ``(y0, y1)``: the greedy runs of :func:`_march_piece`
+#: repeat the same first trials (a pure function of the frame and the positions)
+_MARCH_CACHE: "weakref.WeakKeyDictionary[_Frame, tuple[dict, dict]]" = weakref.WeakKeyDictionary()
+
+
+def _march_caches(frame: _Frame) -> tuple[dict, dict]:
+    c = _MARCH_CACHE.get(frame)
+    if c is None:
+        c = _MARCH_CACHE[frame] = ({}, {})
+    return c
+
+
+def _seam_on(frame: _Frame, y: float) -> _Seam:
+    """``_Seam(frame, y)``, remembered per frame."""
+    seams = _march_caches(frame)[0]
+    y = float(y)
+    sm = seams.get(y)
+    if sm is None:
+        sm = seams[y] = _Seam(frame, y)
+    return sm
+
+
+def _range_between(frame: _Frame, y0: float, y1: float) -> tuple[float, float]:
+    """:func:`_strip_range` of the strip between the seams on the target at ``y0`` and ``y1``,
+    remembered per frame."""
+    ranges = _march_caches(frame)[1]
+    key = (float(y0), float(y1))
+    r = ranges.get(key)
+    if r is None:
+        r = ranges[key] = _strip_range(frame, _seam_on(frame, y0), _seam_on(frame, y1))
+    return r
+
+
 def _march(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float) -> list[float]:
     """Seam positions 0 = y_0 < ... < y_N = 1 by the greedy march (module doc, step 1), balanced:
     the smallest range limit that still gives N strips (bisection, 6 steps), so the last strip is
@@ -144,10 +180,9 @@ def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float, y_st
     ys = [y_start]
     while ys[-1] < y_end:
         y0 = ys[-1]
-        A = _Seam(frame, y0)
 
         def ok(y1: float) -> bool:
-            lo, hi = _strip_range(frame, A, _Seam(frame, y1))
+            lo, hi = _range_between(frame, y0, y1)
             return hi - lo <= limit
 
         if ok(y_end):
