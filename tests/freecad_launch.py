@@ -34,6 +34,15 @@ def freecad_env(tmp_path: Path, pythonpath: bool = True) -> dict[str, str]:
     return env
 
 
+def xvfb_run(*cmd: str) -> list[str]:
+    """``xvfb-run`` for a FreeCAD GUI run on a virtual screen. ``-a`` looks for a free display from
+    the ``-n`` given before it (xvfb-run reads its options in order); each pytest-xdist worker starts its search at its own number (99, 119, ...), so two GUI
+    tests started at the same moment by two workers never race for the same display's lock."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    index = int(worker[2:]) if worker[2:].isdigit() else 0
+    return ["xvfb-run", "-n", str(99 + 20 * index), "-a", "-s", "-screen 0 1280x1024x24", *cmd]
+
+
 def run_process(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
     """Run in a new session; on timeout kill the whole process group (FreeCAD, Xvfb) and fail."""
     proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from conftest import freecadcmd_or_skip
-from freecad_launch import freecad_env, run_fc_unittest, run_process, summary
+from freecad_launch import freecad_env, run_fc_unittest, run_process, summary, xvfb_run
 
 REPO = Path(__file__).resolve().parents[1]
 WB = REPO / "freecad_workbench"
@@ -67,7 +67,7 @@ def test_joined_command_in_gui_under_xvfb(tmp_path: Path) -> None:
     env["QT_QPA_PLATFORM"] = "xcb"
     env["GHT_JOINED_GUI"] = "1"
     script = WB / "freecad" / "ght_workbench" / "tests" / "fc_joined.py"
-    proc = run_process(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(script)], env, tmp_path, 180)
+    proc = run_process(xvfb_run(exe, str(script)), env, tmp_path, 180)
     result = tmp_path / "joined_gui.json"
     assert result.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{summary(proc)}"
     res = json.loads(result.read_text())

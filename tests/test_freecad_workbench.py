@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from conftest import freecadcmd_or_skip
-from freecad_launch import assert_no_traceback, freecad_env, run_process, summary
+from freecad_launch import assert_no_traceback, freecad_env, run_process, summary, xvfb_run
 
 REPO = Path(__file__).resolve().parents[1]
 WB = REPO / "freecad_workbench"
@@ -138,7 +138,7 @@ def test_gui_workbench_under_xvfb(tmp_path: Path) -> None:
     (mod / "ght_workbench").symlink_to(WB, target_is_directory=True)
     env["QTWEBENGINE_DISABLE_SANDBOX"] = "1"  # Qt WebEngine refuses to start as root otherwise
     env["QT_QPA_PLATFORM"] = "xcb"
-    proc = run_process(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", exe, str(WB_TESTS / "gui_check.py")], env, tmp_path, 240)
+    proc = run_process(xvfb_run(exe, str(WB_TESTS / "gui_check.py")), env, tmp_path, 240)
     result_file = tmp_path / "gui_result.json"
     assert result_file.exists(), f"GUI check wrote no result (rc={proc.returncode}):\n{summary(proc)}"
     res = json.loads(result_file.read_text())
