@@ -31,6 +31,7 @@ import numpy as np
 
 from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
                                  plot_deviation, report_markdown)
+from .approximation.target import TRIM_ALLOWED, TrimmedTargetError, trim_words
 from .core.errors import GHTError
 from .design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
@@ -62,6 +63,10 @@ def add_parser(sub: Any, common: Callable[[argparse.ArgumentParser], None], epil
                     help="how each strip is fitted: auto (default: per strip the closer of the rails loft and the "
                          "dual fit of the target's tangent planes), loft (rails lofts only) or dual (the dual fit "
                          "wherever it is usable)")
+    sp.add_argument("--untrimmed", action="store_true",
+                    help="a trimmed face (holes, or an outline inside its surface's (u, v) box) is refused unless "
+                         "given this: cover the underlying surface over the face's whole (u, v) box knowingly "
+                         "(report.json records the covered fraction under info.trim)")
     sp.add_argument("--no-progress", action="store_true", help="no progress lines on stderr even on a terminal")
     sp.add_argument("--face", type=int, default=1, metavar="N", help="face number, 1-based in file order (default 1)")
     sp.add_argument("--thickness", type=float, metavar="T",
@@ -156,7 +161,10 @@ def cmd_approximate(args: argparse.Namespace) -> int:
         sheet = make_sheet(args.thickness, args.k_factor, din_k_factor=args.din_k_factor, side=args.side or "normal")
         target = step_target(path, args.face - 1)
         result = run_approximation(target, args.tol, max_panels=args.max_panels, direction=args.direction,
-                                   method=args.method, progress=_progress_lines(args))
+                                   method=args.method, progress=_progress_lines(args), untrimmed=args.untrimmed)
+    except TrimmedTargetError as exc:
+        raise GHTError(f"{path}: face {args.face} is {trim_words(exc.covered, exc.holes)}; {TRIM_ALLOWED}, or "
+                       "--untrimmed to cover the underlying surface over its whole (u, v) box knowingly") from None
     except GHTError as exc:
         raise GHTError(f"{path}: {' '.join(str(exc).split())}") from None
     with OutputFolder(args.out) as folder:

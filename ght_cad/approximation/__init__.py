@@ -123,6 +123,7 @@ def approximate(
     optimizer_budget: int = 60,
     dual_degree: int = 10,
     progress: Callable[[str], None] | None = None,
+    untrimmed: bool = False,
 ) -> ApproximationResult:
     r"""Cover ``target`` with exactly developable panels within ``tol`` (module doc).
 
@@ -152,6 +153,9 @@ def approximate(
         optimizer_budget: objective evaluations per strip for that optimizer.
         dual_degree: degree m of the fitted dual curves.
         progress: called with a line of text per step (e.g. ``print``).
+        untrimmed: cover a trimmed CAD face's underlying surface over its whole (u, v) box
+            knowingly (``info["trim"]`` records the covered fraction); without it a trimmed face
+            is refused (:func:`.target.check_trim`).
 
     Returns:
         :class:`ApproximationResult`.
@@ -185,6 +189,10 @@ def approximate(
     t0 = time.perf_counter()
     tgt = as_target(target)
     info: dict[str, Any] = {"target": tgt.name, "bounds": list(tgt.bounds)}
+    from .target import check_trim  # issue 24: a trimmed face only with untrimmed=True
+
+    if (trim := check_trim(tgt, untrimmed)) is not None:
+        info["trim"] = trim
     if direction == "auto":
         direction, est = _choose_direction(tgt, tol)
         info["estimate"] = est

@@ -31,15 +31,21 @@ class SurfaceTarget:
         jet: the evaluator.
         bounds: ``(u0, u1, v0, v1)``.
         name: label for messages and reports.
+        trim: for a CAD face, how much of its surface's (u, v) box it covers:
+            ``{"covered": A_face / A_box, "holes": inner wires}`` (``A_box`` the area of the same
+            surface over the face's (u, v) box); None when the target is its whole box
+            (:func:`check_trim`).
     """
 
-    def __init__(self, jet: _JET, bounds: Sequence[float], name: str = "target") -> None:
+    def __init__(self, jet: _JET, bounds: Sequence[float], name: str = "target", *,
+                 trim: dict[str, float] | None = None) -> None:
         b = tuple(float(x) for x in bounds)
         if len(b) != 4 or not all(math.isfinite(x) for x in b) or not (b[1] > b[0] and b[3] > b[2]):
             raise GHTError(f"target bounds {bounds!r} are not allowed; give (u0, u1, v0, v1) with u1 > u0, v1 > v0")
         self._jet = jet
         self.bounds = b
         self.name = name
+        self.trim = dict(trim) if trim is not None else None
 
     def jet(self, u: np.ndarray, v: np.ndarray, order: int = 2) -> list[np.ndarray]:
         """``[S, S_u, S_v(, S_uu, S_vv, S_uv)]`` at the points, each (n, 3)."""
@@ -50,6 +56,61 @@ class SurfaceTarget:
 
     def __repr__(self) -> str:
         return f"SurfaceTarget({self.name!r}, bounds={self.bounds})"
+
+
+#: a face covering less than ``1 - TRIM_TOL`` of its surface's (u, v) box is a trimmed face
+TRIM_TOL = 1e-6
+
+
+class TrimmedTargetError(GHTError):
+    """A trimmed face (holes, or a boundary inside its surface's (u, v) box) given to
+    :func:`ght_cad.approximate` without ``untrimmed=True``; ``covered`` and ``holes`` as in
+    :attr:`SurfaceTarget.trim`, ``name`` the target's."""
+
+    def __init__(self, name: str, covered: float, holes: int) -> None:
+        self.name, self.covered, self.holes = name, float(covered), int(holes)
+        super().__init__(f"the target {name!r} is {trim_words(covered, holes)}; {TRIM_ALLOWED}, or untrimmed=True to "
+                         "cover the underlying surface over its whole (u, v) box knowingly")
+
+
+#: what :class:`TrimmedTargetError` allows (the front ends name their own switch after it)
+TRIM_ALLOWED = ("the panels would cover the whole (u, v) box, where the face has no material; allowed: a face "
+                "whose trim is its (u, v) box")
+
+
+def trim_words(covered: float, holes: int) -> str:
+    """``"a trimmed face: it covers 0.8727 of its surface's (u, v) box, 1 hole"``."""
+    return (f"a trimmed face: it covers {covered:.4g} of its surface's (u, v) box, {holes} hole"
+            f"{'' if holes == 1 else 's'}")
+
+
+def is_trimmed(trim: dict[str, float] | None) -> bool:
+    """True when ``trim`` (:attr:`SurfaceTarget.trim`) has holes or covers less than ``1 - TRIM_TOL``."""
+    return trim is not None and (int(trim.get("holes", 0)) > 0 or float(trim["covered"]) < 1.0 - TRIM_TOL)
+
+
+def check_trim(target: SurfaceTarget, untrimmed: bool = False) -> dict[str, float] | None:
+    r"""The target's trim record for the report, refusing a trimmed face.
+
+    A CAD face covers the fraction ``c = A_face / A_box`` of its surface's (u, v) box (``A_box``:
+    the surface over the face's (u, v) bounds) and has ``h`` inner wires; it is trimmed when
+    ``c < 1 - TRIM_TOL`` or ``h > 0``. :func:`ght_cad.approximate` covers the whole box.
+
+    Returns:
+        ``{"covered": c, "holes": h, "untrimmed": untrimmed}`` for a CAD face, None otherwise.
+
+    Raises:
+        TrimmedTargetError: a trimmed face and not ``untrimmed`` (the message names c and h).
+        GHTError: ``untrimmed`` not a bool.
+    """
+    if not isinstance(untrimmed, (bool, np.bool_)):
+        raise GHTError(f"untrimmed={untrimmed!r} is not allowed; it must be True or False")
+    trim = getattr(target, "trim", None)
+    if trim is None:
+        return None
+    if is_trimmed(trim) and not untrimmed:
+        raise TrimmedTargetError(target.name, trim["covered"], trim.get("holes", 0))
+    return {"covered": float(trim["covered"]), "holes": int(trim.get("holes", 0)), "untrimmed": bool(untrimmed)}
 
 
 def _ght_jet(surf: Any) -> _JET:

@@ -28,15 +28,47 @@ __all__ = ["face_target", "shape_target", "step_target", "approximate_face", "pa
 
 
 def face_target(face: Any) -> SurfaceTarget:
-    """The surface of one face as an approximation target (bounds: its (u, v) box).
+    """The surface of one face as an approximation target (bounds: its (u, v) box), with its
+    ``trim`` (:func:`face_trim`: the fraction of the box the face covers, its holes).
 
     Raises:
         GHTError: a shape with other than one face.
     """
-    _, ad, bounds, ev = _open_face(face)
+    f, ad, bounds, ev = _open_face(face)
     if ev.kind == "bspline" and getattr(ev, "_nurbs", None) is None:
         ev = _unperiodic(ad, bounds) or ev
-    return SurfaceTarget(lambda u, v, k: ev.jet(u, v, min(k, 2)), bounds, f"{ev.kind} face")
+    return SurfaceTarget(lambda u, v, k: ev.jet(u, v, min(k, 2)), bounds, f"{ev.kind} face", trim=face_trim(f, bounds))
+
+
+def face_trim(face: Any, bounds: tuple[float, float, float, float]) -> dict[str, float]:
+    r"""How much of its surface's (u, v) box a face covers: ``{"covered": A_face / A_box, "holes": h}``.
+
+    ``A_face``: the face's area (``BRepGProp.SurfaceProperties_s``); ``A_box``: the area of the
+    same surface restricted to the face's (u, v) bounds ``bounds``
+    (``BRepBuilderAPI_MakeFace(surface, u0, u1, v0, v1)``); ``h``: the face's wires but the outer
+    one. A face whose trim is its (u, v) box gives ``covered = 1`` (to the integration's
+    round-off) and ``h = 0``.
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.TopAbs import TopAbs_WIRE
+
+    def area(fc: Any) -> float:
+        props = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(fc, props)
+        return abs(float(props.Mass()))
+
+    wires = 0
+    exp = TopExp_Explorer(face, TopAbs_WIRE)
+    while exp.More():
+        wires += 1
+        exp.Next()
+    mk = BRepBuilderAPI_MakeFace(BRep_Tool.Surface_s(face), *bounds, 1e-7)
+    box = area(mk.Face()) if mk.IsDone() else 0.0
+    covered = area(face) / box if box > 0 else 1.0
+    return {"covered": covered, "holes": max(wires - 1, 0)}
 
 
 def _unperiodic(ad: Any, bounds: tuple[float, float, float, float]) -> Any:

@@ -93,6 +93,12 @@ def approximation_target(spec: SurfaceSpec, source: str) -> Any:
         except GHTError as exc:
             raise _fail(source, f"{key}.face" if "face=" in str(exc) else f"{key}.step",
                         " ".join(str(exc).split())) from None
+        from ..approximation.target import TRIM_ALLOWED, is_trimmed, trim_words
+
+        if is_trimmed(tgt.trim) and not spec.untrimmed:
+            raise _fail(source, key, f"face {t.face} of {t.step!r} is {trim_words(tgt.trim['covered'], tgt.trim['holes'])}; "
+                        f"{TRIM_ALLOWED}, or untrimmed = true on {spec.key} to cover the underlying surface over its "
+                        "whole (u, v) box knowingly")
     else:
         try:
             tgt = as_target(_patch(t))
@@ -147,7 +153,7 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
     tgt = approximation_target(spec, source)
     with np.errstate(all="ignore"):
         result = run_approximation(tgt, spec.tol, direction=spec.direction, max_panels=spec.max_panels,
-                                   method=spec.method)
+                                   method=spec.method, untrimmed=spec.untrimmed)
     return ApproximatedSurface(result, tgt, spec.method)
 
 
@@ -157,7 +163,8 @@ BEST_DEVIATION_TRIES = (6, 3)
 
 
 def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_panels: int = 64,
-                      method: str = "auto", progress: Callable[[str], None] | None = None) -> Any:
+                      method: str = "auto", progress: Callable[[str], None] | None = None,
+                      untrimmed: bool = False) -> Any:
     r""":func:`ght_cad.approximate` as the front ends (``ght-cad approximate``, design files, the
     FreeCAD feature) call it, with one guarantee more on failure: the message names the best
     deviation reached with at most ``max_panels`` panels.
@@ -170,6 +177,7 @@ def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_p
     the smallest largest deviation (both ways) of the successful runs is the best deviation reached,
     an upper bound of what ``max_panels`` panels can do (within 2^(1/8) ≈ 9 % in ``t`` of the
     smallest tolerance the march meets with them). Up to 9 more runs of the core, on failure only.
+    ``untrimmed``: as :func:`ght_cad.approximate` (a trimmed face refused without it).
 
     Raises:
         GHTError: bad arguments (the core's message), or no approximation within ``tol``: one line
@@ -178,7 +186,7 @@ def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_p
     """
     from ..approximation import approximate
 
-    kw = dict(direction=direction, max_panels=max_panels, method=method)
+    kw = dict(direction=direction, max_panels=max_panels, method=method, untrimmed=untrimmed)
     try:
         return approximate(target, tol, progress=progress, **kw)
     except GHTError as exc:
@@ -266,6 +274,10 @@ def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
              f"- total area: {report['total_area']:.6g}", "",
              "| panel | max out | max in | theta_max (deg) | area | flat area |",
              "|---|---|---|---|---|---|"]
+    trim = (report.get("info") or {}).get("trim")
+    if trim and (trim["holes"] or trim["covered"] < 1.0 - 1e-6):
+        lines[6:6] = [f"- trimmed target covered over its whole (u, v) box (untrimmed): the face covers "
+                      f"{trim['covered']:.4g} of it, {trim['holes']} hole(s)"]
     for p in report["panel_report"]:
         lines.append(f"| P{p['index']} | {p['max_out']:.4g} | {p['max_in']:.4g} | {p['theta_max_deg']:.2e} | "
                      f"{p['area']:.8g} | {p.get('flat_area', float('nan')):.8g} |")

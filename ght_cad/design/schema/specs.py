@@ -91,6 +91,8 @@ class SurfaceSpec:
     max_panels: int = 64
     direction: str = "auto"
     method: str = "auto"
+    #: ``type = "approximate"``: cover a trimmed STEP face over its whole (u, v) box knowingly
+    untrimmed: bool = False
 
 
 @dataclass
@@ -211,7 +213,7 @@ class Design:
         for sd in [d["surface"] or {}] + d["surfaces"]:
             sd.pop("key", None)
             if sd.get("type") != "approximate":  # the keys of an approximate surface only
-                for k in ("target", "tol", "max_panels", "direction", "method"):
+                for k in ("target", "tol", "max_panels", "direction", "method", "untrimmed"):
                     sd.pop(k, None)
             if sd.get("sheet", 0) is None:  # no per-surface sheet overrides: as before
                 sd.pop("sheet")

@@ -13,7 +13,7 @@ from .specs import SurfaceSpec, TargetSpec
 from .checker import _Checker, _short, _tname
 
 
-_APPROX_KEYS = ("type", "target", "tol", "max_panels", "direction", "method")
+_APPROX_KEYS = ("type", "target", "tol", "max_panels", "direction", "method", "untrimmed")
 
 
 #: the keys of ``[surfaces.target]`` by kind of target (the kind is told by its first key)
@@ -29,7 +29,8 @@ _TARGET_FIRST = {"step": "step", "ght": "control_points", "nurbs": "poles"}
 
 def _parse_approximate(ck: _Checker, st: dict, path: str, extra: tuple[str, ...] = ()) -> SurfaceSpec:
     """``type = "approximate"`` at ``path``: ``tol`` (> 0), ``max_panels`` (1..256), ``direction``
-    (:data:`APPROX_DIRECTIONS`), ``method`` (:data:`APPROX_METHODS`, default ``auto``) and the
+    (:data:`APPROX_DIRECTIONS`), ``method`` (:data:`APPROX_METHODS`, default ``auto``), ``untrimmed``
+    (a boolean, default false: a trimmed STEP face is covered over its whole (u, v) box only with it) and the
     ``[<path>.target]`` table (:func:`_parse_target`)."""
     ck.keys(st, path, _APPROX_KEYS + extra)
     tol = ck.number(st, "tol", path, required=True, lo=0.0, lo_open=True,
@@ -37,9 +38,10 @@ def _parse_approximate(ck: _Checker, st: dict, path: str, extra: tuple[str, ...]
     max_panels = ck.integer(st, "max_panels", path, 64, lo=1, hi=MAX_APPROX_PANELS)
     direction = ck.string(st, "direction", path, "auto", choices=APPROX_DIRECTIONS)
     method = ck.string(st, "method", path, "auto", choices=APPROX_METHODS)
+    untrimmed = ck.boolean(st, "untrimmed", path, False)
     target = _parse_target(ck, st, f"{path}.target")
     return SurfaceSpec("approximate", target=target, tol=tol, max_panels=max_panels, direction=direction,
-                       method=method)
+                       method=method, untrimmed=untrimmed)
 
 
 def _parse_target(ck: _Checker, st: dict, tpath: str) -> TargetSpec:
