@@ -6,7 +6,7 @@ in the same run, on
   ``exact_gradients=True`` (:func:`ght_cad.design.composite_value_and_grad`) and ``False``;
   I-GWO (the file's own method) for reference;
 * the hull plate rails loft (``examples/design_hull_plate.toml``, fan share over the rails' 6
-  shape parameters): the same, with :meth:`ght_cad.loft.LoftProblem.gradient_of`.
+  shape parameters): the same, with :meth:`ght_cad.optimize.problems.loft.LoftProblem.gradient_of`.
 
 Printed per run: objective evaluations ``nfev`` (finite-difference points included; exact
 gradients counted separately as ``njev``), the measured cost of one exact gradient in objective

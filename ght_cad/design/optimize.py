@@ -252,7 +252,7 @@ def _value_and_grad_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpe
                        shape_of: Callable[[np.ndarray], dict[str, float]], accept: Acceptor | None = None
                        ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
     """Population ``value_and_grad(X) -> ((pop,), (pop, dim))`` of the design objective where it is
-    exact (composite; rails through :class:`ght_cad.loft.LoftProblem`), else None. With ``accept``
+    exact (composite; rails through :class:`ght_cad.optimize.problems.loft.LoftProblem`), else None. With ``accept``
     (the sheet rule) a refused candidate gets ``(+inf, 0)``, as in the plain objective."""
     surf = design.surface
     assert surf is not None
@@ -277,9 +277,9 @@ def _rails_value_and_grad_fn(design: Design, curves: dict[str, Any], spec: Optim
                              shape_of: Callable[[np.ndarray], dict[str, float]], accept: Acceptor | None = None
                              ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
     r"""``value_and_grad`` of a ``rails`` objective (:func:`_rails_objective_fn`): the same loft and
-    measures, and the exact gradient :meth:`ght_cad.loft.LoftProblem.gradient_of` (implicit-function
+    measures, and the exact gradient :meth:`ght_cad.optimize.problems.loft.LoftProblem.gradient_of` (implicit-function
     derivative of the traced branch, moving breakpoints). Where the loft's structure is not
-    locally fixed (:class:`ght_cad.loft.LoftGradientFallback`) forward differences of step 1e-7
+    locally fixed (:class:`ght_cad.optimize.problems.loft.LoftGradientFallback`) forward differences of step 1e-7
     inwards, their evaluations counted in ``vg.extra_nfev``. None when a rail is re-solved by a
     join for every candidate (the join is not differentiated here: finite differences). ``accept``
     (the sheet rule) sees every candidate loft before it is measured; a refused one gets
@@ -357,7 +357,7 @@ def _rails_objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSp
                         rejoin: bool, accept: Acceptor | None = None) -> Callable[[dict[str, float]], float]:
     r"""Objective of a ``rails`` surface over the rails' shape parameters: the developable loft of
     the candidate rails (:func:`ght_cad.developable_loft`) measured by
-    :meth:`ght_cad.loft.LoftProblem.measures_of`: ``fan_share`` = fan area / loft area,
+    :meth:`ght_cad.optimize.problems.loft.LoftProblem.measures_of`: ``fan_share`` = fan area / loft area,
     ``fairness`` = ``∫_0^1 |d'(λ)|² dλ`` (d the unit ruling direction), ``regression`` =
     ``∫ max(0, 1 - c/margin)² dλ`` (c the distance of the edge-of-regression parameter ``v*`` from
     [0, 1]), or ``weighted`` = ``w0 fan_share + w1 fairness + w2 regression``. A candidate without a
@@ -655,7 +655,7 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
         progress: progress bar on a terminal.
         curves: already built curves (joins applied).
         exact_gradients: give the optimizer the exact gradient where one exists (composites:
-            :func:`composite_value_and_grad`; rails: :meth:`ght_cad.loft.LoftProblem.value_and_grad`);
+            :func:`composite_value_and_grad`; rails: :meth:`ght_cad.optimize.problems.loft.LoftProblem.value_and_grad`);
             ``False`` leaves the objective a plain callable (``hybrid`` then uses finite differences).
 
     Returns:

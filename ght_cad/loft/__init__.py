@@ -33,8 +33,9 @@ Modules: :mod:`.rails` (rail adapters), :mod:`.equation` (``F`` and its continua
 :class:`DevelopableLoft`), :mod:`.build` (:func:`developable_loft`), :mod:`.plot`
 (:func:`plot_loft_sign`). The optimization problem over the rails' shape parameters and its
 exact gradients live in :mod:`ght_cad.optimize.problems.loft`; ``ght_cad.loft.LoftProblem``,
-``LOFT_OBJECTIVES``, ``LoftGradientFallback`` and ``loft_measures_and_gradients`` still work
-(loaded from there on first use, so that the loft never imports the optimize layer).
+``LOFT_OBJECTIVES``, ``LoftGradientFallback`` and ``loft_measures_and_gradients`` are deprecated
+aliases of those (loaded from there on use with a :class:`DeprecationWarning`, so that importing
+the loft never imports the optimize layer; not in ``__all__``).
 """
 
 from __future__ import annotations
@@ -56,13 +57,9 @@ __all__ = [
     "LoftReport",
     "loft_function",
     "plot_loft_sign",
-    "LoftProblem",
-    "LOFT_OBJECTIVES",
-    "LoftGradientFallback",
-    "loft_measures_and_gradients",
 ]
 
-#: Names that moved to :mod:`ght_cad.optimize.problems.loft` (a higher layer): loaded on first use.
+#: Names that moved to :mod:`ght_cad.optimize.problems.loft` (a higher layer): deprecated aliases.
 _MOVED = {
     "LoftProblem": "ght_cad.optimize.problems.loft",
     "LOFT_OBJECTIVES": "ght_cad.optimize.problems.loft",
@@ -70,4 +67,4 @@ _MOVED = {
     "loft_measures_and_gradients": "ght_cad.optimize.problems.loft",
 }
 
-__getattr__ = lazy_getattr(__name__, _MOVED, globals())
+__getattr__ = lazy_getattr(__name__, _MOVED, globals(), deprecated=True)

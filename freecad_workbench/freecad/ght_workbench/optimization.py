@@ -10,7 +10,7 @@ Problems (``ght_cad.optimize.problems``), chosen by ``Problem`` and the ``Target
 * ``Developability``, two GHT curve targets: :class:`StripProblem`, ``R = ∫(1 - n_a·n_b) du`` of the
   ruled strip between them (parameters ``a.mu ... b.gamma``).
 * ``Loft``, one *Developable loft* target whose two rails are GHT curves:
-  :class:`ght_cad.loft.LoftProblem` over the rails' ``a.mu ... b.gamma``, objective
+  :class:`ght_cad.optimize.problems.loft.LoftProblem` over the rails' ``a.mu ... b.gamma``, objective
   ``WeightFanShare · fan share + WeightRulingFairness · ∫|d'|² + WeightRegression · (edge of
   regression penalty)`` of the exact developable loft (+inf where none exists).
 
@@ -126,7 +126,7 @@ class OptimizationFeature(FeatureProxy):
         return prob, [(t, p, p.lower()) for p in ("Mu", "Nu", "Gamma")]
 
     def loft_problem(self, obj: Any, targets: list, free: Any) -> tuple[Any, list[tuple[Any, str, str]]]:
-        """(:class:`ght_cad.loft.LoftProblem`, mapping to the rails' Mu/Nu/Gamma) of one loft target."""
+        """(:class:`ght_cad.optimize.problems.loft.LoftProblem`, mapping to the rails' Mu/Nu/Gamma) of one loft target."""
         from ght_cad.optimize.problems import LoftProblem
 
         from .ght_curve import core_curve

@@ -25,7 +25,7 @@ PLANE_OBJECTIVES = ("AL", "En", "CVEn", "weighted")
 STRIP_OBJECTIVES = ("R",)
 
 
-#: objectives of a ``rails`` surface (the developable loft, :data:`ght_cad.loft.LOFT_OBJECTIVES`) and their
+#: objectives of a ``rails`` surface (the developable loft, :data:`ght_cad.optimize.problems.loft.LOFT_OBJECTIVES`) and their
 #: weighted sum ``w0 fan_share + w1 fairness + w2 regression``
 RAILS_OBJECTIVES = ("fan_share", "fairness", "regression", "weighted")
 
