@@ -98,7 +98,7 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     in the report."""
     from .cad.approximate import panels_shell
     from .cad.occ import write_step
-    from .core.io import atomic_write
+    from .core.io import atomic_write, strict_json
 
     sheets = panel_sheets(result, target, sheet)
     if sheets is not None:
@@ -121,7 +121,7 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     report["files"] = names
     report["tool"] = "ght-cad"
     with atomic_write(folder.path("report.json")) as fh:
-        fh.write(json.dumps(report, indent=2, default=_json_default))
+        fh.write(json.dumps(strict_json(report), indent=2, default=_json_default, allow_nan=False))
     with atomic_write(folder.path("report.md")) as fh:
         fh.write(report_markdown(report))
     return report

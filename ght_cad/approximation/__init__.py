@@ -43,7 +43,12 @@ Algorithm (all kernel-free, numpy/scipy):
    cone with its apex there) and its deviation is measured both ways (panel points projected onto
    the target and target points projected onto the panel, Gauss–Newton). If a panel exceeds
    ``tol``, the march is repeated with a smaller ``f``; a result needing more than ``max_panels``
-   panels raises :class:`ght_cad.core.errors.GHTError` naming the best deviation reached.
+   panels raises :class:`ght_cad.core.errors.GHTError` naming the best deviation reached and its
+   panel count. When already the first march needs more than ``max_panels`` strips, the best
+   deviation is that of the finest march with at most ``max_panels`` strips (:func:`_march_within`:
+   the smallest range limit whose march fits, found by marches alone), built and measured like
+   any other result: ONE build and measure more, on failure only, not a search over ``tol``
+   (where no developable joins its seams, the finest march with fewer strips is tried instead).
 
 4. **Loft or dual fit per strip** (``method="auto"``, spec 10.1): every strip also gets the dual
    fit of the target's tangent planes along its middle curve (:mod:`ght_cad.approximation_dual`:
@@ -83,7 +88,8 @@ from .frame import _DiagonalFrame, _Frame, _unit, make_frame, STRIP_DIRECTIONS, 
 from .seams import (BSplineRuled, _det, _match, _ruling_deviation, _Rulings, _Seam, SeamCurve,
                     _strip_rulings, _W)  # noqa: F401
 from .result import ApproximationResult, ConeStrip, Panel  # noqa: F401
-from .splitting import (_choose_direction, _estimate, _estimate_curvature, _greedy, _march, _march_piece, _offsets,
+from .splitting import (_choose_direction, _estimate, _estimate_curvature, _greedy, _march, _march_piece, _march_within,
+                        _offsets,
                         _strip_range, DIAGONAL_GAIN, DIAGONAL_MIN_STRIPS)  # noqa: F401
 from .fitting import _build_panel, _choose_methods, _dual_seams, _strip_dev  # noqa: F401
 from .deviation import _measure_panel, _project_panel, _strip_grid  # noqa: F401
@@ -162,9 +168,14 @@ def approximate(
 
     Raises:
         GHTError: bad arguments, or no approximation within ``tol`` with at most ``max_panels``
-            panels (the message names the best deviation reached and its panel count, or "none"
-            when no developable joins the seams, e.g. asymptotic seams: NotDevelopableError of the
-            loft is caught there).
+            panels: one line ``no approximation of the target within tol=T with at most
+            max_panels=N panels; best deviation reached D with n panels``. D is the smallest largest
+            deviation of the results measured; when the first march already needs more than N
+            strips, the deviation of the finest march with at most N strips (:func:`_march_within`,
+            one build and measure more, no search over ``tol``; with fewer strips where that build
+            is refused). "none" when no developable joins
+            the seams (e.g. asymptotic seams: NotDevelopableError of the loft is caught there) or
+            no march fits in N strips (fewer than the diagonal frame's two pieces).
     """
     _check_number("tol", tol, 0.0)
     if not tol > 0:
@@ -195,7 +206,8 @@ def approximate(
         info["trim"] = trim
     if direction == "auto":
         direction, est = _choose_direction(tgt, tol)
-        info["estimate"] = est
+        # strict JSON (report.json): an infinite estimate (asymptotic seams) is written as null
+        info["estimate"] = {k: (float(v) if math.isfinite(v) else None) for k, v in est.items()}
         what = f"rulings along {direction}" if direction in ("u", "v") else f"seams along the {direction} of the box"
         say(f"direction: {what} (estimated strips " + ", ".join(f"{k} {v:.3g}" for k, v in est.items()) + ")")
     frame = make_frame(tgt, direction)
@@ -205,17 +217,15 @@ def approximate(
     history = []
     panels: list[Panel] = []
     refused: str | None = None
-    for attempt in range(8):
-        ys = _march(frame, tol, f, max_panels, min_width=1e-6)
+    def cover(ys: list[float]) -> tuple[float, list[Panel], list[Any], list[_Seam]] | None:
+        """Build and measure the strips between the seams ``ys`` (steps 2-4): the best mix, or None
+        when no developable joins some seams."""
+        nonlocal refused
         n = len(ys) - 1
-        say(f"march f={f:.3f}: {n} strips")
-        if n > max_panels:
-            history.append({"f": f, "panels": n, "max_deviation": None})
-            break
         loft_seams = _offsets(frame, ys, offset_degree, offset_iterations)
         chosen = [False] * n
         duals: list[Any] = []
-        choice = [{} for _ in range(n)]
+        choice: list[dict[str, Any]] = [{} for _ in range(n)]
         if method != "loft" and frame.closed_x:
             # a full turn of tangent planes: one GHT dual curve cannot close, and closed seams keep
             # constant offsets; measured on the cap, the dual seams were 2.3x farther (0.48 vs 0.21)
@@ -240,7 +250,7 @@ def approximate(
             mixes.append((loft_seams, [False] * n))
         best_mix = None
         for seams, ch in mixes:
-            panels, maps = [], []
+            built, maps = [], []
             try:
                 for i, (A, B) in enumerate(zip(seams[:-1], seams[1:])):
                     exact = _build_panel(frame, A, B)
@@ -250,18 +260,31 @@ def approximate(
                     surf = BSplineRuled(data)
                     out, inn, mp = _measure_panel(frame, surf, A, B)
                     th = data.info.get("theta_max_deg", math.nan)
-                    panels.append(Panel(surf, A.y, B.y, out, inn, max(out, inn), float(th) if math.isfinite(th) else 0.0,
-                                        exact=exact, method="dual" if ch[i] else "loft", choice=dict(choice[i])))
+                    built.append(Panel(surf, A.y, B.y, out, inn, max(out, inn), float(th) if math.isfinite(th) else 0.0,
+                                       exact=exact, method="dual" if ch[i] else "loft", choice=dict(choice[i])))
                     maps.append(mp)
             except (GHTError, FloatingPointError) as exc:  # NotDevelopableError included: a refused mix
                 say(f"  mix refused: {exc}")
                 refused = f"{type(exc).__name__}: {exc}"
                 continue
-            w = max(p.max_deviation for p in panels)
+            w = max(p.max_deviation for p in built)
             if best_mix is None or w < best_mix[0]:
-                best_mix = (w, panels, maps, seams)
+                best_mix = (w, built, maps, seams)
             if w <= tol:
                 break
+        return best_mix
+
+    overshoot: int | None = None  # strips of the first march when it needs more than max_panels
+    for attempt in range(8):
+        ys = _march(frame, tol, f, max_panels, min_width=1e-6)
+        n = len(ys) - 1
+        say(f"march f={f:.3f}: {n} strips" if n <= max_panels else f"march f={f:.3f}: more than {max_panels} strips")
+        if n > max_panels:
+            history.append({"f": f, "panels": n, "max_deviation": None})
+            if best is None:
+                overshoot = n
+            break
+        best_mix = cover(ys)
         if best_mix is None:  # no developable between some seams: a finer march
             history.append({"f": f, "panels": n, "max_deviation": None, "error": "no developable between the seams"})
             panels = []
@@ -278,6 +301,25 @@ def approximate(
         f *= 0.93
     else:
         panels = []
+    if overshoot is not None:
+        # the best deviation within max_panels: ONE build and measure of the finest march that
+        # fits (_march_within), not a search over tol; where no developable joins its seams (a
+        # refusal, found while building), the finest march with fewer strips
+        cap = max_panels
+        while best is None and cap >= 1:
+            ys = _march_within(frame, tol, f, cap, min_width=1e-6)
+            if ys is None:
+                break
+            n = len(ys) - 1
+            say(f"march needs more than {max_panels} strips at tol {tol:.4g}; measuring the finest {n}-strip covering")
+            best_mix = cover(ys)
+            history.append({"f": None, "panels": n, "max_deviation": None if best_mix is None else best_mix[0],
+                            "best_within_max_panels": True})
+            if best_mix is not None:
+                best = (best_mix[0], n)
+                say(f"  {n} panels, max deviation {best_mix[0]:.4g} (tol {tol:.4g})")
+            cap = n - 1
+        panels = []
     info["history"] = history
     if not panels or max(p.max_deviation for p in panels) > tol or len(panels) > max_panels:
         if best is None and refused is not None:
@@ -289,8 +331,9 @@ def approximate(
             )
         if best is None:
             raise GHTError(
-                f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels: "
-                f"the march needed more than {max_panels} strips; raise max_panels or tol"
+                f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels; "
+                f"best deviation reached: none (the march needed more than {max_panels} strips and no march fits in "
+                f"{max_panels} along direction={direction!r}); raise max_panels or tol"
             )
         raise GHTError(
             f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels; "

@@ -11,6 +11,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..core.io import strict_json as _strict
 from ..surfaces.ruled import RuledSurface
 
 
@@ -119,8 +120,9 @@ class ApproximationResult:
         return [p.surface for p in self.panels]
 
     def as_dict(self) -> dict[str, Any]:
-        """Plain JSON-able report."""
-        return {
+        """Plain report, strict JSON (``json.dumps(..., allow_nan=False)``): a number that is not
+        finite (an infinite direction estimate, a dual fit that failed) is written as None (null)."""
+        return _strict({
             "panels": len(self.panels),
             "tol": self.tol,
             "direction": self.direction,
@@ -130,7 +132,7 @@ class ApproximationResult:
             "panel_report": [dict(p.as_dict(), index=i + 1) for i, p in enumerate(self.panels)],
             "seams": self.seams,
             "info": self.info,
-        }
+        })
 
     def flat_pattern(self, **kwargs: Any) -> Any:
         """All panels unrolled on one sheet with seam marks (:func:`ght_cad.unroll.unroll_composite`

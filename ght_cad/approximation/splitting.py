@@ -6,6 +6,7 @@ on the target. Moved from ``ght_cad/approximation.py`` (issue 27); every name is
 
 from __future__ import annotations
 
+import math
 import weakref
 
 import numpy as np
@@ -139,28 +140,64 @@ def _range_between(frame: _Frame, y0: float, y1: float) -> tuple[float, float]:
     return r
 
 
-def _march(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float) -> list[float]:
-    """Seam positions 0 = y_0 < ... < y_N = 1 by the greedy march (module doc, step 1), balanced:
-    the smallest range limit that still gives N strips (bisection, 6 steps), so the last strip is
-    not a narrow remainder. The frame's :meth:`~_Frame.breaks` (the diagonal frame's y = 1/2) are
-    seams: each piece between them is marched on its own."""
+def _march(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float,
+           balance: bool = True) -> list[float]:
+    """Seam positions 0 = y_0 < ... < y_N = 1 by the greedy march (module doc, step 1) with the
+    range limit ``2 tol f``, balanced: the smallest range limit that still gives N strips
+    (bisection, 6 steps), so the last strip is not a narrow remainder (``balance=False``: the plain
+    greedy march, for counting). The frame's :meth:`~_Frame.breaks` (the diagonal frame's
+    y = 1/2) are seams: each piece between them is marched on its own. More than ``max_panels``
+    strips: the march stops after ``max_panels + 1``."""
     cuts = [0.0, *frame.breaks(), 1.0]
     ys = [0.0]
     for a, b in zip(cuts[:-1], cuts[1:]):
         left = max_panels - (len(ys) - 1)
         if left < 1:
             return ys + [b]
-        ys += _march_piece(frame, tol, f, left, min_width, a, b)[1:]
+        ys += _march_piece(frame, tol, f, left, min_width, a, b, balance)[1:]
     return ys
 
 
+def _march_within(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float,
+                  doublings: int = 40, bisections: int = 6) -> list[float] | None:
+    r"""The seams of the finest march with at most ``max_panels`` strips, for a march at
+    ``f`` that needs more: the smallest share ``g`` (range limit ``2 tol g``) whose greedy march
+    gives at most ``max_panels`` strips, found by doubling ``g = 2^k f`` until it fits and then
+    ``bisections`` steps on ``log g`` (``g = sqrt(g_lo g_hi)``; stopped early at exactly
+    ``max_panels`` strips), then :func:`_march` balanced at that ``g``. Marches only (no panel is
+    built): the caller builds and measures the result once. None when no march fits (fewer
+    ``max_panels`` than the frame's pieces between :meth:`~_Frame.breaks`, or a strip range that
+    is not finite)."""
+    if max_panels < len(frame.breaks()) + 1:
+        return None
+    lo, hi = f, None
+    for _ in range(doublings):
+        g = 2.0 * lo
+        if len(_march(frame, tol, g, max_panels, min_width, balance=False)) - 1 <= max_panels:
+            hi = g
+            break
+        lo = g
+    if hi is None:
+        return None
+    for _ in range(bisections):
+        mid = math.sqrt(lo * hi)
+        n = len(_march(frame, tol, mid, max_panels, min_width, balance=False)) - 1
+        if n <= max_panels:
+            hi = mid
+            if n == max_panels:
+                break
+        else:
+            lo = mid
+    return _march(frame, tol, hi, max_panels, min_width)
+
+
 def _march_piece(frame: _Frame, tol: float, f: float, max_panels: int, min_width: float, y_start: float,
-                 y_end: float) -> list[float]:
+                 y_end: float, balance: bool = True) -> list[float]:
     """:func:`_march` from ``y_start`` to ``y_end``."""
     limit = 2 * tol * f
     ys = _greedy(frame, limit, max_panels, min_width, y_start, y_end)
     n = len(ys) - 1
-    if n <= 1 or n > max_panels:
+    if n <= 1 or n > max_panels or not balance:
         return ys
     lo, hi = limit * ((n - 1) / n) ** 2 * 0.9, limit
     for _ in range(6):

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import tempfile
 from pathlib import Path
-from typing import Callable, Iterator, IO
+from typing import Any, Callable, Iterator, IO
 
-__all__ = ["atomic_path", "atomic_write", "write_text_atomic", "write_bytes_atomic"]
+__all__ = ["atomic_path", "atomic_write", "write_text_atomic", "write_bytes_atomic", "strict_json"]
 
 
 @contextlib.contextmanager
@@ -90,3 +91,20 @@ def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> Path:
     with atomic_write(path, "wb") as fh:
         fh.write(data)
     return Path(path)
+
+
+def strict_json(o: Any) -> Any:
+    """Plain JSON data for ``json.dumps(..., allow_nan=False)``: numpy scalars as Python numbers,
+    numpy arrays as lists, a float that is not finite (NaN, ±inf) as None (null), in nested dicts
+    (keys as str), lists and tuples (as lists); other values unchanged."""
+    if isinstance(o, dict):
+        return {str(k): strict_json(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [strict_json(v) for v in o]
+    if getattr(o, "ndim", 0) and hasattr(o, "tolist"):  # numpy array
+        return strict_json(o.tolist())
+    if hasattr(o, "item") and not isinstance(o, (str, bytes)):  # numpy scalar
+        o = o.item()
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    return o

@@ -157,78 +157,24 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
     return ApproximatedSurface(result, tgt, spec.method)
 
 
-#: how many times :func:`run_approximation` doubles ``tol`` looking for the best deviation within
-#: ``max_panels`` when the march alone needs more strips, and how many bisection steps follow
-BEST_DEVIATION_TRIES = (6, 3)
-
-
 def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_panels: int = 64,
                       method: str = "auto", progress: Callable[[str], None] | None = None,
                       untrimmed: bool = False) -> Any:
-    r""":func:`ght_cad.approximate` as the front ends (``ght-cad approximate``, design files, the
-    FreeCAD feature) call it, with one guarantee more on failure: the message names the best
-    deviation reached with at most ``max_panels`` panels.
-
-    The core names it when some march fitted in ``max_panels`` strips but missed ``tol``; when the
-    very first march already needs more strips (the target curves too much for ``tol``), the core
-    has none to name. Then the tolerance is raised until an approximation with at most
-    ``max_panels`` panels succeeds: doubled, ``t_k = 2^k tol`` (k = 1 .. 6), then 3 bisection steps
-    on ``log t`` between the last failing and the first succeeding value (``t = sqrt(t_lo t_hi)``);
-    the smallest largest deviation (both ways) of the successful runs is the best deviation reached,
-    an upper bound of what ``max_panels`` panels can do (within 2^(1/8) ≈ 9 % in ``t`` of the
-    smallest tolerance the march meets with them). Up to 9 more runs of the core, on failure only.
-    ``untrimmed``: as :func:`ght_cad.approximate` (a trimmed face refused without it).
+    r""":func:`ght_cad.approximate` as the front ends (``ght-cad approximate``, design files) call it:
+    a plain call with their settings. On failure the core's own one-line message names the
+    best deviation reached with at most ``max_panels`` panels (when even the first march needs more
+    strips, the core builds and measures the finest march with at most ``max_panels`` strips once;
+    the FreeCAD feature calls the core directly and gets the same message). ``untrimmed``: as
+    :func:`ght_cad.approximate` (a trimmed face refused without it).
 
     Raises:
-        GHTError: bad arguments (the core's message), or no approximation within ``tol``: one line
-            ``... best deviation reached D with N panels ...`` (or that none was reached up to
-            ``2^6 tol``).
+        GHTError: bad arguments, or ``no approximation of the target within tol=T with at most
+            max_panels=N panels; best deviation reached D with n panels`` (the core's message).
     """
     from ..approximation import approximate
 
-    kw = dict(direction=direction, max_panels=max_panels, method=method, untrimmed=untrimmed)
-    try:
-        return approximate(target, tol, progress=progress, **kw)
-    except GHTError as exc:
-        msg = " ".join(str(exc).split())
-        if "best deviation reached" in msg or "the march needed more than" not in msg:
-            raise
-    say = progress or (lambda s: None)
-    best: tuple[float, int, float] | None = None
-
-    def attempt(t: float) -> bool:
-        nonlocal best
-        say(f"tol={tol:g} needs more than {max_panels} panels; looking for the best deviation at tol={t:.4g}")
-        try:
-            res = approximate(target, t, **kw)
-        except GHTError:
-            return False
-        if best is None or res.max_deviation < best[0]:
-            best = (float(res.max_deviation), len(res.panels), t)
-        return True
-
-    doublings, bisections = BEST_DEVIATION_TRIES
-    lo, hi = float(tol), None
-    for k in range(1, doublings + 1):
-        if attempt(tol * 2.0 ** k):
-            hi = tol * 2.0 ** k
-            break
-        lo = tol * 2.0 ** k
-    if hi is not None:
-        for _ in range(bisections):
-            mid = math.sqrt(lo * hi)
-            if attempt(mid):
-                hi = mid
-            else:
-                lo = mid
-    if best is None:
-        raise GHTError(f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels; "
-                       f"best deviation reached: none with at most {max_panels} panels up to "
-                       f"tol={tol * 2.0 ** doublings:g}; raise max_panels")
-    d, n, t = best
-    raise GHTError(f"no approximation of the target within tol={tol:g} with at most max_panels={max_panels} panels "
-                   f"(the march needed more strips); best deviation reached {d:.6g} with {n} panels (a run at "
-                   f"tol={t:.4g}); raise max_panels or tol")
+    return approximate(target, tol, direction=direction, max_panels=max_panels, method=method, progress=progress,
+                       untrimmed=untrimmed)
 
 
 # ------------------------------------------------------------------------------------------------

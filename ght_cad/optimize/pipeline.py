@@ -29,7 +29,7 @@ from typing import Any, Callable
 
 from ..core._kernel import adapter
 from ..core.errors import GHTError
-from ..core.io import write_text_atomic
+from ..core.io import strict_json, write_text_atomic
 from ..core.progress import Progress
 from ..surfaces.ruled import RuledSurface
 from .optimizers import OptimizeResult, OptimizerState, minimize
@@ -79,17 +79,7 @@ class DesignResult:
         return "\n".join(lines)
 
 
-def _strict(o: Any) -> Any:
-    """Plain JSON data: numpy scalars as Python numbers, NaN/inf as None (strict JSON)."""
-    if isinstance(o, dict):
-        return {str(k): _strict(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_strict(v) for v in o]
-    if hasattr(o, "item") and not isinstance(o, (str, bytes)):  # numpy scalar
-        o = o.item()
-    if isinstance(o, float):
-        return o if math.isfinite(o) else None
-    return o
+_strict = strict_json  # moved to ght_cad.core.io (shared with the approximation's report)
 
 
 def _brep(obj: Any, notes: list[str]) -> Any:
