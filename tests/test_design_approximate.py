@@ -177,6 +177,32 @@ def test_run_refusals_exit_2_with_one_line(tmp_path: Path, capsys: pytest.Captur
 # ------------------------------------------------------------------------------------------------
 # runs (the approximation takes seconds)
 # ------------------------------------------------------------------------------------------------
+def test_unmet_tolerance_exits_2_with_the_cores_best_deviation(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """``max_panels = 1`` at ``tol = 2`` (the march needs 3 strips): exit 2, one line naming the file,
+    the surface and the core's best deviation reached with one panel (one build and measure of the
+    one-strip covering, ~2 s; the front end's tol search of before took up to 9 more runs); it is
+    the deviation of the one panel ``ght_cad.approximate`` gives at a tolerance it meets (1e-5
+    relative: 6 digits printed). Nothing written."""
+    import re
+
+    from ght_cad.approximation import approximate
+    from ght_cad.design.approximate import approximation_target
+
+    data = _variant(max_panels=1, method="loft")
+    path = tmp_path / "d.toml"
+    path.write_text(_toml(data))
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(path) in err[0] and "surfaces[0]" in err[0], err
+    m = re.search(r"no approximation of the target within tol=2 with at most max_panels=1 panels; "
+                  r"best deviation reached ([0-9.e+-]+) with 1 panels", err[0])
+    assert m, err
+    spec = parse_design(data, str(path)).surfaces[0]
+    one = approximate(approximation_target(spec, str(path)), 1e3, max_panels=1, method="loft")
+    assert len(one.panels) == 1 and abs(one.max_deviation - float(m.group(1))) <= 1e-5 * one.max_deviation
+    assert not (tmp_path / "out").exists()
+
+
 def _target_face():
     """The example's target as an OCCT B-spline face (the quadratic Bezier patch of its poles)."""
     pytest.importorskip("OCP")
