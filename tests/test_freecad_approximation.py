@@ -7,7 +7,8 @@ in at most 14 panels, the deviation measured by FreeCAD's ``distToShape`` both w
 PanelCount; a cone face of a PartDesign Body in one panel; a B-spline dome imported from STEP
 within 1 mm; the Direction and Method properties (the core's choices) driving a small dome's panels
 (Method loft, Direction u then v) with the progress indicator fed, the Report view clean;
-refusals naming the property. Here: the printed figures, and
+refusals naming the property; a trimmed face (a hole, a curved outline) refused naming Untrimmed
+and covered over its (u, v) box with it. Here: the printed figures, and
 the flat pattern's DXF read back with ezdxf (one closed outline per panel).
 """
 
@@ -26,7 +27,7 @@ _NUM = r"([\deE.+-]+)"
 
 
 def test_developable_approximation_inside_freecadcmd(tmp_path: Path) -> None:
-    out = run_fc_unittest("freecad.ght_workbench.tests.fc_approximation", tmp_path, min_tests=5, timeout=900)
+    out = run_fc_unittest("freecad.ght_workbench.tests.fc_approximation", tmp_path, min_tests=6, timeout=900)
     flat = out.replace("\t", "\n").replace("\r", "\n")
     cap = re.search(rf"cap tol 1: (\d+) panels, MaxDeviation {_NUM}, measured target->shell {_NUM} shell->target {_NUM}", flat)
     assert cap, out[-3000:]
@@ -41,6 +42,12 @@ def test_developable_approximation_inside_freecadcmd(tmp_path: Path) -> None:
     assert small and int(small.group(1)) >= 1 and int(small.group(2)) >= 1, out[-3000:]
     dome = re.search(rf"dome tol 1: (\d+) panels, MaxDeviation {_NUM}, measured target->shell {_NUM} shell->target {_NUM}", flat)
     assert dome and max(float(dome.group(3)), float(dome.group(4))) <= 1.01, out[-3000:]
+
+    # a trimmed face (a hole; a curved outline) refused naming Untrimmed; with it covered over its box
+    trim = re.search(rf"trimmed dome: hole covers {_NUM} \(1 hole\), deck covers {_NUM}; refused; Untrimmed: (\d+) panels, "
+                     rf"MaxDeviation {_NUM}", flat)
+    assert trim and 0.9 < float(trim.group(1)) < 0.95 and 0.8 < float(trim.group(2)) < 0.9, out[-3000:]
+    assert int(trim.group(3)) >= 1 and float(trim.group(4)) <= 1.0, trim.group(0)
 
     pytest.importorskip("ezdxf")
     from ezdxf import recover

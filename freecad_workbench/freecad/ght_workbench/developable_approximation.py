@@ -16,6 +16,10 @@ module only adapts FreeCAD to it and back:
   ``face.toNurbs()`` (OCCT's exact NURBS conversion of the face, its pcurves converted with it, so
   the parameter box is the converted face's). Whatever cannot be read that way is evaluated point
   by point by FreeCAD (``value``/``getDN``: correct, slow).
+* :func:`face_trim`: how much of its surface's (u, v) box the face covers (``face.Area`` over the
+  area of ``face.Surface.toShape(u0, u1, v0, v1)``) and its holes (``len(face.Wires) - 1``): the
+  core covers the whole box, so a trimmed face is refused unless the property ``Untrimmed`` is
+  set (then Report records the fraction).
 * the panels (the core's :class:`~ght_cad.surfaces.bspline.BSplineSurfaceData`, degree 1 across the
   rulings, fitted to 1e-7 of the size) become ``Part.BSplineSurface`` faces
   (:func:`.convert.face_from_data`) joined into one shell along their seams at 1e-6 of the target
@@ -44,6 +48,7 @@ parameter range wide, and at its apex, where the rail's derivative vanishes, the
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -135,9 +140,25 @@ def face_target(face: "Part.Face", name: str = "face") -> Any:
     bounds = tuple(float(x) for x in src.ParameterRange)
     if not all(np.isfinite(bounds)):
         raise GHTError(f"{name} has the parameter range {bounds}; an approximation target must be a bounded face")
-    target = SurfaceTarget(lambda u, v, k: surf.jet(u, v, min(k, 2)), bounds, f"{name} ({surf.type_name})")
+    target = SurfaceTarget(lambda u, v, k: surf.jet(u, v, min(k, 2)), bounds, f"{name} ({surf.type_name})",
+                           trim=face_trim(face))
     target.path = surf.path + how
     return target
+
+
+def face_trim(face: "Part.Face") -> dict[str, float]:
+    r"""How much of its surface's (u, v) box a FreeCAD face covers (the OCP adapter's
+    :func:`ght_cad.cad.approximate.face_trim` with FreeCAD's Part API):
+    ``{"covered": face.Area / A_box, "holes": len(face.Wires) - 1}``, ``A_box`` the area of
+    ``face.Surface.toShape(u0, u1, v0, v1)`` over the face's ``ParameterRange``. A face whose trim
+    is its box gives ``covered = 1`` (to round-off) and no holes."""
+    u0, u1, v0, v1 = (float(x) for x in face.ParameterRange)
+    try:
+        box = float(face.Surface.toShape(u0, u1, v0, v1).Area)
+    except Exception:  # noqa: BLE001 - a surface FreeCAD cannot restrict: treated as its box
+        box = 0.0
+    covered = float(face.Area) / box if box > 0 and math.isfinite(box) else 1.0
+    return {"covered": covered, "holes": max(len(face.Wires) - 1, 0)}
 
 
 def target_face(link: Any, what: str) -> "Part.Face":
@@ -283,6 +304,11 @@ class DevelopableApproximationFeature(FeatureProxy):
                 setattr(obj, name, list(choices))
                 if value in choices:
                     setattr(obj, name, value)
+        if "Untrimmed" not in obj.PropertiesList:
+            obj.addProperty("App::PropertyBool", "Untrimmed", "Approximation", "Cover a trimmed face (holes, or an outline "
+                            "inside its surface's (u, v) box) over the whole box of its surface knowingly; false: a "
+                            "trimmed face is refused")
+            obj.Untrimmed = False
         if "PanelMethods" not in obj.PropertiesList:
             obj.addProperty("App::PropertyStringList", "PanelMethods", "Result", "Per panel: loft or dual (how its seams were found)")
 
@@ -321,17 +347,22 @@ class DevelopableApproximationFeature(FeatureProxy):
                 within Tolerance with at most MaxPanels panels (the best deviation reached).
         """
         from ght_cad.approximation import approximate
+        from ght_cad.approximation.target import TRIM_ALLOWED, TrimmedTargetError, trim_words
 
         face = target_face(obj.Target, f"{obj.Label}.Target")
         tol = tolerance_property(obj)
         max_panels = int(obj.MaxPanels)
         if max_panels < 1:
             raise GHTError(f"{obj.Label}.MaxPanels={max_panels} is not allowed; it must be an integer >= 1")
-        target = face_target(face, f"{obj.Target[0].Label}.{(obj.Target[1] or ['Face1'])[0]}")
+        label = f"{obj.Target[0].Label}.{(obj.Target[1] or ['Face1'])[0]}"
+        target = face_target(face, label)
         try:
             with _RecomputeProgress(f"{obj.Label}: developable approximation") as say:
                 res = approximate(target, tol, direction=str(obj.Direction), max_panels=max_panels,
-                                  method=str(obj.Method), progress=say)
+                                  method=str(obj.Method), progress=say, untrimmed=bool(obj.Untrimmed))
+        except TrimmedTargetError as exc:
+            raise GHTError(f"{obj.Label}.Target = {label} is {trim_words(exc.covered, exc.holes)}; {TRIM_ALLOWED}, or "
+                           f"set {obj.Label}.Untrimmed = True to cover its surface over the whole (u, v) box knowingly") from None
         except GHTError as exc:  # name the feature's properties, not the core's arguments
             raise GHTError(f"{' '.join(str(exc).split())} (properties Tolerance, MaxPanels)") from None
         return res, target.path
@@ -356,6 +387,10 @@ class DevelopableApproximationFeature(FeatureProxy):
         obj.Report = (f"{len(panels)} developable panel{'s' if len(panels) != 1 else ''} within {res.max_deviation:.4g} (Tolerance {res.tol:g}), rulings along "
                       f"{res.direction}, Method {obj.Method} ({obj.PanelMethods.count('loft')} loft, {obj.PanelMethods.count('dual')} dual), target "
                       f"evaluated by {path}, {res.info.get('seconds', 0.0):.1f} s")
+        trim = res.info.get("trim")
+        if trim and (trim["holes"] or trim["covered"] < 1.0 - 1e-6):
+            obj.Report += (f"; Untrimmed: the trimmed target ({trim['covered']:.4g} of its (u, v) box, {trim['holes']} "
+                           "hole(s)) covered over its whole box")
         obj.Shape = shape
         self._exact = [_exact(p) for p in panels]  # not saved (FeatureProxy.__getstate__): see surface
 
@@ -439,6 +474,7 @@ def make_developable_approximation(
     max_panels: int = 64,
     direction: str = "auto",
     method: str = "auto",
+    untrimmed: bool = False,
     flat_pattern: bool = False,
     doc: Any = None,
     name: str = "DevelopableApproximation",
@@ -452,6 +488,7 @@ def make_developable_approximation(
         direction: one of :data:`DIRECTIONS` (the core's: ``"auto"``, ``"u"``, ``"v"``, ...): the
             parameter the rulings run along.
         method: ``"auto"``, ``"loft"`` or ``"dual"`` (:data:`METHODS`): how each strip is fitted.
+        untrimmed: property ``Untrimmed``: cover a trimmed face over its surface's whole (u, v) box.
         flat_pattern: also make the *Flat pattern* of all panels (a child in the tree,
             :func:`flat_patterns_of`).
 
@@ -473,6 +510,7 @@ def make_developable_approximation(
     obj.MaxPanels = int(max_panels)
     obj.Direction = direction
     obj.Method = method
+    obj.Untrimmed = bool(untrimmed)
     obj.Document.recompute()
     if flat_pattern and not failed(obj):  # a failed approximation has no panels to unroll
         from .flat_pattern import make_flat_pattern

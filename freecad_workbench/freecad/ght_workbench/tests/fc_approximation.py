@@ -13,7 +13,9 @@ Direction and Method are enumerations of the core's choices and reach it (a smal
 loft along u, then v: every panel a loft, DirectionUsed as asked, recorded in Report), with the
 ``Base.ProgressIndicator`` fed by the core's progress lines and nothing in the Report view.
 Refusals (bad Tolerance, MaxPanels, unset Target, a tolerance the panel count cannot meet) are one
-line each naming the property.
+line each naming the property. A trimmed face (the small dome with a hole: covers 0.9295 of its
+surface's (u, v) box; with a curved outline: 0.8588) is refused naming ``Untrimmed`` and the
+fraction; with ``Untrimmed`` it is covered over its whole box and Report records the fraction.
 
 Run: ``PYTHONPATH=<repo>/freecad_workbench:<repo> freecadcmd -t freecad.ght_workbench.tests.fc_approximation``
 """
@@ -246,6 +248,48 @@ class DevelopableApproximationTest(RefusalAssertions, unittest.TestCase):
         self.assertEqual(list(obj.getEnumerationsOfProperty("Direction")), da.DIRECTIONS)
         self.assertEqual(obj.Direction, "u")
         print(f"small dome tol 1: loft along u {loft_u} panels; loft along v {obj.PanelCount} panels")
+
+    def test_trimmed_face_refused_unless_untrimmed(self):
+        # the small dome with a hole (a vertical cylinder r 60 cut through it) and trimmed by a curved
+        # outline (common with a side cylinder r 300): face_trim measures the covered fraction of the
+        # surface's (u, v) box; the feature refuses both naming Untrimmed and the fraction; with
+        # Untrimmed the surface is covered over its whole box and Report records the fraction
+        pts = [[App.Vector(x, y, (x * x + y * y) / 4000) for y in range(-200, 201, 100)] for x in range(-200, 201, 100)]
+        srf = Part.BSplineSurface()
+        srf.interpolate(pts)
+        plain = srf.toShape()
+        holed = plain.cut(Part.makeCylinder(60, 400, App.Vector(0, 0, -100))).Faces[0]
+        deck = plain.common(Part.makeCylinder(300, 400, App.Vector(0, -330, -100))).Faces[0]
+        for face in (plain, Part.makeCone(2, 4, 10).Faces[0], self.cap().Shape.Faces[0]):
+            trim = da.face_trim(face)
+            self.assertEqual(trim["holes"], 0)
+            self.assertAlmostEqual(trim["covered"], 1.0, delta=1e-9)
+        th, td = da.face_trim(holed), da.face_trim(deck)
+        self.assertEqual((th["holes"], td["holes"]), (1, 0))
+        # the hole's area on the dome, by FreeCAD: the cut-away disc (plain.common(cylinder))
+        disc = plain.common(Part.makeCylinder(60, 400, App.Vector(0, 0, -100))).Area
+        self.assertAlmostEqual(th["covered"], 1.0 - disc / plain.Area, delta=1e-6)
+        feats = []
+        for label, face, holes in (("HoledDome", holed, "1 hole"), ("DeckDome", deck, "0 holes")):
+            src = self.doc.addObject("Part::Feature", label)
+            src.Shape = face
+            self.doc.recompute()
+            obj = da.make_developable_approximation((src, "Face1"), 1.0, method="loft", direction="u", doc=self.doc)
+            self.assertTrue(_base.failed(obj), obj.State)
+            msg = obj.getStatusString()
+            covered = th["covered"] if label == "HoledDome" else td["covered"]
+            self.assertRegex(msg, rf"^{obj.Label}.Target = {label}.Face1 is a trimmed face: it covers {covered:.4g} of its "
+                             rf"surface's \(u, v\) box, {holes}; .*set {obj.Label}.Untrimmed = True")
+            feats.append(obj)
+        self.doc.removeObject(feats[1].Name)
+        obj = feats[0]
+        obj.Untrimmed = True
+        self.assert_recompute_clean(self.doc, obj)
+        self.assert_panels(obj)
+        self.assertLessEqual(obj.MaxDeviation, 1.0)
+        self.assertIn(f"Untrimmed: the trimmed target ({th['covered']:.4g} of its (u, v) box, 1 hole(s))", obj.Report)
+        print(f"trimmed dome: hole covers {th['covered']:.4f} (1 hole), deck covers {td['covered']:.4f}; refused; "
+              f"Untrimmed: {obj.PanelCount} panels, MaxDeviation {obj.MaxDeviation:.4f}")
 
     def test_refusals_name_the_property(self):
         cone = self.doc.addObject("Part::Cone", "Cone")
