@@ -211,3 +211,22 @@ def test_design_key_untrimmed(dome, tmp_path: Path, capsys: pytest.CaptureFixtur
     spec = parse_design(d, "d.toml").surfaces[0]
     assert spec.untrimmed is True and parse_design(BASE, "d.toml").surfaces[0].untrimmed is False
     assert parse_design(d, "d.toml").to_dict()["surfaces"][0]["untrimmed"] is True
+
+
+@pytest.mark.slow
+def test_design_untrimmed_true_runs_and_reports_the_fraction(dome, tmp_path: Path) -> None:
+    """``untrimmed = true`` on a design's approximate surface with the holed STEP face: the run
+    succeeds and ``surface.approximation.trim`` records 0.874 and the hole."""
+    from test_design_approximate import BASE, _toml
+
+    from ght_cad.cad.occ import write_step
+
+    write_step(holed_face(dome), tmp_path / "holed.step")
+    d = copy.deepcopy(BASE)
+    d["surfaces"][0].update(target={"step": "holed.step", "face": 1}, tol=2.0, method="loft", untrimmed=True)
+    d["outputs"] = {"files": ["json"], "figures": []}
+    (tmp_path / "d.toml").write_text(_toml(d))
+    assert main(["run", str(tmp_path / "d.toml"), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
+    ap = json.loads((tmp_path / "out" / "report.json").read_text())["surface"]["approximation"]
+    trim = ap["trim"]
+    assert trim["untrimmed"] and trim["holes"] == 1 and 0.85 < trim["covered"] < 0.9 and ap["max_deviation"] <= 2.0, trim

@@ -220,7 +220,7 @@ def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
              f"- total area: {report['total_area']:.6g}", "",
              "| panel | max out | max in | theta_max (deg) | area | flat area |",
              "|---|---|---|---|---|---|"]
-    trim = (report.get("info") or {}).get("trim")
+    trim = report.get("trim") or (report.get("info") or {}).get("trim")
     if trim and (trim["holes"] or trim["covered"] < 1.0 - 1e-6):
         lines[6:6] = [f"- trimmed target covered over its whole (u, v) box (untrimmed): the face covers "
                       f"{trim['covered']:.4g} of it, {trim['holes']} hole(s)"]
@@ -234,12 +234,17 @@ def report_markdown(report: dict[str, Any], heading: str = "#") -> str:
 
 
 def approximation_report(result: Any, pattern: Any = None, *, name: str = "target",
-                         method: str = "auto") -> dict[str, Any]:
+                         method: str = "auto", info: bool = True) -> dict[str, Any]:
     """The report of an approximation (``report.json`` of ``ght-cad approximate``, ``surface.approximation``
     of a design's ``approximate`` surface): :meth:`ApproximationResult.as_dict` with the name, the
     ``method`` asked for (each panel's ``method`` says what it got) and, given the flat ``pattern``,
-    every panel's flat area and label."""
+    every panel's flat area and label. ``info=False`` (a design's report) leaves the core's ``info``
+    out but its ``trim`` (a trimmed face covered over its (u, v) box: the fraction, the holes)."""
     report = result.as_dict()
+    if not info:
+        trim = (report.pop("info", None) or {}).get("trim")
+        if trim is not None:
+            report["trim"] = trim
     report["name"] = name
     report["method"] = method
     if pattern is not None:

@@ -495,8 +495,7 @@ def _approximation_summary(built: BuiltSurface) -> dict[str, Any]:
     s = built.surface
     u = np.linspace(0, 1, 257)
     lengths = np.concatenate([np.asarray(p.ruling_lengths(u), dtype=float) for p in s.parts])
-    res = approximation_report(s.result, name=built.design.name, method=s.method)
-    res.pop("info", None)
+    res = approximation_report(s.result, name=built.design.name, method=s.method, info=False)
     return {
         "surface": {
             "type": "approximate",

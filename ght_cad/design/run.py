@@ -307,8 +307,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 from .approximate import approximation_report
 
                 report["surface"]["approximation"] = approximation_report(built.surface.result, pattern,
-                                                                          name=design.name, method=built.surface.method)
-                report["surface"]["approximation"].pop("info", None)
+                                                                          name=design.name, method=built.surface.method,
+                                                                          info=False)
             if "dxf" in want_files:
                 pattern.export_dxf(stage.path(FILE_NAMES["dxf"]), chord_tol=chord_tol)
             if "svg" in want_files:
