@@ -44,7 +44,7 @@ class _Seam:
         t = np.asarray(t, dtype=float).ravel()
         y = np.full(t.size, self.y)
         if not np.any(self.coef):
-            j = self.f.jet(t, y, 1)
+            j = self.f.jet(t, y, 1 if order else 0)
             if not order:
                 return [j[0]]
             return [j[0], np.zeros_like(j[0]) if self.point else j[1]]
