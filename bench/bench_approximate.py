@@ -10,7 +10,7 @@ Targets (as B-spline faces, read through the OCP adapter):
 For each tolerance and method (``--methods``: ``loft`` = rails lofts between the centred seams only,
 ``dual`` = the dual fit of the tangent planes wherever usable, ``auto`` = per strip the closer of
 the two, spec 10.1): ``ght_cad.approximate`` (panels, largest deviation by its own two-way measure,
-wall time, the chosen mix ``dual/loft`` panels) beside the naive baseline of the issue: equally spaced isolines of the target (same
+wall time, the chosen mix ``dual/loft`` panels; a second line: the time of the seam march(es) in it) beside the naive baseline of the issue: equally spaced isolines of the target (same
 direction) as rails on the target, a developable between each pair (the rulings of
 ``det(a', b', b - a) = 0``, the equation ``developable_loft`` traces, solved per ruling), deviation
 measured one way (panel points projected onto the target); the baseline count is the smallest N
@@ -90,8 +90,10 @@ def main() -> None:
             nb = None
             for method in methods:
                 t0 = time.perf_counter()
+                stamps: list[tuple[float, str]] = [(t0, "")]
                 try:
-                    res = approximate(tg[name], tol, max_panels=200, method=method)
+                    res = approximate(tg[name], tol, max_panels=200, method=method,
+                                      progress=lambda m: stamps.append((time.perf_counter(), m)))
                 except GHTError as exc:  # a method that cannot meet tol: say so, keep going
                     print(f"{name:6} {tol:6.3g} {method:>6}  failed: {str(exc)[:80]}", flush=True)
                     continue
@@ -102,6 +104,9 @@ def main() -> None:
                 rows.append((name, tol, len(res.panels), res.max_deviation, dt, nb, method))
                 print(f"{name:6} {tol:6.3g} {method:>6} {len(res.panels):6d} {nd:3d}/{len(res.panels) - nd:<3d} "
                       f"{res.max_deviation:9.4g} {dt:7.1f} {nb:8d} {nb / len(res.panels):6.2f}", flush=True)
+                # the seam march's share of the time: from the message before each "march f=..." to it
+                marches = [b[0] - a[0] for a, b in zip(stamps[:-1], stamps[1:]) if b[1].startswith("march")]
+                print(f"{'':6} {'':6} {'':6}   march {sum(marches):.1f} s of {dt:.1f} s ({len(marches)} marches)", flush=True)
     if args.png:
         from ght_cad.curves.plotting import _figure, _save
 

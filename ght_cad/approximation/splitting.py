@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import weakref
+from typing import Callable
 
 import numpy as np
 
@@ -210,6 +211,74 @@ def _march_piece(frame: _Frame, tol: float, f: float, max_panels: int, min_width
     return ys
 
 
+def _width(frame: _Frame, y0: float, y1: float) -> float:
+    lo, hi = _range_between(frame, y0, y1)
+    return hi - lo
+
+
+def _bisection_point(y0: float, y_end: float, eps: float, j: int) -> float:
+    """The float the bisection of ``[y0, y_end]`` to width ``eps`` (``mid = (lo + hi) / 2``) reaches
+    as its lower end when grid point ``j`` (of ``y0 + j (y_end - y0) / 2^K``) passes and ``j + 1``
+    fails: the same arithmetic, bit for bit."""
+    lo, hi = y0, y_end
+    a, b = 0, _levels(y0, y_end, eps)
+    while hi - lo > eps and b - a > 1:
+        mid = 0.5 * (lo + hi)
+        m = (a + b) // 2
+        if j >= m:
+            lo, a = mid, m
+        else:
+            hi, b = mid, m
+    return lo
+
+
+def _levels(y0: float, y_end: float, eps: float) -> int:
+    """``2^K``, K the halvings of ``y_end - y0`` down to ``eps``."""
+    w, n = y_end - y0, 1
+    while w > eps:
+        w *= 0.5
+        n *= 2
+    return n
+
+
+def _next_seam(width: Callable[[float], float], limit: float, y0: float, y_end: float, r_end: float) -> float:
+    r"""The greedy step: the seam after ``y0``, the point of bisection of ``(y0, y_end]`` for the
+    strip range ``width(y1) <= limit`` to ``eps = max(1e-3 (y_end - y0), 1e-9)``
+    (``r_end = width(y_end) > limit``), found on the same grid ``y0 + j (y_end - y0) / 2^K`` with
+    the same floats, so with a range that grows with y1 the same answer: the largest grid point
+    that passes, the next one failing.
+
+    The range grows about with the square of the strip width, so ``sqrt(width)`` is about linear in
+    ``y1``: its secant through the ends of the bracket (indices ``jl`` passing, ``jh`` failing)
+    estimates the index of ``width = limit``; the trial is the grid point below the estimate after
+    a failing trial and the one above after a passing one (two trials then close the bracket).
+    Safeguard: a model step that does not halve the bracket is followed by a bisection step (at most
+    twice the trials of plain bisection; measured on the hull: 4-5 trials a seam instead of 10)."""
+    eps = max(1e-3 * (y_end - y0), 1e-9)
+    jl, jh = 0, _levels(y0, y_end, eps)
+    g_lo, g_hi, g = 0.0, float(np.sqrt(r_end)), float(np.sqrt(limit))
+    best = y0
+    passed = bisect = False
+    while jh - jl > 1:
+        before = jh - jl
+        model = not bisect and g_hi > g_lo and g_lo <= g <= g_hi
+        if model:
+            est = jl + (jh - jl) * (g - g_lo) / (g_hi - g_lo)
+            m = int(np.floor(est)) + (1 if passed else 0)
+            m = min(max(m, jl + 1), jh - 1)
+        else:
+            m = (jl + jh) // 2
+        y = _bisection_point(y0, y_end, eps, m)
+        r = width(y)
+        passed = r <= limit
+        if passed:
+            jl, g_lo, best = m, float(np.sqrt(max(r, 0.0))), y
+        else:
+            jh, g_hi = m, float(np.sqrt(max(r, 0.0)))
+        bisect = model and jh - jl > before // 2
+    return best
+
+
 def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float, y_start: float = 0.0,
             y_end: float = 1.0) -> list[float]:
     """The greedy march with the deviation range ``limit`` from ``y_start`` to ``y_end`` (stops
@@ -217,21 +286,11 @@ def _greedy(frame: _Frame, limit: float, max_panels: int, min_width: float, y_st
     ys = [y_start]
     while ys[-1] < y_end:
         y0 = ys[-1]
-
-        def ok(y1: float) -> bool:
-            lo, hi = _range_between(frame, y0, y1)
-            return hi - lo <= limit
-
-        if ok(y_end):
+        r_end = _width(frame, y0, y_end)
+        if r_end <= limit:
             ys.append(y_end)
             break
-        lo_y, hi_y = y0, y_end
-        while hi_y - lo_y > max(1e-3 * (y_end - y0), 1e-9):
-            mid = 0.5 * (lo_y + hi_y)
-            if ok(mid):
-                lo_y = mid
-            else:
-                hi_y = mid
+        lo_y = _next_seam(lambda y1: _width(frame, y0, y1), limit, y0, y_end, r_end)
         nxt = max(lo_y, y0 + min_width)
         ys.append(min(nxt, y_end))
         if len(ys) - 1 > max_panels:
