@@ -45,7 +45,7 @@ def _freecad_side(folder: Path) -> None:
     import Part
 
     from freecad.ght_workbench import flat_pattern
-    from ght_cad.face_unroll import unroll_face_data
+    from ght_cad.unrolling.face_unroll import unroll_face_data
 
     reps = int(os.environ.get("GHT_BENCH_REPS", "10"))
     out = {}

@@ -24,7 +24,7 @@ import numpy as np
 from ght_cad import GHTCurve, developable_from_planes
 from ght_cad.curves.curve import integrate
 from ght_cad.surfaces.ruled import CurvePairRuledSurface
-from ght_cad.unroll import ruled_area, unroll
+from ght_cad.unrolling.unroll import ruled_area, unroll
 
 
 def quarter(r: float, z: float) -> GHTCurve:

@@ -177,7 +177,7 @@ def _rounds() -> int:
 
 def ours_call(face: Any, count: int = 1) -> tuple[float, Any]:
     """``count`` calls of ``unroll(face)`` (including the distortion report): (fastest seconds, pattern)."""
-    from ght_cad.unroll import unroll
+    from ght_cad.unrolling.unroll import unroll
 
     best = float("inf")
     for _ in range(count):
@@ -209,7 +209,7 @@ def compare(faces: dict[str, Any], rel_deflection: float = 1e-3, freecadcmd: str
     both sides see the same machine state, each warm; a side's time is its fastest call over all
     rounds, ``ratio_median`` the median over the rounds of (our fastest / flatmesh's fastest).
     """
-    from ght_cad.unroll import unroll
+    from ght_cad.unrolling.unroll import unroll
 
     for face in faces.values():  # one-off costs (imports, caches of pure functions) outside the rounds
         unroll(face, rulings=16)

@@ -59,7 +59,7 @@ def main(out_dir: str | Path = "out") -> dict[str, Any]:
     from ght_cad.cad.developable_faces import face_developability, joint_normal_deviation, shell_faces
     from ght_cad.cad.occ import is_valid, write_step
 
-    from ght_cad.unroll import unroll_composite
+    from ght_cad.unrolling.unroll import unroll_composite
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -34,7 +34,7 @@ from .curves.seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, regi
 # ``ght_cad.unroll`` is the submodule, made callable (its ``__call__`` is the stable function
 # ``unroll`` of spec section 9), so the package attribute is the same object whichever way and in
 # whichever order it is imported (numpy-only, ~30 ms).
-from . import unroll
+from . import unroll  # the shim: ght_cad.unroll and ght_cad.unrolling.unroll, one module object
 
 __version__ = "0.1.0"
 
@@ -93,6 +93,7 @@ _MOVED: dict[str, str] = {
                                         "progress", "step_guard", "_kernel", "outdir")},
     **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
     **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
+    **{n: f"ght_cad.unrolling.{n}" for n in ("unroll", "ruled_development", "face_unroll")},
     **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
 }
 

@@ -42,7 +42,7 @@ import numpy as np
 
 from .flat_pattern import (BoundaryEdge, FlatPanel, _polyline_param, _sagitta3, _shoelace, measure_panel,
                            shared_edge_pairs)
-from .ruled_development import RULED_EDGE_UV
+from .unrolling.ruled_development import RULED_EDGE_UV
 
 __all__ = ["join_panels", "ruled_conormals", "JoinedDevelopment", "rigid_motion_onto", "outline_self_overlap"]
 

@@ -235,7 +235,7 @@ def plate_volume(surface: RuledSurface, sheet: Any, *, rtol: float = 1e-13) -> f
     """
     from .curves.curve import integrate
     from .sheet import ruling_normal
-    from .unroll import _smooth_pieces, ruled_area
+    from .unrolling.unroll import _smooth_pieces, ruled_area
 
     if not isinstance(surface, RuledSurface):
         raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")

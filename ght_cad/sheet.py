@@ -49,7 +49,7 @@ from .faces.ruled_face import FaceRuledSurface
 from .pattern.forming import FormingRow, _fmt_r, forming_table_text, plot_roll_chart  # noqa: F401 - moved there (issue 27)
 from .pattern.model import _inside, romberg_length
 from .surfaces.ruled import SINGULAR_NORMAL_TOL, RuledSurface
-from .ruled_development import _smooth_pieces, unroll_ruled_surface
+from .unrolling.ruled_development import _smooth_pieces, unroll_ruled_surface
 
 __all__ = [
     "SIDES",

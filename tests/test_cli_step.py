@@ -124,7 +124,7 @@ def test_project_face_and_two_strip_shell(tmp_path: Path, capsys) -> None:
     """An exact quarter cone from control planes, and a shell of two G2-joined strips: one panel
     per face, the shared ruling marked on both panels, each panel's area = its strip's area."""
     from ght_cad.cad.developable_faces import composite_shell
-    from ght_cad.unroll import ruled_area
+    from ght_cad.unrolling.unroll import ruled_area
 
     quarter = developable_from_planes([[-400, 1, 0, 0.5], [-400, 1, 1, 0.5], [-400, 0, 1, 0.5]],
                                       [[0, 0, 0, 1], [-400, 0, 0, 1]], 0, 0, -1)

@@ -19,7 +19,7 @@ from ght_cad.cad.cq_plugin import developable_loft_cq  # noqa: E402
 from ght_cad.cad.loft import loft_between  # noqa: E402
 from ght_cad.cad.occ import read_step, write_step  # noqa: E402
 from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
-from ght_cad.unroll import unroll  # noqa: E402
+from ght_cad.unrolling.unroll import unroll  # noqa: E402
 
 RTOL = 1e-9  # as tests/test_unroll_faces.py
 POINTS = [(0.0, 0.0), (4.0, 3.0), (8.0, 0.0)]  # as tests/test_cad_papercuts.py

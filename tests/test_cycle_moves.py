@@ -58,9 +58,9 @@ def test_sheet_forming_names_resolve_from_sheet() -> None:
 def test_ruled_development_names_resolve_from_unroll() -> None:
     """Cycles unroll <-> sheet and unroll <-> join_panels: the development of one ruled surface moved
     from ``ght_cad.unroll`` to ``ght_cad.ruled_development``; ``ght_cad.unroll`` gives every moved name."""
-    import ght_cad.ruled_development as rd
-    import ght_cad.unroll as un
-    from ght_cad.unroll import RuledDevelopment, _smooth_pieces, metric_angles, ruled_area  # noqa: F401 - old imports
+    import ght_cad.unrolling.ruled_development as rd
+    import ght_cad.unrolling.unroll as un
+    from ght_cad.unrolling.unroll import RuledDevelopment, _smooth_pieces, metric_angles, ruled_area  # noqa: F401 - old imports
 
     moved = ["DEFAULT_TOL_DEG", "RULED_EDGE_UV", "RuledDevelopment", "_PanelSeries", "_check_developable", "_chebint",
              "_clenshaw", "_coefficients", "_cheb_rows_of", "_fd5", "_frame", "_initial_edges", "_metric_samples",
@@ -70,7 +70,7 @@ def test_ruled_development_names_resolve_from_unroll() -> None:
         assert getattr(un, name) is getattr(rd, name), name
     assert set(un.__all__) == {"unroll", "unroll_composite", "unroll_ruled", "ruled_area", "RuledDevelopment",
                                "DEFAULT_TOL_DEG"}
-    assert callable(un) and un.unroll_ruled.__module__ == "ght_cad.unroll"
+    assert callable(un) and un.unroll_ruled.__module__ == "ght_cad.unrolling.unroll"
 
 
 def test_unroll_ruled_without_a_sheet_is_the_ruled_development() -> None:
@@ -79,10 +79,10 @@ def test_unroll_ruled_without_a_sheet_is_the_ruled_development() -> None:
     import numpy as np
 
     from ght_cad import GHTCurve
-    from ght_cad.ruled_development import unroll_ruled_surface
+    from ght_cad.unrolling.ruled_development import unroll_ruled_surface
     from ght_cad.sheet import make_sheet
     from ght_cad.surfaces.ruled import CurvePairRuledSurface
-    from ght_cad.unroll import unroll_ruled
+    from ght_cad.unrolling.unroll import unroll_ruled
 
     surf = CurvePairRuledSurface(GHTCurve([(1, 0, 0), (1, 1, 0), (0, 1, 0)], gamma=-1),
                                  GHTCurve([(2, 0, 3), (2, 2, 3), (0, 2, 3)], gamma=-1))

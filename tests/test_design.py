@@ -282,7 +282,7 @@ def test_two_strip_design_end_to_end(tmp_path: Path) -> None:
     # pattern (issue 23): the strips meet G2, so ONE blank labelled with the design's name whose
     # flat area is the sum of the strips' 3-D areas (independent quadrature) to 1e-12; the joint
     # ruling is a bend line, no cut edge is left to mark
-    from ght_cad.unroll import ruled_area as ruled_area_adaptive
+    from ght_cad.unrolling.unroll import ruled_area as ruled_area_adaptive
 
     comp = build_surface(load_design(EXAMPLES / "design_duct_two_strips.toml")).surface
     panels = r["flat_pattern"]["panels"]

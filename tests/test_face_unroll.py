@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from ght_cad.core.errors import NotDevelopableError
-from ght_cad.face_unroll import (
+from ght_cad.unrolling.face_unroll import (
     EdgeData,
     FaceData,
     SurfaceAdapter,
@@ -500,7 +500,7 @@ def test_clip_rulings_uv_disc_chord(c: float, lo: float, hi: float) -> None:
 def test_inner_nodes_of_one_u_match_the_vectorized_rule(u: float, u_lo: float, breaks: list, span) -> None:
     """The plain-float panels of one constant-u edge are the vectorized ones, bit for bit (the
     same cuts at the breaks, halves, panels no wider than span / 8, 12-point rule)."""
-    from ght_cad.face_unroll import _gauss12, _inner_nodes, _inner_nodes_at
+    from ght_cad.unrolling.face_unroll import _gauss12, _inner_nodes, _inner_nodes_at
 
     xg, wg = _gauss12()
     br = np.sort(np.asarray(breaks + [u], dtype=float))

@@ -13,7 +13,7 @@ from ght_cad import GHTCurve
 from ght_cad.core.errors import GHTError
 from ght_cad.flat_pattern import DistortionReport, FlatPattern, clip_segments, romberg_length
 from ght_cad.surfaces.ruled import CurvePairRuledSurface
-from ght_cad.unroll import unroll, unroll_composite
+from ght_cad.unrolling.unroll import unroll, unroll_composite
 
 from dxf_read import dxf_outline_areas, outline_bulges, outline_vertices, svg_outline_areas
 

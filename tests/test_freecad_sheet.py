@@ -23,7 +23,7 @@ def test_sheet_inside_freecad_and_its_plate_unrolled_here(tmp_path) -> None:
     run_fc_unittest("freecad.ght_workbench.tests.fc_sheet", tmp_path, 5, timeout=300)
     from ght_cad.cad.occ import is_valid, read_step
     from ght_cad.cad.sheet_solid import plate_faces
-    from ght_cad.unroll import unroll
+    from ght_cad.unrolling.unroll import unroll
     from tests.test_sheet import cylinder
 
     d = json.loads((tmp_path / "fc_plate.json").read_text())

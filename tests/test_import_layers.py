@@ -55,7 +55,7 @@ _LAYER_OF = {
     # the layer packages of issue 27 are named after their layer; a few modules stay top-level
     "core": ["core"],
     "curves": ["curves"],
-    "surfaces": ["surfaces", "developable", "loft", "sheet", "plate", "unroll", "ruled_development", "face_unroll",
+    "surfaces": ["surfaces", "unrolling", "developable", "loft", "sheet", "plate",
                  "flat_pattern", "pattern", "faces", "developables", "join_panels", "outline_arcs", "blank"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],

@@ -13,7 +13,7 @@ import pytest
 from ght_cad.join_panels import outline_self_overlap, rigid_motion_onto
 from ght_cad.surfaces.ruled import FunctionRuledSurface
 from ght_cad.sheet import Sheet
-from ght_cad.unroll import unroll_composite
+from ght_cad.unrolling.unroll import unroll_composite
 
 R, THETA, H = 50.0, 2.0, 60.0
 

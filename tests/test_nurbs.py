@@ -190,7 +190,7 @@ def test_face_area_inner_integrals_by_pieces(seed: int, pu: int, pv: int, su: in
     B-spline faces) equal the point-by-point quadrature on the same panels to 1e-13 of the
     largest |P| (rounding: the same nodes, summed in another order), for points above and below
     u_lo, on knots and between them, with and without the u_span/8 panel cap."""
-    from ght_cad.face_unroll import _inner_integrals, _inner_integrals_by_pieces
+    from ght_cad.unrolling.face_unroll import _inner_integrals, _inner_integrals_by_pieces
 
     rng = np.random.default_rng(seed)
     U, V, _, _, surface = _random_surface(rng, pu, pv, su, sv, rational)

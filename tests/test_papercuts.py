@@ -55,9 +55,9 @@ def test_unroll_is_one_coherent_module_that_can_be_called():
     root = Path(__file__).resolve().parents[1]
     code = r"""
 import inspect, types
-import ght_cad.unroll
-import ght_cad.unroll as m
-from ght_cad.unroll import unroll_composite, ruled_area
+import ght_cad.unrolling.unroll
+import ght_cad.unrolling.unroll as m
+from ght_cad.unrolling.unroll import unroll_composite, ruled_area
 from ght_cad import unroll as u
 import ght_cad
 assert isinstance(ght_cad.unroll, types.ModuleType), type(ght_cad.unroll)

@@ -35,7 +35,7 @@ from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
 from ght_cad.loft import developable_loft  # noqa: E402
 from ght_cad.plate import plate_bspline, plate_volume  # noqa: E402
 from ght_cad.sheet import Sheet, SheetError, check_offset, ruling_normal  # noqa: E402
-from ght_cad.unroll import unroll  # noqa: E402
+from ght_cad.unrolling.unroll import unroll  # noqa: E402
 from tests.test_loft import CHINE, SHEER, hopper_rails  # noqa: E402
 
 VOLUME_RTOL = 1e-6
@@ -89,7 +89,7 @@ def check_outside_at_thickness(plate, U: np.ndarray, V: np.ndarray, T: float) ->
 def _abs_turn(loft, sheet) -> float:
     """``(T²/2) ∫ |2H| dA = (T²/2) ∫ |ω| |g| du`` (ω = n'·e, module doc of ght_cad.plate)."""
     from ght_cad.curves.curve import integrate
-    from ght_cad.unroll import _smooth_pieces
+    from ght_cad.unrolling.unroll import _smooth_pieces
 
     def f(u: np.ndarray) -> np.ndarray:
         n, n1 = ruling_normal(loft, u, 1)

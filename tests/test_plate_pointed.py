@@ -30,7 +30,7 @@ from ght_cad.core.errors import NotDevelopableError  # noqa: E402
 from ght_cad.loft import developable_loft  # noqa: E402
 from ght_cad.plate import plate_volume  # noqa: E402
 from ght_cad.sheet import Sheet, SheetError, bending_radius, check_offset, ruling_normal  # noqa: E402
-from ght_cad.unroll import unroll  # noqa: E402
+from ght_cad.unrolling.unroll import unroll  # noqa: E402
 from tests.test_plate_fans import _size, check_inside_outside, check_outside_at_thickness  # noqa: E402
 
 SHEER = np.array([[0, -900, 1200], [1500, -1000, 1250], [3000, -700, 1350], [4200, 0, 1500]], float)

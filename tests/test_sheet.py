@@ -22,7 +22,7 @@ from ght_cad.sheet import (
     make_sheet,
     ruling_normal,
 )
-from ght_cad.unroll import unroll, unroll_composite
+from ght_cad.unrolling.unroll import unroll, unroll_composite
 
 CLOSED_FORM_RTOL = 1e-9
 

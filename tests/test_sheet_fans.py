@@ -18,7 +18,7 @@ import pytest
 from ght_cad import GHTCurve
 from ght_cad.loft import developable_loft
 from ght_cad.sheet import OffsetRuledSurface, Sheet, ruling_normal
-from ght_cad.unroll import ruled_area, unroll
+from ght_cad.unrolling.unroll import ruled_area, unroll
 
 #: relative tolerance of the neutral pattern against the reference (measured: below 4e-15)
 FAN_RTOL = 1e-12

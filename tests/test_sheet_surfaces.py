@@ -132,7 +132,7 @@ def test_neutral_patterns_as_for_one_surface() -> None:
     """Each panel is its surface's neutral pattern exactly as a single [surface] unrolls it."""
     from ght_cad.design import unroll_surfaces
     from ght_cad.sheet import OffsetRuledSurface
-    from ght_cad.unroll import ruled_area, unroll
+    from ght_cad.unrolling.unroll import ruled_area, unroll
 
     d, builts, sheets, rails = _sheets(_dory())
     pat = unroll_surfaces(builts)
@@ -181,7 +181,7 @@ k_factor = 0.4
 def test_neutral_patterns_exact_without_fans() -> None:
     from ght_cad.design import unroll_surfaces
     from ght_cad.sheet import OffsetRuledSurface
-    from ght_cad.unroll import ruled_area
+    from ght_cad.unrolling.unroll import ruled_area
 
     d, builts, sheets, rails = _sheets(CYL)
     assert [s.orientation for s in sheets] == [1.0, -1.0]  # side's rails given the other way round

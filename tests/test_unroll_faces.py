@@ -18,7 +18,7 @@ from ght_cad.surfaces.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face
 from ght_cad.cad.unroll_faces import face_ruling_direction, unroll_face
 from ght_cad.core.errors import GHTError, NotDevelopableError
-from ght_cad.unroll import unroll, unroll_composite
+from ght_cad.unrolling.unroll import unroll, unroll_composite
 
 RTOL = 1e-9
 
@@ -137,7 +137,7 @@ def test_affine_ruled_face_maps_like_the_projection() -> None:
     projecting every point onto its ruling instead gives the same pattern (outline, bend lines,
     area) to 1e-12 of its size."""
     from ght_cad.cad.unroll_faces import _open_face, face_data
-    from ght_cad.face_unroll import unroll_face_data
+    from ght_cad.unrolling.face_unroll import unroll_face_data
 
     tf, _, bounds, ev = _open_face(_tangent_developable_face())
     assert ev.ruled_hint == "v" and ev.affine_ruled

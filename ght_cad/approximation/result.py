@@ -36,7 +36,7 @@ class ConeStrip(RuledSurface):
 
     def area(self) -> float:
         """3-D area (:func:`ght_cad.unroll.ruled_area`)."""
-        from ..unroll import ruled_area
+        from ..unrolling.unroll import ruled_area
 
         return float(ruled_area(self, rtol=1e-13))
 
@@ -137,6 +137,6 @@ class ApproximationResult:
     def flat_pattern(self, **kwargs: Any) -> Any:
         """All panels unrolled on one sheet with seam marks (:func:`ght_cad.unroll.unroll_composite`
         of the exact developables, whose fans and apexes it handles; labels P1..PN in seam order)."""
-        from ..unroll import unroll_composite
+        from ..unrolling.unroll import unroll_composite
 
         return unroll_composite([p.exact if p.exact is not None else p.surface for p in self.panels], **kwargs)

@@ -108,7 +108,7 @@ def unfold_skin(
             ``allow_split``), a face graph that is not connected.
     """
     from ..core.errors import NotDevelopableError
-    from ..face_unroll import unroll_face_data
+    from ..unrolling.face_unroll import unroll_face_data
     from ..flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
     from ..sheet import Sheet, SheetError
 
@@ -145,7 +145,7 @@ def unfold_skin(
         if kind != "plane":
             ruled = "v" if kind in ("cylinder", "cone", "extrusion") else None
             if ruled is None:
-                from ..face_unroll import ruling_direction
+                from ..unrolling.face_unroll import ruling_direction
 
                 ruled = ruling_direction(fd.surface, fd.bounds)[0]
                 if ruled is None:

@@ -55,12 +55,12 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ._ocp import TopoDS
 
-from .. import face_unroll as _core
+from ..unrolling import face_unroll as _core
 from ..core.errors import GHTError
-from ..face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
+from ..unrolling.face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
 from ..flat_pattern import FlatPattern
 from ..surfaces.nurbs import NurbsCurve, NurbsSurface
-from ..unroll import DEFAULT_TOL_DEG
+from ..unrolling.unroll import DEFAULT_TOL_DEG
 
 __all__ = ["unroll_face", "FaceRuledSurface", "flat_faces", "face_ruling_direction", "face_area", "face_data", "shape_faces"]
 

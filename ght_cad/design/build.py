@@ -531,7 +531,7 @@ def _worst(ds: Sequence[dict[str, float]]) -> dict[str, float]:
 
 
 def _composite_summary(built: BuiltSurface) -> dict[str, Any]:
-    from ..unroll import ruled_area as exact_area
+    from ..unrolling.unroll import ruled_area as exact_area
 
     comp = built.surface
     spec = built.design.surface

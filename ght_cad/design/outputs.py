@@ -159,7 +159,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
     panel per strip (``"per-surface"``). A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
     distortion is then in the pattern's errors.
     """
-    from ..unroll import unroll
+    from ..unrolling.unroll import unroll
 
     d = built.design
     sheet = d.sheet.to_sheet() if d.sheet is not None else None  # [sheet]: the neutral surface (spec 6.1)
@@ -169,7 +169,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
         return panel_pattern(built.surface.result, built.surface.part_sheets(sheet), tol_deg=d.unroll.tol_deg,
                              rulings=d.unroll.rulings, samples=d.unroll.samples, units=d.units)
     if _is_composite(built.surface):
-        from ..unroll import unroll_composite
+        from ..unrolling.unroll import unroll_composite
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                                 samples=d.unroll.samples, units=d.units, labels=[g.name for g in d.surface.segments or []],
@@ -250,7 +250,7 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     blank (:func:`ght_cad.join_panels.join_panels`); sharp chines stay separate panels with marks."""
     if len(builts) == 1:
         return unroll_surface(builts[0])
-    from ..unroll import unroll_composite
+    from ..unrolling.unroll import unroll_composite
 
     d = builts[0].design
     if d.sheet is not None and not all(b.sheet_resolved for b in builts):

@@ -445,7 +445,7 @@ def unroll_step_face(p: Path, face: Any, k: int, n: int, *, best_effort: bool, t
         GHTError: any other refusal, the message prefixed with the file and face number.
     """
     from ..core.errors import NotDevelopableError
-    from ..unroll import unroll
+    from ..unrolling.unroll import unroll
 
     kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
     try:

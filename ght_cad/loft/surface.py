@@ -338,7 +338,7 @@ class DevelopableLoft(RuledSurface):
 
     def area(self) -> float:
         """3-D area, sum over the segments of ``∫∫ |(a' + v g') × g| dv du``."""
-        from ..unroll import ruled_area
+        from ..unrolling.unroll import ruled_area
 
         return float(sum(ruled_area(sg, rtol=1e-13) for sg in self.segments))
 
@@ -427,7 +427,7 @@ class DevelopableLoft(RuledSurface):
 
     # -- report --------------------------------------------------------------------------
     def _make_report(self, samples: int, candidates: list[dict[str, Any]], area_rtol: float) -> LoftReport:
-        from ..unroll import ruled_area
+        from ..unrolling.unroll import ruled_area
         from ..surfaces.ruled import _theta
 
         size = self._pair.size

@@ -179,8 +179,8 @@ def optimize_design(
             out.files["step"] = folder / f"{stem}.step"
     if flat and isinstance(obj, RuledSurface):
         try:
-            from ..unroll import DEFAULT_TOL_DEG
-            from ..unroll import unroll as _unroll
+            from ..unrolling.unroll import DEFAULT_TOL_DEG
+            from ..unrolling.unroll import unroll as _unroll
 
             tol = DEFAULT_TOL_DEG if tol_deg is None else float(tol_deg)
             theta = float(after.get("theta_max", obj.developability().theta_max))

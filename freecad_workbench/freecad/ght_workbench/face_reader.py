@@ -22,7 +22,7 @@ import FreeCAD as App
 import Part
 
 from ght_cad.core.errors import GHTError
-from ght_cad.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, jets_agree,
+from ght_cad.unrolling.face_unroll import (EdgeData, FaceData, SurfaceAdapter, analytic_jet, chain_loop, fd_derivative, jets_agree,
                                  surface_jet)
 from ght_cad.surfaces.nurbs import NurbsCurve, NurbsSurface, expand_knots
 

@@ -36,7 +36,7 @@ import FreeCAD as App
 import Part
 
 from ght_cad.core.errors import GHTError
-from ght_cad.face_unroll import unroll_face_data
+from ght_cad.unrolling.face_unroll import unroll_face_data
 
 from ._base import BaseCommand, FeatureProxy, ViewProviderBase, info_panel, new_feature, register_command, set_read_only
 from .convert import edge_from_data

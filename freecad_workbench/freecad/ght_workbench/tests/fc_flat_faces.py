@@ -27,7 +27,7 @@ from freecad.ght_workbench import _base, export, flat_pattern
 from freecad.ght_workbench.tests.fc_features import _reopen  # save, close, reopen, recompute (into $GHT_FC_OUT)
 from freecad.ght_workbench.tests.refusal import RefusalAssertions
 from ght_cad.core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
-from ght_cad.face_unroll import unroll_face_data
+from ght_cad.unrolling.face_unroll import unroll_face_data
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
 RTOL = 1e-9

@@ -36,7 +36,7 @@ import FreeCAD as App
 import Part
 
 from freecad.ght_workbench import _base, face_reader, flat_pattern
-from ght_cad.face_unroll import unroll_face_data
+from ght_cad.unrolling.face_unroll import unroll_face_data
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
 RESULTS_JSON = os.path.join(OUT, "nurbs.json")
