@@ -91,7 +91,7 @@ def _candidates(design, n: int):
 
 def cost_per_candidate(designs, n: int) -> None:
     from ght_cad.design import SHEET_MARGIN, check_sheet
-    from ght_cad.sheet import Sheet, SheetError
+    from ght_cad.sheetmetal.sheet import Sheet, SheetError
 
     print(f"\n1. cost per candidate ({n} random candidates per design; median ms)")
     print(f"{'design':48s} {'candidate':>10s} {'check':>8s} {'ratio':>6s} {'refused':>8s}")
@@ -116,7 +116,7 @@ def sample_study(designs, n: int) -> None:
     import math
 
     from ght_cad.design import sheet_parts
-    from ght_cad.sheet import Sheet, check_offset
+    from ght_cad.sheetmetal.sheet import Sheet, check_offset
 
     print(f"\n2. rulings checked per candidate ({n} candidates per design): largest relative overestimate of "
           "min |rho_0| against 513 rulings, and check time / time at 513")

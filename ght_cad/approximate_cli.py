@@ -148,7 +148,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     from .cad.approximate import step_target
     from .core.outdir import OutputFolder
     from .design.approximate import run_approximation
-    from .sheet import make_sheet
+    from .sheetmetal.sheet import make_sheet
 
     path = Path(args.target)
     if path.suffix.lower() not in (".step", ".stp"):

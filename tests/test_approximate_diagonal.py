@@ -230,7 +230,7 @@ def test_small_saddle_end_to_end_without_a_kernel(tmp_path):
     target's normal side, the deviation plot."""
     from ght_cad.approximation import ConeStrip
     from ght_cad.design.approximate import panel_sheets, plot_deviation
-    from ght_cad.sheet import Sheet
+    from ght_cad.sheetmetal.sheet import Sheet
 
     def jet(u, v, order):
         return saddle_target()._jet(u, v, order)

@@ -46,8 +46,8 @@ def test_sheet_forming_names_resolve_from_sheet() -> None:
     roll chart) moved to ``ght_cad.pattern.forming``; the sheet reads the pattern model and the face
     pieces (``ght_cad.pattern.model``, ``ght_cad.faces``) directly."""
     import ght_cad.pattern.forming as forming
-    import ght_cad.sheet as sheet
-    from ght_cad.sheet import FormingRow, forming_table_text, plot_roll_chart  # noqa: F401 - the old import works
+    import ght_cad.sheetmetal.sheet as sheet
+    from ght_cad.sheetmetal.sheet import FormingRow, forming_table_text, plot_roll_chart  # noqa: F401 - the old import works
 
     for name in ("FormingRow", "forming_table_text", "plot_roll_chart", "_fmt_r"):
         assert getattr(sheet, name) is getattr(forming, name), name
@@ -80,7 +80,7 @@ def test_unroll_ruled_without_a_sheet_is_the_ruled_development() -> None:
 
     from ght_cad import GHTCurve
     from ght_cad.unrolling.ruled_development import unroll_ruled_surface
-    from ght_cad.sheet import make_sheet
+    from ght_cad.sheetmetal.sheet import make_sheet
     from ght_cad.surfaces.ruled import CurvePairRuledSurface
     from ght_cad.unrolling.unroll import unroll_ruled
 

@@ -309,7 +309,7 @@ def test_two_strip_design_per_surface_panels_and_joined_blank_agree(tmp_path: Pa
     sum of those panels' flat areas to 1e-12 and its outline is one simple loop whose boundary edges
     are the panels' outer edges less the joint (same lengths to 1e-12)."""
     from ght_cad.design import build_surface, ruled_area, unroll_surface
-    from ght_cad.join_panels import outline_self_overlap
+    from ght_cad.sheetmetal.join_panels import outline_self_overlap
 
     per = parse_design_text(TWO_STRIPS.replace("[unroll]\n", '[unroll]\npanels = "per-surface"\n'), "two.toml")
     assert per.unroll.panels == "per-surface" and parse_design_text(TWO_STRIPS, "two.toml").unroll.panels == "joined"

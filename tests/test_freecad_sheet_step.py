@@ -19,7 +19,7 @@ pytestmark = pytest.mark.freecad
 def test_plates_from_ght_cad_are_valid_in_freecad(tmp_path) -> None:
     from ght_cad.cad.sheet_solid import plate_solid, write_plate_step
     from ght_cad.surfaces.ruled import CurvePairRuledSurface
-    from ght_cad.sheet import Sheet, ruling_normal
+    from ght_cad.sheetmetal.sheet import Sheet, ruling_normal
     from tests.test_sheet import cylinder, quarter
 
     r, h, T = 240.0, 100.0, 4.0

@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from ght_cad.join_panels import outline_self_overlap, rigid_motion_onto
+from ght_cad.sheetmetal.join_panels import outline_self_overlap, rigid_motion_onto
 from ght_cad.surfaces.ruled import FunctionRuledSurface
-from ght_cad.sheet import Sheet
+from ght_cad.sheetmetal.sheet import Sheet
 from ght_cad.unrolling.unroll import unroll_composite
 
 R, THETA, H = 50.0, 2.0, 60.0

@@ -33,8 +33,8 @@ from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_nam
 from ght_cad.developable import developable_bspline, ruled_pieces  # noqa: E402
 from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
 from ght_cad.loft import developable_loft  # noqa: E402
-from ght_cad.plate import plate_bspline, plate_volume  # noqa: E402
-from ght_cad.sheet import Sheet, SheetError, check_offset, ruling_normal  # noqa: E402
+from ght_cad.sheetmetal.plate import plate_bspline, plate_volume  # noqa: E402
+from ght_cad.sheetmetal.sheet import Sheet, SheetError, check_offset, ruling_normal  # noqa: E402
 from ght_cad.unrolling.unroll import unroll  # noqa: E402
 from tests.test_loft import CHINE, SHEER, hopper_rails  # noqa: E402
 

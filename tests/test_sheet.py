@@ -14,7 +14,7 @@ from ght_cad import GHTCurve
 from ght_cad.developable import RectifyingDevelopable, TangentDevelopable, developable_from_planes
 from ght_cad.core.errors import GHTError
 from ght_cad.surfaces.ruled import CurvePairRuledSurface
-from ght_cad.sheet import (
+from ght_cad.sheetmetal.sheet import (
     OffsetRuledSurface,
     Sheet,
     SheetError,

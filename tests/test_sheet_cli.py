@@ -16,7 +16,7 @@ import ezdxf  # noqa: E402
 from ght_cad.cad.occ import write_step  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_solid, write_plate_step  # noqa: E402
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
-from ght_cad.sheet import Sheet  # noqa: E402
+from ght_cad.sheetmetal.sheet import Sheet  # noqa: E402
 
 R, H, T, K = 240.0, 100.0, 4.0, 0.42
 

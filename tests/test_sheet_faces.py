@@ -12,7 +12,7 @@ pytest.importorskip("build123d")
 
 from build123d import Solid  # noqa: E402
 
-from ght_cad.sheet import Sheet, SheetError  # noqa: E402
+from ght_cad.sheetmetal.sheet import Sheet, SheetError  # noqa: E402
 from ght_cad.unrolling.unroll import unroll  # noqa: E402
 
 RTOL = 1e-9

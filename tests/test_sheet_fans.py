@@ -17,7 +17,7 @@ import pytest
 
 from ght_cad import GHTCurve
 from ght_cad.loft import developable_loft
-from ght_cad.sheet import OffsetRuledSurface, Sheet, ruling_normal
+from ght_cad.sheetmetal.sheet import OffsetRuledSurface, Sheet, ruling_normal
 from ght_cad.unrolling.unroll import ruled_area, unroll
 
 #: relative tolerance of the neutral pattern against the reference (measured: below 4e-15)

@@ -23,7 +23,7 @@ from ght_cad.design import (SHEET_MARGIN, build_curves, build_surface, check_she
 from ght_cad.design.optimize import _SheetGuard, _objective_fn, _value_and_grad_fn, composite_objective  # noqa: E402
 from ght_cad.design.optimize import composite_value_and_grad  # noqa: E402
 from ght_cad.surfaces.ruled import RuledSurface  # noqa: E402
-from ght_cad.sheet import Sheet, SheetError, check_offset  # noqa: E402
+from ght_cad.sheetmetal.sheet import Sheet, SheetError, check_offset  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -12,7 +12,7 @@ pytest.importorskip("OCP")
 from ght_cad.cad.occ import is_valid, read_step  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
 from ght_cad.surfaces.ruled import CurvePairRuledSurface  # noqa: E402
-from ght_cad.sheet import Sheet, SheetError, ruling_normal  # noqa: E402
+from ght_cad.sheetmetal.sheet import Sheet, SheetError, ruling_normal  # noqa: E402
 from ght_cad.unrolling.unroll import unroll  # noqa: E402
 from tests.test_sheet import _surfaces, cylinder, quarter  # noqa: E402
 

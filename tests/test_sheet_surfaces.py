@@ -131,7 +131,7 @@ def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
 def test_neutral_patterns_as_for_one_surface() -> None:
     """Each panel is its surface's neutral pattern exactly as a single [surface] unrolls it."""
     from ght_cad.design import unroll_surfaces
-    from ght_cad.sheet import OffsetRuledSurface
+    from ght_cad.sheetmetal.sheet import OffsetRuledSurface
     from ght_cad.unrolling.unroll import ruled_area, unroll
 
     d, builts, sheets, rails = _sheets(_dory())
@@ -180,7 +180,7 @@ k_factor = 0.4
 @pytest.mark.slow
 def test_neutral_patterns_exact_without_fans() -> None:
     from ght_cad.design import unroll_surfaces
-    from ght_cad.sheet import OffsetRuledSurface
+    from ght_cad.sheetmetal.sheet import OffsetRuledSurface
     from ght_cad.unrolling.unroll import ruled_area
 
     d, builts, sheets, rails = _sheets(CYL)

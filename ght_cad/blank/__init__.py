@@ -110,7 +110,7 @@ def unfold_skin(
     from ..core.errors import NotDevelopableError
     from ..unrolling.face_unroll import unroll_face_data
     from ..flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
-    from ..sheet import Sheet, SheetError
+    from ..sheetmetal.sheet import Sheet, SheetError
 
     if bend_lines not in ("tangent", "centre", "center"):
         raise BlankError(f"bend_lines={bend_lines!r} is not allowed; allowed: 'tangent' or 'centre'")

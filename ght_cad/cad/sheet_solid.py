@@ -59,7 +59,7 @@ from ._ocp import TopoDS
 
 from ..core.errors import GHTError
 from ..surfaces.ruled import RuledSurface
-from ..sheet import Sheet, SheetError, make_sheet
+from ..sheetmetal.sheet import Sheet, SheetError, make_sheet
 from .occ import is_valid, quiet_occt, unwrap
 
 #: how :func:`plate_solid` makes the solid of a RuledSurface: "exact" (its six faces built and sewn)
@@ -117,7 +117,7 @@ class PlateSolid:
         (:func:`ght_cad.plate.plate_volume`); None for a thickened face."""
         if self.surface is None:
             return None
-        from ..plate import plate_volume
+        from ..sheetmetal.plate import plate_volume
 
         return plate_volume(self.surface, self.sheet)
 
@@ -159,7 +159,7 @@ def _distance_to_surface(face: TopoDS_Face, point: np.ndarray) -> float:
 
 def _face_sheet_check(face: TopoDS_Face, sheet: Sheet, label: str) -> None:
     """The core's curvature check on a CAD face (:class:`ght_cad.sheet.FaceSheet`)."""
-    from ..sheet import FaceSheet
+    from ..sheetmetal.sheet import FaceSheet
     from .unroll_faces import _open_face, face_data
 
     f, _, bounds, ev = _open_face(face)
@@ -209,7 +209,7 @@ def plate_solid(
     if sheet is None or sheet.is_zero:
         raise SheetError(f"thickness={None if sheet is None else sheet.thickness!r} is not allowed for a solid plate; give a thickness > 0")
     if isinstance(surface_or_face, RuledSurface):
-        from ..sheet import check_offset
+        from ..sheetmetal.sheet import check_offset
 
         check_offset(surface_or_face, sheet, f"surface {label!r}")
         if method == "exact":
@@ -278,7 +278,7 @@ def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
     from OCP.ShapeFix import ShapeFix_Solid
     from OCP.TopAbs import TopAbs_SHELL
 
-    from ..plate import plate_bspline
+    from ..sheetmetal.plate import plate_bspline
     from .occ import make_face
 
     T = sheet.thickness

@@ -229,7 +229,7 @@ def inside_radius(surface: Any, side: str, thickness: float, *, samples: int = 5
     a cone or fan) are skipped as in ``check_offset``. ``inf`` for a flat surface.
     """
     from ..surfaces.ruled import SINGULAR_NORMAL_TOL
-    from ..sheet import bending_radius
+    from ..sheetmetal.sheet import bending_radius
 
     sigma = 1.0 if side == "normal" else -1.0
     u = np.linspace(0.0, 1.0, samples)
@@ -290,7 +290,7 @@ def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int
         SheetError: the first part the sheet cannot be made on (the message names the part, the
             ruling, its radius and the bound; ``constraint``, ``radius``, ``limit`` as attributes).
     """
-    from ..sheet import check_offset
+    from ..sheetmetal.sheet import check_offset
 
     if sheet is None:
         if design.sheet is None:

@@ -406,7 +406,7 @@ class _SheetGuard:
     """
 
     def __init__(self, design: Design, sheet: Any) -> None:
-        from ..sheet import Sheet
+        from ..sheetmetal.sheet import Sheet
 
         self.design = design
         self.sheet = sheet
@@ -419,7 +419,7 @@ class _SheetGuard:
         self._tie = itertools.count()
 
     def __call__(self, surface: Any, shape: dict[str, float]) -> float:
-        from ..sheet import SheetError
+        from ..sheetmetal.sheet import SheetError
 
         self.checked += 1
         try:
@@ -496,7 +496,7 @@ def thickness_factor(design: Design, surface: Any, *, rtol: float = 1e-4, upto: 
         SheetError: the sheet itself is refused (``f < 1``).
         GHTError: ``rtol`` not in (0, 1) or ``upto`` not a finite number > 2.
     """
-    from ..sheet import Sheet, SheetError
+    from ..sheetmetal.sheet import Sheet, SheetError
 
     if not (isinstance(rtol, (int, float)) and 0.0 < rtol < 1.0):
         raise GHTError(f"rtol={rtol!r} is not allowed; it must be a number in (0, 1)")
@@ -537,7 +537,7 @@ def _fmt_shape(shape: dict[str, float], names: Sequence[str]) -> str:
 def _sheet_infeasible(design: Design, spec: OptimizeSpec, guard: _SheetGuard, names: Sequence[str],
                       start: dict[str, Any], rejected_results: int = 0) -> GHTError:
     """The one-line error when no candidate passed the sheet rule (or none passed the final check)."""
-    from ..sheet import SheetError
+    from ..sheetmetal.sheet import SheetError
 
     sh = guard.sheet
     kt = abs(sh.neutral_offset)
@@ -575,7 +575,7 @@ def _check_start(design: Design, curves: dict[str, Any], shape: dict[str, float]
     import sys
 
     from ..core.progress import progress_enabled
-    from ..sheet import SheetError
+    from ..sheetmetal.sheet import SheetError
 
     try:
         r = _verified_radius(design, curves, shape)

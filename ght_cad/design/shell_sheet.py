@@ -243,7 +243,7 @@ def surface_sheets(design: Design, builts: Sequence[BuiltSurface]) -> tuple[list
     Raises:
         DesignError: ``side_reference = "shell"`` on a shell that cannot be oriented.
     """
-    from ..sheet import ruling_normal
+    from ..sheetmetal.sheet import ruling_normal
 
     assert design.sheet is not None
     rails = shared_rails(builts)
@@ -303,7 +303,7 @@ def rail_joints(builts: Sequence[BuiltSurface], sheets: Sequence[SurfaceSheet], 
     (``m_i · w_j > 0``, ``w_j`` the unit direction into surface ``j`` across the rail), ``gap``
     where it turns away, ``flush`` within 1e-9 (points on a zero-length ruling, a pointed end, have
     no direction across the rail and are left out of the kind)."""
-    from ..sheet import ruling_normal
+    from ..sheetmetal.sheet import ruling_normal
 
     out = []
     for r in rails:

@@ -343,7 +343,7 @@ def _step_plates(p: Path, shape: Any, faces: Sequence[int] | None, thickness: An
     Raises:
         SheetError: a given ``thickness`` that differs from a plate's.
     """
-    from ..sheet import make_sheet
+    from ..sheetmetal.sheet import make_sheet
 
     if faces or (thickness is None and k_factor is None and din_k_factor is None and side is None) or thickness == 0:
         return None
@@ -386,7 +386,7 @@ def _check_plate_thickness(p: Path, thickness: Any, k_factor: Any, din_k_factor:
     Raises:
         SheetError: a bad value, or one that does not match ``found`` (naming ``what`` and its faces).
     """
-    from ..sheet import SheetError, make_sheet
+    from ..sheetmetal.sheet import SheetError, make_sheet
 
     if thickness is None:
         return
@@ -402,7 +402,7 @@ def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any
                 din_k_factor: Any, side: str | None,
                 face_names: Callable[[], dict[int, str]]) -> tuple[Any, dict[str, Any] | None]:
     """The sheet of :func:`unroll_step` and the plate found in the file (see there)."""
-    from ..sheet import SheetError, make_sheet
+    from ..sheetmetal.sheet import SheetError, make_sheet
 
     if thickness is None and k_factor is None and din_k_factor is None and side is None:
         return None, None

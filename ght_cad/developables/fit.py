@@ -112,7 +112,7 @@ def ruled_pieces(surface: RuledSurface) -> list[RuledPiece]:
                 k = int(getattr(sg, "end_order", 2))
                 out.append(RuledPiece(lo, hi, sg, (k, k)))
             return out
-    from ..sheet import OffsetRuledSurface
+    from ..sheetmetal.sheet import OffsetRuledSurface
 
     if isinstance(surface, OffsetRuledSurface):
         base = ruled_pieces(surface.base)

@@ -216,7 +216,7 @@ def unroll_face_data(
     info: dict[str, Any] = {"best_effort": bool(best_effort)}
     fsheet = None
     if sheet is not None and not sheet.is_zero:  # the neutral surface replaces the face's own
-        from ..sheet import FaceSheet
+        from ..sheetmetal.sheet import FaceSheet
 
         fsheet = FaceSheet(face, sheet, label)
         ev = fsheet.neutral

@@ -74,7 +74,7 @@ def unroll_ruled(
         SheetError: a thickness beyond a bending radius of the surface.
     """
     if sheet is not None and not sheet.is_zero:
-        from ..sheet import unroll_ruled_sheet
+        from ..sheetmetal.sheet import unroll_ruled_sheet
 
         return unroll_ruled_sheet(surface, sheet, best_effort=best_effort, tol_deg=tol_deg, rulings=rulings,
                                   samples=samples, units=units, label=label)
@@ -186,7 +186,7 @@ def _sheet_arg(sheet: Any, thickness: Any, k_factor: Any, din_k_factor: Any, sid
     loose = thickness is not None or k_factor is not None or din_k_factor is not None or side != "normal"
     if sheet is None and not loose:
         return None
-    from ..sheet import Sheet, SheetError, make_sheet
+    from ..sheetmetal.sheet import Sheet, SheetError, make_sheet
 
     if sheet is not None:
         if loose:
@@ -278,7 +278,7 @@ def unroll_composite(
                      sheet=sh)
         panels.extend(pat.panels)
         if join:
-            from ..join_panels import ruled_conormals
+            from ..sheetmetal.join_panels import ruled_conormals
 
             ruled = isinstance(part, RuledSurface) and len(pat.panels) == 1
             conormals.extend([ruled_conormals(part) if ruled else None] * len(pat.panels))
@@ -295,7 +295,7 @@ def unroll_composite(
         e.xyz = pts
     try:
         if join:  # matched on the same edges as the marks (the design's with marks_on="design")
-            from ..join_panels import join_panels
+            from ..sheetmetal.join_panels import join_panels
 
             panels = join_panels(panels, conormals, tol_deg=tol_deg, label=join_label)
         mark_shared_edges(panels)

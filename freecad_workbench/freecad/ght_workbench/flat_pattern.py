@@ -224,7 +224,7 @@ class FlatPatternFeature(FeatureProxy):
         Raises:
             SheetError: a bad K-factor or a thickness beyond a bending radius (naming the value).
         """
-        from ght_cad.sheet import Sheet
+        from ght_cad.sheetmetal.sheet import Sheet
 
         T = float(obj.Thickness.Value) if hasattr(obj.Thickness, "Value") else float(obj.Thickness)
         K = float(obj.KFactor)

@@ -168,7 +168,7 @@ class PlateFeature(FeatureProxy):
         Raises:
             SheetError: T <= 0, K outside [0, 1], an unknown side (naming the property).
         """
-        from ght_cad.sheet import Sheet, SheetError
+        from ght_cad.sheetmetal.sheet import Sheet, SheetError
 
         T = float(obj.Thickness.Value)
         if not (math.isfinite(T) and T > 0):
@@ -186,9 +186,9 @@ class PlateFeature(FeatureProxy):
         return faces[int(k) - 1] if k.isdigit() and 1 <= int(k) <= len(faces) else None
 
     def compute(self, obj: Any) -> None:
-        from ght_cad.plate import plate_bspline, plate_volume
+        from ght_cad.sheetmetal.plate import plate_bspline, plate_volume
         from ght_cad.surfaces.ruled import RuledSurface
-        from ght_cad.sheet import check_offset
+        from ght_cad.sheetmetal.sheet import check_offset
 
         from .joined_developable import core_frame
 

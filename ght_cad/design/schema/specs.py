@@ -177,7 +177,7 @@ class SheetSpec:
 
     def to_sheet(self) -> Any:
         """The :class:`ght_cad.sheet.Sheet`."""
-        from ...sheet import Sheet
+        from ...sheetmetal.sheet import Sheet
 
         return Sheet(self.thickness, self.k_factor, self.side)
 

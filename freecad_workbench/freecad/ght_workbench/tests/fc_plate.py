@@ -71,7 +71,7 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
     def assert_plate(self, pl, what: str, names: tuple = plate.FACE_NAMES) -> None:
         """Valid solid of the named faces (six; a pointed end has no end wall); Volume vs closed
         form; inside on X, outside at T."""
-        from ght_cad.sheet import ruling_normal
+        from ght_cad.sheetmetal.sheet import ruling_normal
 
         self.assertFalse(_base.failed(pl), f"{what}: {pl.getStatusString()}")
         sh = pl.Shape
@@ -188,7 +188,7 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
 
     def test_plate_of_loft_with_fans_and_its_flat_pattern(self):
         from ght_cad import unroll
-        from ght_cad.sheet import Sheet
+        from ght_cad.sheetmetal.sheet import Sheet
 
         lf = self.loft()
         T, K = 4.0, 0.42
@@ -276,7 +276,7 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
         self.assert_plate(pl, "geodesic developable")
 
     def test_refusals(self):
-        from ght_cad.sheet import Sheet, check_offset
+        from ght_cad.sheetmetal.sheet import Sheet, check_offset
 
         dev = self.cylinder()
         pl = plate.make_plate(dev, 1.0, 0.5, "normal", doc=self.doc)

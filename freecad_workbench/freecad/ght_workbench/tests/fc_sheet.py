@@ -24,7 +24,7 @@ import Part
 from freecad.ght_workbench import export, flat_pattern
 from freecad.ght_workbench.tests.fc_features import _recompute, _reopen
 from freecad.ght_workbench.tests.refusal import RefusalAssertions
-from ght_cad.sheet import SheetError
+from ght_cad.sheetmetal.sheet import SheetError
 
 OUT = os.environ.get("GHT_FC_OUT") or tempfile.mkdtemp(prefix="ght_fc_")
 R, H, T, K = 240.0, 100.0, 4.0, 0.42
@@ -103,7 +103,7 @@ class SheetTest(RefusalAssertions, unittest.TestCase):
         from freecad.ght_workbench import developable
         from freecad.ght_workbench.tests.fc_features import quarter_cylinder_planes
         from ght_cad import unroll
-        from ght_cad.sheet import Sheet
+        from ght_cad.sheetmetal.sheet import Sheet
 
         p0, p1, p2 = quarter_cylinder_planes(self.doc)
         box = self.doc.addObject("Part::Box", "Box")
