@@ -11,7 +11,7 @@ import pytest
 
 from ght_cad import GHTCurve
 from ght_cad.core.errors import GHTError
-from ght_cad.flat_pattern import DistortionReport, FlatPattern, clip_segments, romberg_length
+from ght_cad.pattern.flat_pattern import DistortionReport, FlatPattern, clip_segments, romberg_length
 from ght_cad.surfaces.ruled import CurvePairRuledSurface
 from ght_cad.unrolling.unroll import unroll, unroll_composite
 
@@ -284,7 +284,7 @@ def test_edge_marks_of_a_narrow_panel_stay_inside_it() -> None:
     """A 1-unit-wide strip joined to a 15.7-unit-wide one: the edge-mark label of each panel lies
     inside that panel and its ticks and text are scaled to it (the marks were sized for the widest
     panel: the narrow strip's "E1" sat 0.94 units inward, outside its 1-unit width)."""
-    from ght_cad.flat_pattern import _inside
+    from ght_cad.pattern.flat_pattern import _inside
 
     s1 = CurvePairRuledSurface(quarter(10.0, 0.0), quarter(10.0, 10.0))  # ends at the ruling (0, 10, z)
     b = GHTCurve([(0, 10, 0), (-0.5, 10, 0), (-1.0, 9.95, 0)])

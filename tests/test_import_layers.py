@@ -55,8 +55,8 @@ _LAYER_OF = {
     # the layer packages of issue 27 are named after their layer; a few modules stay top-level
     "core": ["core"],
     "curves": ["curves"],
-    "surfaces": ["surfaces", "unrolling", "sheetmetal", "developable", "loft",
-                 "flat_pattern", "pattern", "faces", "developables", "outline_arcs", "blank"],
+    "surfaces": ["surfaces", "unrolling", "sheetmetal", "pattern", "developable", "loft", "faces", "developables",
+                 "blank"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
     "optimize": ["optimize", "approximation", "approximation_dual"],
     "kernel": ["cad"],

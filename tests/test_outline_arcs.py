@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from ght_cad.core.errors import GHTError
-from ght_cad.outline_arcs import arc_chain, bulge_polygon_area
+from ght_cad.pattern.outline_arcs import arc_chain, bulge_polygon_area
 
 
 def arc_distance(q: np.ndarray, p0: np.ndarray, p1: np.ndarray, b: float) -> np.ndarray:

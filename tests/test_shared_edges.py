@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad import flat_pattern as fp
-from ght_cad.flat_pattern import (MARK_FRACTIONS, BoundaryEdge, FlatPanel, _inside, _interp_polyline,
+from ght_cad.pattern import flat_pattern as fp
+from ght_cad.pattern.flat_pattern import (MARK_FRACTIONS, BoundaryEdge, FlatPanel, _inside, _interp_polyline,
                                   _polyline_param, _sagitta3, mark_shared_edges)
 
 ROOT = Path(__file__).resolve().parents[1]

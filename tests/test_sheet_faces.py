@@ -100,7 +100,7 @@ def test_forming_label_avoids_a_hole() -> None:
     """A drilled cylinder plate: the one forming label sits on the plate, not in the hole at its centre."""
     from build123d import Plane
 
-    from ght_cad.flat_pattern import _inside
+    from ght_cad.pattern.flat_pattern import _inside
 
     cyl = Solid.make_cylinder(50, 40, angle=120)
     c, s = math.cos(math.radians(60)), math.sin(math.radians(60))

@@ -137,7 +137,7 @@ def _arc_then_line(t: np.ndarray) -> np.ndarray:
 
 
 def test_boundary_edge_with_breaks_measures_a_g1_curve_exactly() -> None:
-    from ght_cad.flat_pattern import BoundaryEdge, piecewise_romberg_length, piecewise_samples
+    from ght_cad.pattern.flat_pattern import BoundaryEdge, piecewise_romberg_length, piecewise_samples
 
     exact = 0.01 * np.pi / 2 + 2.0
     whole = BoundaryEdge("e", _arc_then_line, _arc_then_line, samples=257)

@@ -109,7 +109,7 @@ def unfold_skin(
     """
     from ..core.errors import NotDevelopableError
     from ..unrolling.face_unroll import unroll_face_data
-    from ..flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
+    from ..pattern.flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
     from ..sheetmetal.sheet import Sheet, SheetError
 
     if bend_lines not in ("tangent", "centre", "center"):
@@ -321,7 +321,7 @@ def unfold_skins(
     Raises:
         BlankError: from :func:`unfold_skin`; a ``base_face`` in none of the skins.
     """
-    from ..flat_pattern import FlatPattern, layout_panels
+    from ..pattern.flat_pattern import FlatPattern, layout_panels
 
     def holds(s: SheetSkin, n: int) -> bool:
         return any(f.number == n or f.partner == n for f in s.faces)

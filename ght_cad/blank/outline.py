@@ -16,7 +16,7 @@ def _merge(panels: dict[int, Any], motion: dict[int, _Motion], order: list[int],
            label: str, samples: int) -> list[list[Any]]:
     """The blank's loops: every face's boundary edges except the tree's shared edges, moved into
     place and chained end to start (reversing where needed); the largest loop first."""
-    from ..flat_pattern import BoundaryEdge, _shoelace
+    from ..pattern.flat_pattern import BoundaryEdge, _shoelace
 
     pieces = []
     for n in order:

@@ -120,7 +120,7 @@ def _side(a0: np.ndarray, a1: np.ndarray, p: np.ndarray) -> float:
 
 def _panel_point(panel: Any, m: _Motion) -> np.ndarray:
     """An interior point of a placed face: its outline's area centroid (vertex mean if outside)."""
-    from ..flat_pattern import _centroid
+    from ..pattern.flat_pattern import _centroid
 
     return m(_centroid(panel.loop_polylines()[0]))
 

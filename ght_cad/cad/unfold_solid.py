@@ -280,7 +280,7 @@ def blank_plates(unfolded: Unfolded) -> list[Any]:
     from build123d import Solid
     from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
 
-    from ..flat_pattern import FlatPattern
+    from ..pattern.flat_pattern import FlatPattern
     from .unroll_faces import flat_faces
 
     out = []

@@ -58,7 +58,7 @@ from ._ocp import TopoDS
 from ..unrolling import face_unroll as _core
 from ..core.errors import GHTError
 from ..unrolling.face_unroll import EdgeData, FaceData, SurfaceAdapter, face_area, unroll_face_data
-from ..flat_pattern import FlatPattern
+from ..pattern.flat_pattern import FlatPattern
 from ..surfaces.nurbs import NurbsCurve, NurbsSurface
 from ..unrolling.unroll import DEFAULT_TOL_DEG
 

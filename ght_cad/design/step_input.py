@@ -253,7 +253,7 @@ def unroll_step(
             ``best_effort``); the one-line message names the file, the face number and the
             measured ``θ_max`` and ``DD``.
     """
-    from ..flat_pattern import FlatPattern, layout_panels, mark_shared_edges
+    from ..pattern.flat_pattern import FlatPattern, layout_panels, mark_shared_edges
 
     p = Path(path)
     if p.suffix.lower() not in STEP_SUFFIXES:

@@ -1,8 +1,12 @@
-"""Flat patterns below :mod:`ght_cad.flat_pattern` (issue 27): the model (:mod:`.model`: boundary
-edges, panels, the distortion report), the layout and edge marks (:mod:`.layout`) and the writers
-(:mod:`.io`: DXF through ezdxf and a hand-written R12 writer, SVG, PNG).
+"""Flat patterns (issue 27): the pattern of an unrolled surface, its layout and its writers.
 
-These modules import nothing above the curves layer: :class:`ght_cad.flat_pattern.FlatPattern`
-(which reaches the sheet and the CAD adapters) stays in :mod:`ght_cad.flat_pattern`, and every
-name moved here stays importable from there.
+Modules: :mod:`~ght_cad.pattern.flat_pattern` (:class:`FlatPattern`, the distortion measures of spec
+section 6; it reaches the CAD adapters only through the kernel registry), :mod:`~ght_cad.pattern.model`
+(boundary edges, panels, the distortion report), :mod:`~ght_cad.pattern.layout` (layout and edge
+marks), :mod:`~ght_cad.pattern.forming` (the sheet's forming rows as presented by the pattern),
+:mod:`~ght_cad.pattern.outline_arcs` (outlines as exact lines and circular arcs) and
+:mod:`~ght_cad.pattern.io` (DXF through ezdxf and a hand-written R12 writer, SVG, PNG).
+``flat_pattern`` and ``outline_arcs`` keep their old paths ``ght_cad.<name>`` (the same module
+object), and every name moved out of :mod:`~ght_cad.pattern.flat_pattern` into ``model``, ``layout``
+and ``io`` stays importable from there. This package imports none of them.
 """

@@ -369,7 +369,7 @@ class FlatPanel:
             θ the signed sweep, 0 straight); ``kinds`` the edges' kinds ("line", "arc", "arcs",
             "curve", "point").
         """
-        from ..outline_arcs import arc_chain
+        from .outline_arcs import arc_chain
 
         key = float(chord_tol)
         if key not in self._arcs:

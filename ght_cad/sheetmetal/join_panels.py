@@ -40,7 +40,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..flat_pattern import (BoundaryEdge, FlatPanel, _polyline_param, _sagitta3, _shoelace, measure_panel,
+from ..pattern.flat_pattern import (BoundaryEdge, FlatPanel, _polyline_param, _sagitta3, _shoelace, measure_panel,
                            shared_edge_pairs)
 from ..unrolling.ruled_development import RULED_EDGE_UV
 

@@ -37,7 +37,7 @@ import numpy as np
 from ..core.errors import DegenerateGeometryError, NotDevelopableError
 from ..core._vec import norm as _norm
 from ..core._vec import stack as _stack
-from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _unit_samples, measure_panel
+from ..pattern.flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _unit_samples, measure_panel
 from ..surfaces.ruled import _theta_parameters
 from .ruled_development import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes,
                                 metric_angles, metric_stencil)

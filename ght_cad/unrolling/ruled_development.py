@@ -43,7 +43,7 @@ from ..core._vec import stack as _stack
 from ..core._vec import dot as _dot
 from ..core._vec import norm as _norm
 from ..core._vec import unique_inverse as _unique_inverse
-from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
+from ..pattern.flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel
 from ..surfaces.ruled import RuledSurface
 
 __all__ = [

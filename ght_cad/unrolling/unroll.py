@@ -22,7 +22,7 @@ import numpy as np
 
 from ..core.errors import GHTError
 from ..core._validate import is_real
-from ..flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel  # noqa: F401
+from ..pattern.flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel  # noqa: F401
 from ..surfaces.ruled import RuledSurface
 # the development of one ruled surface moved to ght_cad.ruled_development (issue 27); every name is still given here
 from .ruled_development import (_EDGES0, _INT, _K, _N, _ONES, _V, _VI, _X, DEFAULT_TOL_DEG, RULED_EDGE_UV,  # noqa: F401
@@ -288,7 +288,7 @@ def unroll_composite(
                     if e.name in RULED_EDGE_UV:
                         u, v = RULED_EDGE_UV[e.name](np.linspace(0.0, 1.0, len(e.xyz)))
                         swap.append((e, np.asarray(part.evaluate(u, v), dtype=float)))
-    from ..flat_pattern import layout_panels, mark_shared_edges
+    from ..pattern.flat_pattern import layout_panels, mark_shared_edges
 
     kept = [e.xyz for e, _ in swap]
     for e, pts in swap:
