@@ -201,25 +201,6 @@ def test_cad_tests_pass_with_the_other_build123d() -> None:
     assert " passed" in tail
 
 
-@pytest.mark.slow
-@pytest.mark.timeout(3600)
-def test_cadquery_extra_works_on_ocp_7_9_without_build123d() -> None:
-    """``.venv-cadquery``: ``pip install -e '.[cadquery]'`` gives cadquery 2.8 on OCP 7.9 (cadquery-ocp
-    alone: no build123d, no second OCP distribution); the plugin's tests, tests/test_cq_world.py, the
-    cadquery example and the cadquery halves of other modules pass there, none of them skipped."""
-    python = _venv(".venv-cadquery", ["-e", f"{ROOT}[cadquery]", *TEST_TOOLS])
-    there = _versions(python)
-    assert there["cadquery"].startswith("2.8") and there["cadquery-ocp"].startswith("7.9"), there
-    assert "build123d" not in there and "cadquery-ocp-novtk" not in there, there
-    tails = [_pytest_in(python, CADQUERY_TESTS), _pytest_in(python, CADQUERY_SLOW_TESTS, marks="")]
-    assert all(" passed" in tail for tail in tails)
-    # none of the cadquery tests may skip there: only what needs build123d does (test_install.py's own
-    # build123d checks, the README's build123d blocks), and the host suite when GHT_CAD_HOST_SUITES=off asks
-    skipped = [line for tail in tails for line in tail.splitlines() if line.startswith("SKIPPED")]
-    allowed = ("could not import 'build123d'", "GHT_CAD_HOST_SUITES=off")
-    assert all(any(a in line for a in allowed) for line in skipped), skipped
-
-
 @pytest.mark.freecad
 def test_core_and_run_in_debian_freecad_python(tmp_path: Path) -> None:
     """FreeCAD's Python for real (Debian 12: /usr/bin/python3 with python3-numpy 1.24, scipy 1.10,
