@@ -147,7 +147,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     """``ght-cad approximate TARGET.step --tol T --out DIR``."""
     from .cad.approximate import step_target
     from .core.outdir import OutputFolder
-    from .design.approximate import run_approximation
+    from .approximation import approximate
     from .sheetmetal.sheet import make_sheet
 
     path = Path(args.target)
@@ -160,8 +160,8 @@ def cmd_approximate(args: argparse.Namespace) -> int:
     try:
         sheet = make_sheet(args.thickness, args.k_factor, din_k_factor=args.din_k_factor, side=args.side or "normal")
         target = step_target(path, args.face - 1)
-        result = run_approximation(target, args.tol, max_panels=args.max_panels, direction=args.direction,
-                                   method=args.method, progress=_progress_lines(args), untrimmed=args.untrimmed)
+        result = approximate(target, args.tol, max_panels=args.max_panels, direction=args.direction,
+                             method=args.method, progress=_progress_lines(args), untrimmed=args.untrimmed)
     except TrimmedTargetError as exc:
         raise GHTError(f"{path}: face {args.face} is {trim_words(exc.covered, exc.holes)}; {TRIM_ALLOWED}, or "
                        "--untrimmed to cover the underlying surface over its whole (u, v) box knowingly") from None

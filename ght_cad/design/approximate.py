@@ -5,7 +5,7 @@ is a face of a STEP file (path relative to the design file, 1-based face number,
 approximate --face``), a GHT patch ``S(u, v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P_ij``
 (:class:`ght_cad.surfaces.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.surfaces.nurbs.NurbsSurface`). It is
 covered by :func:`ght_cad.approximate` with the surface's ``tol``, ``max_panels``, ``direction`` and
-``method`` (:func:`run_approximation`): the same call ``ght-cad approximate``
+``method``: the same call ``ght-cad approximate``
 (:mod:`ght_cad.approximate_cli`) makes, and both write their
 outputs through the functions of this module: the panels sewn into one shell
 (:func:`ght_cad.cad.approximate.panels_shell`), their flat patterns on one sheet with seam marks
@@ -22,14 +22,14 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from ..core.errors import GHTError
 from .schema import DesignError, SurfaceSpec
 
-__all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "run_approximation", "is_approximation",
+__all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "is_approximation",
            "plot_deviation",
            "report_markdown", "approximation_report", "panel_sheets", "panel_pattern", "panel_plates"]
 
@@ -142,7 +142,7 @@ def _check_regular(tgt: Any, source: str, key: str) -> None:
 
 
 def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
-    """:func:`run_approximation` of the surface's target with its ``tol``, ``max_panels``,
+    """:func:`ght_cad.approximate` of the surface's target with its ``tol``, ``max_panels``,
     ``direction`` and ``method`` (the call ``ght-cad approximate`` makes).
 
     Raises:
@@ -150,31 +150,13 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
         GHTError: no approximation within ``tol`` with ``max_panels`` panels (the message names the
             best deviation reached; the caller adds the file and key).
     """
-    tgt = approximation_target(spec, source)
-    with np.errstate(all="ignore"):
-        result = run_approximation(tgt, spec.tol, direction=spec.direction, max_panels=spec.max_panels,
-                                   method=spec.method, untrimmed=spec.untrimmed)
-    return ApproximatedSurface(result, tgt, spec.method)
-
-
-def run_approximation(target: Any, tol: float, *, direction: str = "auto", max_panels: int = 64,
-                      method: str = "auto", progress: Callable[[str], None] | None = None,
-                      untrimmed: bool = False) -> Any:
-    r""":func:`ght_cad.approximate` as the front ends (``ght-cad approximate``, design files) call it:
-    a plain call with their settings. On failure the core's own one-line message names the
-    best deviation reached with at most ``max_panels`` panels (when even the first march needs more
-    strips, the core builds and measures the finest march with at most ``max_panels`` strips once;
-    the FreeCAD feature calls the core directly and gets the same message). ``untrimmed``: as
-    :func:`ght_cad.approximate` (a trimmed face refused without it).
-
-    Raises:
-        GHTError: bad arguments, or ``no approximation of the target within tol=T with at most
-            max_panels=N panels; best deviation reached D with n panels`` (the core's message).
-    """
     from ..approximation import approximate
 
-    return approximate(target, tol, direction=direction, max_panels=max_panels, method=method, progress=progress,
-                       untrimmed=untrimmed)
+    tgt = approximation_target(spec, source)
+    with np.errstate(all="ignore"):
+        result = approximate(tgt, spec.tol, direction=spec.direction, max_panels=spec.max_panels,
+                             method=spec.method, untrimmed=spec.untrimmed)
+    return ApproximatedSurface(result, tgt, spec.method)
 
 
 # ------------------------------------------------------------------------------------------------
