@@ -61,9 +61,9 @@ def test_facade_basis_stays_the_function_after_importing_the_old_module_path() -
     """
     code = (
         "import json, sys, ght_cad, ght_cad.basis, ght_cad.curves.basis as m; import ght_cad.basis as b; "
-        "from ght_cad.basis import _DIFF_CACHE; "
+        "from ght_cad.basis import _compact_differences; "
         "print(json.dumps([b is ght_cad.basis is m.basis, sys.modules['ght_cad.basis'] is m, "
-        "_DIFF_CACHE is m._DIFF_CACHE]))"
+        "_compact_differences is m._compact_differences]))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert json.loads(out.stdout) == [True, True, True]

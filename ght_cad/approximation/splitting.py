@@ -7,7 +7,6 @@ on the target. Moved from ``ght_cad/approximation.py`` (issue 27); every name is
 from __future__ import annotations
 
 import math
-import weakref
 from typing import Callable
 
 import numpy as np
@@ -107,16 +106,14 @@ def _strip_range(frame: _Frame, A: _Seam, B: _Seam, n: int = 49) -> tuple[float,
     return float(d.min()), float(d.max())
 
 
-#: per frame: the seams on the target (``_Seam(frame, y)``) and the strip ranges between two of them
-#: that the march has built, by ``y`` and ``(y0, y1)``: the greedy runs of :func:`_march_piece`
-#: repeat the same first trials (a pure function of the frame and the positions)
-_MARCH_CACHE: "weakref.WeakKeyDictionary[_Frame, tuple[dict, dict]]" = weakref.WeakKeyDictionary()
-
-
 def _march_caches(frame: _Frame) -> tuple[dict, dict]:
-    c = _MARCH_CACHE.get(frame)
+    """Per frame (kept on the frame, as the per-object caches of the other modules): the seams on
+    the target (``_Seam(frame, y)``) and the strip ranges between two of them that the march has
+    built, by ``y`` and ``(y0, y1)``: the greedy runs of :func:`_march_piece` repeat the same first
+    trials (a pure function of the frame and the positions)."""
+    c = frame.__dict__.get("_march_caches")
     if c is None:
-        c = _MARCH_CACHE[frame] = ({}, {})
+        c = frame._march_caches = ({}, {})  # type: ignore[attr-defined]
     return c
 
 

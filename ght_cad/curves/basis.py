@@ -267,16 +267,18 @@ def evaluate_derivatives(t: np.ndarray, control_points: np.ndarray, seed: Seed, 
     return out
 
 
-_DIFF_CACHE: dict[tuple, list[np.ndarray | None]] = {}
-
-
 def _compact_differences(P: np.ndarray, K: int) -> list[np.ndarray | None]:
     """Control points of ``(Q0 - Q1)^(q)``, ``(Q2 - Q1)^(q)``, ``Q1^(q)`` for q = 0..K, each (3, n-q+1, dim)
-    (``n!/(n-q)! Δ^q`` of the blocks; None for q > n). Kept for the last few control polygons."""
-    key = (P.shape, K, P.tobytes())
-    hit = _DIFF_CACHE.get(key)
-    if hit is not None:
-        return hit
+    (``n!/(n-q)! Δ^q`` of the blocks; None for q > n), read-only. Kept for the last 32 control
+    polygons (:func:`ght_cad.core._cache.readonly_cache`, keyed by the polygon's bytes)."""
+    P = np.asarray(P, dtype=float)
+    return _compact_differences_of(P.shape, int(K), P.tobytes())
+
+
+@readonly_cache(maxsize=32)
+def _compact_differences_of(shape: tuple[int, ...], K: int, data: bytes) -> list[np.ndarray | None]:
+    """:func:`_compact_differences` of the float polygon of ``shape`` stored in ``data`` (C order)."""
+    P = np.frombuffer(data, dtype=float).reshape(shape)
     n = P.shape[0] - 3
     P1 = P[1 : n + 2]
     D = np.stack([P[: n + 1] - P1, P[2 : n + 3] - P1, P1])
@@ -287,11 +289,7 @@ def _compact_differences(P: np.ndarray, K: int) -> list[np.ndarray | None]:
             continue
         if q:
             D = (n - q + 1) * np.diff(D, axis=1)
-        D.setflags(write=False)
         out.append(D)
-    if len(_DIFF_CACHE) >= 32:
-        _DIFF_CACHE.pop(next(iter(_DIFF_CACHE)))
-    _DIFF_CACHE[key] = out
     return out
 
 

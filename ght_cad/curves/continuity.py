@@ -37,6 +37,7 @@ import numpy as np
 
 from .curve import GHTCurve
 from ..core.errors import GHTError, SingularJoinError
+from ..core._cache import readonly_cache
 from .seeds import MAX_DERIVATIVE, BernsteinSeed, GBTSeed, GHTSeed, make_seed, seed_names
 
 __all__ = [
@@ -169,21 +170,20 @@ def _end_rows(curve: GHTCurve, end: int, max_order: int) -> list[np.ndarray]:
     return [curve.basis(t, r)[0] for r in range(max_order + 1)]
 
 
-_JET_CACHE: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
 _BUILTIN_SEEDS = (GHTSeed, GBTSeed, BernsteinSeed)
 
 
 def _seed_end_jets(seed) -> tuple[np.ndarray, np.ndarray]:
-    """``seed.end_jets()``, cached for the built-in seed classes (keyed by class and μ, ν, γ)."""
+    """``seed.end_jets()``, cached for the built-in seed classes (keyed by class and μ, ν, γ; read-only)."""
     if type(seed) not in _BUILTIN_SEEDS:
         return seed.end_jets()
-    key = (type(seed), seed.mu, seed.nu, seed.gamma)
-    hit = _JET_CACHE.get(key)
-    if hit is None:
-        if len(_JET_CACHE) > 4096:
-            _JET_CACHE.clear()
-        hit = _JET_CACHE[key] = seed.end_jets()
-    return hit
+    return _builtin_end_jets(type(seed), seed.mu, seed.nu, seed.gamma)
+
+
+@readonly_cache(maxsize=4096)
+def _builtin_end_jets(cls: type, mu: float, nu: float, gamma: float) -> tuple[np.ndarray, np.ndarray]:
+    """``cls(mu, nu, gamma).end_jets()`` for a built-in seed class (:func:`ght_cad.core._cache.readonly_cache`)."""
+    return cls(mu, nu, gamma).end_jets()
 
 
 def _end_rows_fast(curve: GHTCurve, end: int, max_order: int) -> list[np.ndarray]:

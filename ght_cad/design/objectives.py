@@ -3,11 +3,11 @@ r"""Fairness measures of curves and composites (spec section 7), shared by the r
 
 from __future__ import annotations
 
-import functools
 from typing import Any, Sequence
 
 import numpy as np
 
+from ..core._cache import readonly_cache
 from ..core._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
 from ..core.errors import GHTError
 from .schema import PLANE_OBJECTIVES
@@ -71,7 +71,7 @@ def composite_dual_objectives(composite: Any, objective: str = "CVEn", weights: 
     return float(sum(v["value"] for v in per)), per
 
 
-@functools.lru_cache(maxsize=16)
+@readonly_cache(maxsize=16)
 def _population_basis(nodes: int, degree: int) -> Any:
     """Cached :class:`ght_cad.optimize.problems.PopulationBasis` on ``nodes`` Gauss–Legendre nodes."""
     from ..optimize.problems import PopulationBasis
@@ -79,7 +79,7 @@ def _population_basis(nodes: int, degree: int) -> Any:
     return PopulationBasis(_gauss_legendre(nodes)[0], degree)
 
 
-@functools.lru_cache(maxsize=16)
+@readonly_cache(maxsize=16)
 def _end_basis(degree: int) -> Any:
     """Cached :class:`ght_cad.optimize.problems.PopulationBasis` at the two ends ``t = 0, 1``."""
     from ..optimize.problems import PopulationBasis

@@ -15,12 +15,12 @@ verified by sampling.
 
 from __future__ import annotations
 
-from functools import lru_cache
 from math import floor, log2
 from typing import Any, Sequence
 
 import numpy as np
 
+from ..core._cache import readonly_cache
 from ..core._validate import affine_parts, as_parameter_array, check_unit_interval
 from ..curves.basis import _check_order, seed_basis
 from .bspline import BSplineSurfaceData, fit_function
@@ -33,7 +33,7 @@ __all__ = ["GHTSurface", "join_patches", "measure_patch_continuity", "basis_bspl
 _SIDES = ("u0", "u1", "v0", "v1")
 
 
-@lru_cache(maxsize=256)
+@readonly_cache(maxsize=256)
 def _basis_fit(degree: int, seed: Seed, tol: float, p: int) -> tuple[np.ndarray, np.ndarray, float]:
     r = min(3, p - 1)
     ends = np.array([0.0, 1.0])
@@ -41,8 +41,6 @@ def _basis_fit(degree: int, seed: Seed, tol: float, p: int) -> tuple[np.ndarray,
     end_derivatives = ([j[0] for j in jets], [j[1] for j in jets])
     fit = fit_function(lambda t: seed_basis(np.asarray(t, float), degree, seed, 0), tol=tol, degree=p,
                        end_derivatives=end_derivatives)
-    fit.poles.setflags(write=False)
-    fit.knots.setflags(write=False)
     return fit.poles, fit.knots, float(fit.max_deviation)
 
 
