@@ -13,11 +13,32 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from .core._lazy import lazy_getattr
+from .core import _aliases
+
+#: Modules moved into the layer packages (issue 27): old name (relative to ``ght_cad``) -> new module
+#: path. The old path stays importable as the same module object, through the import hook of
+#: :mod:`ght_cad.core._aliases` (an old package name maps its submodules too:
+#: ``ght_cad.<old>.<sub>`` is ``<new>.<sub>``); as an attribute of this package it is imported on
+#: first use, like the names of :data:`_LAZY`. Code in the repository imports the new paths
+#: (``tests/test_layer_packages.py`` fails on an old one).
+_MOVED: dict[str, str] = {
+    **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
+                                        "progress", "step_guard", "_kernel", "outdir")},
+    **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
+    **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
+    **{n: f"ght_cad.unrolling.{n}" for n in ("unroll", "ruled_development", "face_unroll")},
+    **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels")},
+    **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
+    **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
+}
+
+_aliases.install(__name__, _MOVED)
 # ``ght_cad.basis`` is the function basis (spec section 9) and also the old path of the module
-# ght_cad.curves.basis: its shim is imported first, so that a later ``import ght_cad.basis`` finds
-# it in sys.modules and does not replace the function by the module.
-from . import basis as _basis_module  # noqa: F401
+# ght_cad.curves.basis: that old path is put into sys.modules now, so that a later
+# ``import ght_cad.basis`` finds it there and does not replace the function by the module.
+_aliases.alias_now(__name__, _MOVED, "basis")
+
+from .core._lazy import lazy_getattr
 from .curves.basis import basis, bernstein
 from .curves.curve import GHTCurve
 from .core.errors import (
@@ -31,10 +52,10 @@ from .core.errors import (
 )
 from .curves.seeds import BernsteinSeed, GBTSeed, GHTSeed, Seed, make_seed, register_seed, seed_names
 
-# ``ght_cad.unroll`` is the submodule, made callable (its ``__call__`` is the stable function
-# ``unroll`` of spec section 9), so the package attribute is the same object whichever way and in
-# whichever order it is imported (numpy-only, ~30 ms).
-from . import unroll  # the shim: ght_cad.unroll and ght_cad.unrolling.unroll, one module object
+# ``ght_cad.unroll`` is the module ght_cad.unrolling.unroll, made callable (its ``__call__`` is the
+# stable function ``unroll`` of spec section 9), so the package attribute is the same object whichever
+# way and in whichever order it is imported (numpy-only, ~30 ms).
+from .unrolling import unroll
 
 __version__ = "0.1.0"
 
@@ -85,25 +106,11 @@ _LAZY: dict[str, str] = {
     "approximate": "ght_cad.approximation",
 }
 
-#: Modules moved into the layer packages (issue 27): old name -> new module path. The old path
-#: ``ght_cad.<name>`` stays importable (a shim at the old file makes it the same module object);
-#: as an attribute of this package it is imported on first use, like the names of :data:`_LAZY`.
-_MOVED: dict[str, str] = {
-    **{n: f"ght_cad.core.{n}" for n in ("errors", "_validate", "_vec", "_quadrature", "_cache", "_lazy", "io",
-                                        "progress", "step_guard", "_kernel", "outdir")},
-    **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
-    **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
-    **{n: f"ght_cad.unrolling.{n}" for n in ("unroll", "ruled_development", "face_unroll")},
-    **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels")},
-    **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
-    **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
-}
-
 _lazy_name = lazy_getattr(__name__, _LAZY, globals())
 
 
 def __getattr__(name: str) -> Any:
     """A name of :data:`_LAZY` or an old module path of :data:`_MOVED`, imported on first use."""
     if name in _MOVED:
-        return importlib.import_module(f"{__name__}.{name}")  # the shim, which also sets the attribute
+        return importlib.import_module(f"{__name__}.{name}")  # through the alias hook, which sets the attribute
     return _lazy_name(name)

@@ -20,8 +20,8 @@ app        ``ght_cad.app`` (CLI, batch, sweeps, demo, STEP unfold); command hand
 =========  ====================================================================================
 
 A module is in the layer of its first package below ``ght_cad`` (:data:`_LAYER_OF`). The old
-path of a moved module (``ght_cad.curve``, a shim that is the module ``ght_cad.curves.curve``) is
-in the layer of the module it stands for, so importing it is never an upward import.
+path of a moved module (``ght_cad.curve``, an alias of the module ``ght_cad.curves.curve`` in
+``ght_cad._MOVED``) counts as the module it stands for.
 
 An import may go to the same or a lower layer. The imports that go UP today are listed below as an
 explicit allow-list (:data:`ALLOWED_UPWARD`: the kernel hook, and the loft's deprecated aliases of
@@ -45,6 +45,9 @@ import ast
 from pathlib import Path
 
 import pytest
+
+import ght_cad
+from ght_cad.core._aliases import AliasFinder
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKBENCH = ROOT / "freecad_workbench" / "freecad"
@@ -110,12 +113,7 @@ def imports_of(source: str, name: str, is_pkg: bool, known: set[str]) -> set[str
         if isinstance(node, ast.Import):
             targets = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[: len(base) - (node.level - 1)]
-                mod = ".".join(base + ([node.module] if node.module else []))
-            else:
-                mod = node.module or ""
+            mod = from_module(node, package)
             targets = [f"{mod}.{a.name}" if f"{mod}.{a.name}" in known else mod for a in node.names]
         elif isinstance(node, ast.Call) and _callee(node) == "import_module" and node.args:
             # importlib.import_module("ght_cad.x"): an import written as a string
@@ -126,11 +124,22 @@ def imports_of(source: str, name: str, is_pkg: bool, known: set[str]) -> set[str
             # a table of module paths imported on first use ({name: "ght_cad.x"}: core._lazy)
             targets = [v.value for v in node.values]
         for t in targets:
+            if t not in known:  # an old path (ght_cad._MOVED) is the module it names now
+                t = ALIASES.target(t) or t
             while t and t not in known:
                 t = t.rpartition(".")[0]
             if t and t != name:
                 found.add(t)
     return found
+
+
+def from_module(node: ast.ImportFrom, package: str) -> str:
+    """The absolute module of ``from <module> import ...`` written in ``package`` (relative or not)."""
+    if not node.level:
+        return node.module or ""
+    base = package.split(".")
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
 
 
 def _callee(node: ast.Call) -> str:
@@ -144,35 +153,14 @@ def import_graph() -> dict[str, set[str]]:
     return {m: imports_of(f.read_text(encoding="utf-8"), m, is_pkg, known) for m, (f, is_pkg) in mods.items()}
 
 
-def shim_target(path: Path) -> str | None:
-    """The module an old path's shim stands for (issue 27), or None if ``path`` is no shim.
-
-    A shim is ``from .<package> import <name> as _module`` and ``sys.modules[__name__] = _module``:
-    importing the old path gives the moved module itself.
-    """
-    text = path.read_text(encoding="utf-8")
-    if "sys.modules[__name__] = _module" not in text:
-        return None
-    for node in ast.parse(text).body:
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and [a.asname for a in node.names] == ["_module"]:
-            return f"ght_cad.{node.module}.{node.names[0].name}"
-    raise AssertionError(f"{path} sets sys.modules[__name__] but imports no _module from a layer package")
-
-
-def shims() -> dict[str, str]:
-    """Old module path -> the module it is now (every shim left by a move of issue 27)."""
-    return {m: t for m, (f, is_pkg) in modules().items() if not is_pkg and (t := shim_target(f)) is not None}
-
-
-_SHIMS: dict[str, str] | None = None
+#: Old paths of moved modules (issue 27, ``ght_cad._MOVED``): an import of one is an import of the
+#: module it names now (the alias hook of ``ght_cad.core._aliases`` makes them one module object).
+ALIASES = AliasFinder("ght_cad", ght_cad._MOVED)
 
 
 def layer(module: str) -> str:
-    """The layer of ``module``: by its first package below ``ght_cad``; a shim's is its target's."""
-    global _SHIMS
-    if _SHIMS is None:
-        _SHIMS = shims()
-    module = _SHIMS.get(module, module)
+    """The layer of ``module``: by its first package below ``ght_cad``; an old path's is its new one's."""
+    module = ALIASES.target(module) or module
     if module == "ght_cad":
         return "facade"
     if module.startswith("ght_workbench"):

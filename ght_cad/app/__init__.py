@@ -4,8 +4,8 @@ Modules: :mod:`~ght_cad.app.cli` (the parser, ``main``: the console entry point 
 :mod:`~ght_cad.app.batch` (many designs in parallel processes or on Dask),
 :mod:`~ght_cad.app.sweep` (``[sweep]`` variants of a design), :mod:`~ght_cad.app.demo` (the embedded
 default design) and :mod:`~ght_cad.app.unfold_step` (blanks of a STEP file's bent parts). Each keeps
-its old path ``ght_cad.<name>`` (the same module object;
-the shim keeps ``python -m ght_cad.cli`` running the command line). The app's packages
+its old path ``ght_cad.<name>`` (the same module object, through ``ght_cad.core._aliases``, which
+also keeps ``python -m ght_cad.cli`` running the command line). The app's packages
 (``ght_cad.commands``, ``ght_cad.design``) and ``ght_cad.approximate_cli`` stay top-level. This
 package imports none of them.
 """
