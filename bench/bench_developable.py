@@ -59,7 +59,7 @@ def main(repeat: int = 5) -> dict[str, float]:
     print(f"build123d ruled face between two edges (+check):    {t_base * 1e3:9.2f} ms")
     print(f"ratio ght / build123d: {t_ght / t_base:.1f}x")
     from ght_cad.cad.occ import make_face
-    from ght_cad.developable import EnvelopeDevelopable, developable_bspline
+    from ght_cad.developables.envelope import EnvelopeDevelopable, developable_bspline
 
     stages = {
         "developable_from_planes (checks)": lambda: developable_from_planes(planes, frames, 0.3, -0.2, 0.1),

@@ -38,9 +38,9 @@ def tangent_plane(phi_deg: float) -> np.ndarray:
 
 
 def build() -> Any:
-    """The two-segment composite (a :class:`ght_cad.developable.CompositeDevelopable`)."""
+    """The two-segment composite (a :class:`ght_cad.developables.envelope.CompositeDevelopable`)."""
     from ght_cad import developable_from_planes
-    from ght_cad.developable import CompositeDevelopable, join_developable
+    from ght_cad.developables.envelope import CompositeDevelopable, join_developable
 
     first = developable_from_planes([tangent_plane(a) for a in (0, 30, 60, 90)], [INLET, OUTLET], gamma=-1.0)
     free = [tangent_plane(a) for a in (100, 110, 120, 140, 160, 180)]  # rows 0..2 are solved

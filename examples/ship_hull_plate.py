@@ -30,7 +30,7 @@ SHAPE = {"mu": 0.3, "nu": -0.2, "gamma": 0.1}
 
 
 def build() -> Any:
-    """The exact plate surface (an :class:`ght_cad.developable.EnvelopeDevelopable`)."""
+    """The exact plate surface (an :class:`ght_cad.developables.envelope.EnvelopeDevelopable`)."""
     from ght_cad import developable_from_planes
     from ght_cad.surfaces.planes import plane_from_point_normal
 

@@ -30,6 +30,7 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels")},
     **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
     **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
+    "developable": "ght_cad.developables.envelope",
 }
 
 _aliases.install(__name__, _MOVED)
@@ -93,7 +94,7 @@ __all__ = [
 # Names provided by modules that import scipy or are heavier: loaded on first use so that
 # ``import ght_cad`` stays fast (< 0.3 s) and never touches a CAD kernel.
 _LAZY: dict[str, str] = {
-    "developable_from_planes": "ght_cad.developable",
+    "developable_from_planes": "ght_cad.developables.envelope",
     "join": "ght_cad.curves.continuity",
     "measure_continuity": "ght_cad.curves.continuity",
     "Continuity": "ght_cad.curves.continuity",

@@ -293,7 +293,7 @@ def _row(job: BatchJob, status: str, error: str | None, result: dict[str, Any] |
 #: Modules a design run imports on first use (OCP through build123d, matplotlib, scipy.optimize:
 #: several seconds, against well under a second per design once loaded).
 _RUN_MODULES = ("ght_cad.design", "ght_cad.design.run", "ght_cad.design.outputs", "ght_cad.cad.occ",
-                "ght_cad.cad.developable_faces", "ght_cad.curves.plotting", "ght_cad.developable",
+                "ght_cad.cad.developable_faces", "ght_cad.curves.plotting", "ght_cad.developables.envelope",
                 "ght_cad.unrolling.unroll", "scipy.optimize", "matplotlib.figure", "matplotlib.backends.backend_agg", "build123d")
 
 

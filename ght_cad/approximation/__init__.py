@@ -194,7 +194,7 @@ def approximate(
         from ..approximation_dual import check_optimizer
 
         check_optimizer(optimizer)
-    from ..developable import developable_bspline
+    from ..developables.envelope import developable_bspline
 
     say = progress or (lambda s: None)
     t0 = time.perf_counter()

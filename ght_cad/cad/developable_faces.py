@@ -33,7 +33,7 @@ from ._ocp import TopoDS
 from ._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ..surfaces.bspline import BSplineSurfaceData
-from ..developable import _size, developable_bspline
+from ..developables.envelope import _size, developable_bspline
 from ..core.errors import ConversionError, GHTError
 from ..surfaces.ruled import RuledSurface
 from .occ import is_valid, make_face, shape_class, unwrap
@@ -80,7 +80,7 @@ def planes_from_build123d(plane_or_face: Any) -> np.ndarray:
 
 
 def developable_surface_data(surface: RuledSurface, **kwargs: Any) -> BSplineSurfaceData:
-    """Alias of :func:`ght_cad.developable.developable_bspline` (core, no CAD kernel needed)."""
+    """Alias of :func:`ght_cad.developables.envelope.developable_bspline` (core, no CAD kernel needed)."""
     return developable_bspline(surface, **kwargs)
 
 
@@ -92,7 +92,7 @@ def developable_face(
     end_order: int = 2,
     theta_tol_deg: float = 1e-3,
 ) -> Any:
-    r"""One valid build123d ``Face``: the B-spline surface of :func:`ght_cad.developable.developable_bspline`
+    r"""One valid build123d ``Face``: the B-spline surface of :func:`ght_cad.developables.envelope.developable_bspline`
     (compatible directrix poles, degree 1 across the rulings, θ_max <= ``theta_tol_deg``).
 
     Raises:
@@ -112,7 +112,7 @@ def composite_shell(composite: Any, *, tol: float | None = None, degree: int = 5
     tolerance of ``1e-6`` times the size merges them into shared edges.
 
     Args:
-        composite: :class:`ght_cad.developable.CompositeDevelopable` or a sequence of ruled surfaces.
+        composite: :class:`ght_cad.developables.envelope.CompositeDevelopable` or a sequence of ruled surfaces.
         tol: fit tolerance per face (default relative 1e-7).
         degree: B-spline degree.
         sew_tol: sewing tolerance (default ``1e-6`` times the largest face size).

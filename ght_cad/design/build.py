@@ -124,7 +124,7 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
     spec = design.surface
     assert spec is not None
     if spec.type == "planes":
-        from ..developable import developable_from_planes
+        from ..developables.envelope import developable_from_planes
 
         return developable_from_planes(
             spec.planes, spec.boundary_planes, shape["mu"], shape["nu"], shape["gamma"], normalize=spec.normalize
@@ -162,13 +162,13 @@ def _make_composite(design: Design, shape: dict[str, float]) -> Any:
 
     Join (spec 5.6): the 4-D dual curves meet with ``V(0) = U(1)`` and G1 ``V' = k U'``,
     G2 ``V'' = k² U'' + β2 U'``, G3 ``V''' = k³ U''' + 3kβ2 U'' + β3 U'``
-    (:func:`ght_cad.developable.join_developable`); all strips share the boundary planes, so
+    (:func:`ght_cad.developables.envelope.join_developable`); all strips share the boundary planes, so
     consecutive strips share their joint ruling segment.
 
     Raises:
         GHTError: a join that cannot be solved or a degenerate strip, naming the segment.
     """
-    from ..developable import CompositeDevelopable, developable_from_planes, join_developable
+    from ..developables.envelope import CompositeDevelopable, developable_from_planes, join_developable
     from ..surfaces.planes import normalize_planes
 
     spec = design.surface
@@ -451,7 +451,7 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
 
     A composite surface also gets ``surface.strips`` (per strip: name, shape parameters, area,
     ruling lengths, developability) and ``surface.joints`` (per joint: requested continuity, the
-    order measured by :func:`ght_cad.developable.measure_developable_joint`, its residuals, the
+    order measured by :func:`ght_cad.developables.envelope.measure_developable_joint`, its residuals, the
     angle between the end tangent planes and the ruling distance); ``developability`` is then the
     worst strip's (see ``_developability_dict``).
     """

@@ -50,7 +50,7 @@ def composite_dual_objectives(composite: Any, objective: str = "CVEn", weights: 
     ``w0 AL + w1 En + w2 CVEn``.
 
     Args:
-        composite: a :class:`ght_cad.developable.CompositeDevelopable` of enveloping developables.
+        composite: a :class:`ght_cad.developables.envelope.CompositeDevelopable` of enveloping developables.
         objective: ``AL``, ``En``, ``CVEn`` or ``weighted``.
         weights: ``(w0, w1, w2)`` for ``weighted``.
         nodes: Gauss–Legendre nodes per strip.

@@ -95,7 +95,7 @@ class OptimizationOutcome:
 
 
 def _composite_joint_rows(design: Design, composite: Any) -> list[dict[str, Any]]:
-    """Requested vs measured order (:func:`ght_cad.developable.measure_developable_joint`) per joint."""
+    """Requested vs measured order (:func:`ght_cad.developables.envelope.measure_developable_joint`) per joint."""
     segs = design.surface.segments if design.surface is not None else None
     assert segs
     rows = []
@@ -129,7 +129,7 @@ def composite_objective(design: Design, shape: dict[str, float], objective: str 
 
     The strips are built exactly as for the geometry (strip 0 from its planes, strip i > 0 joined
     G1/G2/G3 to strip i-1, every strip checked on construction) and every joint is measured
-    (:func:`ght_cad.developable.measure_developable_joint`).
+    (:func:`ght_cad.developables.envelope.measure_developable_joint`).
 
     Args:
         design: a validated design with a ``composite`` surface.

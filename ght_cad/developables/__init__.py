@@ -1,8 +1,10 @@
-"""The pieces of :mod:`ght_cad.developable` that need none of its surfaces (issue 27): jets and
-argument checks (:mod:`.jets`, :mod:`.checks`), the certified B-spline fit of a ruled surface
-(:mod:`.fit`) and canal surfaces (:mod:`.canal`).
+"""Developable surfaces (spec section 5, issue 27): one module per piece, this package imports none.
 
-The envelope, tangent, rectifying and composite developables and their joints stay in
-:mod:`ght_cad.developable` (their ``to_face`` reaches the CAD adapters); every name moved here
-stays importable from there.
+Modules: :mod:`~ght_cad.developables.envelope` (the envelope of control planes, tangent, rectifying
+and composite developables and their joints, spec 5.2-5.4 and 5.6; old path
+``ght_cad.developable``), :mod:`~ght_cad.developables.canal` (canal surfaces, 5.5),
+:mod:`~ght_cad.developables.fit` (the certified B-spline fit of a ruled surface),
+:mod:`~ght_cad.developables.jets` and :mod:`~ght_cad.developables.checks` (jets and argument
+checks, which need none of the surfaces). ``envelope`` re-imports every name of ``canal``, ``fit``,
+``jets`` and ``checks`` that it held before they moved.
 """

@@ -1,6 +1,6 @@
 """Canal surfaces (the envelope of a one-parameter family of spheres) and their report.
 
-Moved from :mod:`ght_cad.developable` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.developables.envelope` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Argument and regularity checks of the tangent and rectifying developables.
 
-Moved from :mod:`ght_cad.developable` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.developables.envelope` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A ruled or developable surface as a certified B-spline surface: its smooth pieces and the fit.
 
-Moved from :mod:`ght_cad.developable` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.developables.envelope` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Jets (a value and its derivatives) of products, powers and unit vectors, curve derivatives and
 small argument checks shared by the developables.
 
-Moved from :mod:`ght_cad.developable` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.developables.envelope` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

@@ -371,11 +371,11 @@ class DevelopableLoft(RuledSurface):
 
     def bspline_data(self, tol: float | None = None, degree: int = 5, theta_tol_deg: float = 1e-3) -> list[Any]:
         r"""Plain-data B-spline surfaces, one per segment (poles, knots, degrees; degree 1 across
-        the rulings), from :func:`ght_cad.developable.developable_bspline`: the boundary curves are
+        the rulings), from :func:`ght_cad.developables.envelope.developable_bspline`: the boundary curves are
         fitted together (compatible poles) with ``max_u |f(u) - F(u)| <= max_deviation <= tol``,
         so the faces' edges lie on the rails within ``max_deviation`` (the certified tolerance) and
         joint rulings are exact end poles."""
-        from ..developable import developable_bspline
+        from ..developables.envelope import developable_bspline
 
         return [developable_bspline(sg, tol=tol, degree=degree, theta_tol_deg=theta_tol_deg, end_order=sg.end_order)
                 for sg in self.segments]

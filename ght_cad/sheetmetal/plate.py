@@ -24,7 +24,7 @@ bounded by six ruled faces, all of degree 1 in their second parameter:
 The four boundary curves are fitted TOGETHER as one 12-D function
 ``f(u) = (a, b, a + σT n, b + σT n)`` by :func:`ght_cad.surfaces.bspline.fit_function` (one knot vector,
 deviation at matched parameters, values and first derivatives exact at the ends), piece by piece
-between the surface's ``breakpoints`` (:func:`ght_cad.developable.ruled_pieces`, e.g. a loft's
+between the surface's ``breakpoints`` (:func:`ght_cad.developables.envelope.ruled_pieces`, e.g. a loft's
 fans and main part) and joined with knots of multiplicity ``p`` (:func:`ght_cad.surfaces.bspline.join_bsplines`).
 Every two faces that meet share their boundary curve pole for pole, so a kernel sews them exactly
 (:func:`ght_cad.cad.sheet_solid.plate_solid`). A boundary that stands still on a piece (a fan's
@@ -163,7 +163,7 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
             :class:`ght_cad.sheet.SheetError` where the normal is undefined (a zero ruling).
         ConversionError: the fit did not reach ``tol``.
     """
-    from ..developable import _size, ruled_pieces
+    from ..developables.envelope import _size, ruled_pieces
 
     if not isinstance(surface, RuledSurface):
         raise GHTError(f"surface must be a RuledSurface, got {type(surface).__name__}")

@@ -216,7 +216,7 @@ def meet(A: Any, B: Any, C: Any) -> np.ndarray:
 
     Vectorized: ``A, B, C`` broadcast over leading dimensions, last dimension 4. The map is
     trilinear and alternating, so derivatives follow by the product rule (used by
-    :mod:`ght_cad.developable`). ``X`` satisfies ``A·X = B·X = C·X = 0``. Computed from the
+    :mod:`ght_cad.developables.envelope`). ``X`` satisfies ``A·X = B·X = C·X = 0``. Computed from the
     Plücker coordinates ``p_ij = A_i B_j - A_j B_i`` of ``A ∧ B`` by expanding each 3×3 minor along
     the row of ``C``: ``det(cols i<j<k) = C_k p_ij - C_j p_ik + C_i p_jk``.
 

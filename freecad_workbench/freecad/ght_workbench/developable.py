@@ -142,7 +142,7 @@ class DevelopableFeature(SurfaceOutputs, FeatureProxy):
         return planes, boundary
 
     def surface(self, obj: Any) -> Any:
-        """The core :class:`ght_cad.developable.EnvelopeDevelopable` of the feature."""
+        """The core :class:`ght_cad.developables.envelope.EnvelopeDevelopable` of the feature."""
         from ght_cad import developable_from_planes
 
         planes, boundary = self.control_planes(obj)

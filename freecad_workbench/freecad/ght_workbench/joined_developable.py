@@ -9,14 +9,14 @@ developable) is the envelope of its dual curve ``U(t)``. The new strip's dual cu
 * G3: also ``V'''(0) = k³ U'''(1) + 3kβ2 U''(1) + β3 U'(1)``,
 
 solved for the first ``r + 1`` control planes ``V_0..V_r`` (r = 1, 2, 3 for G1, G2, G3) by
-:func:`ght_cad.developable.join_developable`. ``PlaneCoordinates`` holds only the *free* control
+:func:`ght_cad.developables.envelope.join_developable`. ``PlaneCoordinates`` holds only the *free* control
 planes ``V_{r+1}..V_n`` (4 numbers ``u0, u1, u2, u3`` per plane); the feature prepends the
 ``r + 1`` solved ones, so the new strip's degree is ``n = r + (number of free planes)``.
 Empty ``BoundaryCoordinates`` means the previous strip's boundary planes ``E_a, E_b``: the two
 strips then share their joint ruling segment and ``Fuse`` sews them into one shell whose shared
 edge is a single edge.
 
-``JointOrder`` is *measured* afterwards by :func:`ght_cad.developable.measure_developable_joint`
+``JointOrder`` is *measured* afterwards by :func:`ght_cad.developables.envelope.measure_developable_joint`
 (projective contact order of the two dual curves, relative tolerance ``JointTolerance``), not
 copied from ``Continuity``.
 """
@@ -63,8 +63,8 @@ def _order(continuity: str) -> int:
 
 
 def _surface_of(prev: Any) -> Any:
-    """Core :class:`ght_cad.developable.EnvelopeDevelopable` of a previous feature."""
-    from ght_cad.developable import EnvelopeDevelopable
+    """Core :class:`ght_cad.developables.envelope.EnvelopeDevelopable` of a previous feature."""
+    from ght_cad.developables.envelope import EnvelopeDevelopable
 
     if prev is None:
         raise GHTError("Previous is not set; link a developable (from planes) or a joined developable")
@@ -143,8 +143,8 @@ class JoinedDevelopableFeature(FeatureProxy):
         return planes, (bc.reshape(2, 4) if bc.size else None)
 
     def surface(self, obj: Any) -> Any:
-        """The joined core :class:`ght_cad.developable.EnvelopeDevelopable`."""
-        from ght_cad.developable import join_developable
+        """The joined core :class:`ght_cad.developables.envelope.EnvelopeDevelopable`."""
+        from ght_cad.developables.envelope import join_developable
 
         first = _surface_of(obj.Previous)
         planes, boundary = self.control_planes(obj)
@@ -154,7 +154,7 @@ class JoinedDevelopableFeature(FeatureProxy):
         )
 
     def compute(self, obj: Any) -> None:
-        from ght_cad.developable import developable_bspline, measure_developable_joint
+        from ght_cad.developables.envelope import developable_bspline, measure_developable_joint
 
         first = _surface_of(obj.Previous)
         surf = self.surface(obj)

@@ -46,7 +46,7 @@ class SpineDevelopableFeature(SurfaceOutputs, FeatureProxy):
 
     def surface(self, obj: Any) -> Any:
         """The core :class:`TangentDevelopable` / :class:`RectifyingDevelopable`."""
-        from ght_cad.developable import RectifyingDevelopable, TangentDevelopable
+        from ght_cad.developables.envelope import RectifyingDevelopable, TangentDevelopable
 
         if obj.Curve is None:
             raise GHTError(f"{obj.Label}: no Curve linked")

@@ -44,7 +44,7 @@ class SegmentSpec:
     """One strip of a ``composite`` surface: an enveloping developable of control planes.
 
     Strip 0 is built from its planes (spec 5.2); strip i > 0 is joined to strip i-1 with
-    ``continuity`` (G1/G2/G3) by :func:`ght_cad.developable.join_developable`, which re-solves
+    ``continuity`` (G1/G2/G3) by :func:`ght_cad.developables.envelope.join_developable`, which re-solves
     its first ``r+1`` control planes (``r`` = the order) and keeps the others.
     """
 

@@ -237,7 +237,7 @@ class EnvelopeStrip(RuledSurface):
     ``a(t) = U ∩ U' ∩ E_a``, ``b(t) = U ∩ U' ∩ E_b`` as homogeneous meets ``X = meet(U, U', E)``;
     ``X' = meet(U, U'', E)`` (the term ``meet(U', U', E)`` vanishes), Cartesian derivative
     ``(X'_{1:3} X_0 - X_{1:3} X'_0) / X_0²``. A self-contained construction used to check that
-    the optimized surfaces stay developable when :mod:`ght_cad.developable` is not available.
+    the optimized surfaces stay developable when :mod:`ght_cad.developables.envelope` is not available.
     """
 
     def __init__(self, dual: GHTCurve, boundary_planes: Any) -> None:
@@ -390,7 +390,7 @@ class DualCurveFairnessProblem(FairnessProblem):
     def _surface(self, mu: float, nu: float, gamma: float) -> RuledSurface:
         """The enveloping developable for one full parameter set (checked on construction)."""
         try:
-            from ...developable import developable_from_planes  # written by another engineer
+            from ...developables.envelope import developable_from_planes  # written by another engineer
         except ImportError:
             return EnvelopeStrip(GHTCurve(self.planes, mu, nu, gamma), self.boundary_planes)
         return developable_from_planes(self.planes, self.boundary_planes, float(mu), float(nu), float(gamma))

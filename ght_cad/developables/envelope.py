@@ -31,18 +31,18 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .core._validate import as_parameter_array, check_finite_array, check_unit_interval
-from .curves.basis import evaluate_derivatives
-from .curves.curve import GHTCurve
-from .core.errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
-from .surfaces.planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
-from .surfaces.ruled import Developability, RuledSurface
+from ..core._validate import as_parameter_array, check_finite_array, check_unit_interval
+from ..curves.basis import evaluate_derivatives
+from ..curves.curve import GHTCurve
+from ..core.errors import DegenerateGeometryError, EdgeOfRegressionError, GHTError, SingularJoinError
+from ..surfaces.planes import PARALLEL_TOL, as_plane, check_control_planes, meet, meet_matrix, normalize_planes, plucker
+from ..surfaces.ruled import Developability, RuledSurface
 # Moved to ght_cad.developables (issue 27); every name stays importable from here.
-from .developables.canal import (CanalReport, CanalSurface)  # noqa: F401
-from .developables.checks import (_check_3d_curve, _check_strip_regular, _check_v_range)  # noqa: F401
-from .developables.fit import (_bspline_theta, _check_fit_args, _RuledInterval, _size, _strip_fit, developable_bspline,
+from .canal import (CanalReport, CanalSurface)  # noqa: F401
+from .checks import (_check_3d_curve, _check_strip_regular, _check_v_range)  # noqa: F401
+from .fit import (_bspline_theta, _check_fit_args, _RuledInterval, _size, _strip_fit, developable_bspline,
                                ruled_pieces, RuledPiece)  # noqa: F401
-from .developables.jets import (_check_derivative, _check_range, _cross, _dot, _fmt, _jcartesian, _Jet, _JET_CACHE_MAX,
+from .jets import (_check_derivative, _check_range, _cross, _dot, _fmt, _jcartesian, _Jet, _JET_CACHE_MAX,
                                 _JET_CACHE_SIZE, _jpow, _jprod, _junit, _mul, _ONE, _sign_change_roots, _ZERO,
                                 curve_derivatives)  # noqa: F401
 
@@ -437,7 +437,7 @@ class EnvelopeDevelopable(RuledSurface):
     # -- CAD ------------------------------------------------------------------------------------
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face (degree 1 across the rulings); see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .core._kernel import adapter
+        from ..core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -589,7 +589,7 @@ class TangentDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .core._kernel import adapter
+        from ..core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -654,7 +654,7 @@ class RectifyingDevelopable(RuledSurface):
 
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """One B-spline face; see :func:`ght_cad.cad.developable_faces.developable_face`."""
-        from .core._kernel import adapter
+        from ..core._kernel import adapter
 
         return adapter("developable_face")(self, tol=tol, **kwargs)
 
@@ -782,7 +782,7 @@ def measure_developable_joint(a: EnvelopeDevelopable, b: EnvelopeDevelopable, *,
             dist = max(dist, abs(float(P[0] + P[1:] @ p)) / float(np.linalg.norm(P[1:])) / seg)
     dual = None
     try:
-        from .curves.continuity import measure_continuity
+        from ..curves.continuity import measure_continuity
 
         dual = measure_continuity(a.dual_curve, b.dual_curve, tol=tol) if a.t_range == (0.0, 1.0) == b.t_range else None
     except ImportError:  # pragma: no cover - the continuity module ships with the package
@@ -824,7 +824,7 @@ def join_developable(
             order that the second surface's degree / shape parameters cannot take.
         GHTError: a trimmed ``first``; plus every error of :func:`developable_from_planes`.
     """
-    from .curves.continuity import Continuity, join
+    from ..curves.continuity import Continuity, join
 
     if not isinstance(first, EnvelopeDevelopable):
         raise GHTError(f"first must be an EnvelopeDevelopable, got {type(first).__name__}")
@@ -898,6 +898,6 @@ class CompositeDevelopable:
     def to_shell(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A shell of one B-spline face per segment with shared joint edges; see
         :func:`ght_cad.cad.developable_faces.composite_shell`."""
-        from .core._kernel import adapter
+        from ..core._kernel import adapter
 
         return adapter("composite_shell")(self, tol=tol, **kwargs)
