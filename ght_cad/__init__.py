@@ -31,6 +31,7 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
     **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
     "developable": "ght_cad.developables.envelope",
+    "loft": "ght_cad.developables.loft",  # a package: ght_cad.loft.rails is ght_cad.developables.loft.rails
 }
 
 _aliases.install(__name__, _MOVED)
@@ -102,7 +103,7 @@ _LAZY: dict[str, str] = {
     "curve_to_bspline": "ght_cad.surfaces.bspline",
     "fit_function": "ght_cad.surfaces.bspline",
     "GHTSurface": "ght_cad.surfaces.patch",
-    "developable_loft": "ght_cad.loft",
+    "developable_loft": "ght_cad.developables.loft",
     "unfold": "ght_cad.cad.unfold_solid",
     "approximate": "ght_cad.approximation",
 }

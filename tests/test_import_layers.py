@@ -78,7 +78,7 @@ ALLOWED_UPWARD = {
     KERNEL_HOOK,
     # deprecated aliases (a DeprecationWarning on every use; they go in the next minor release):
     # LoftProblem and three more names moved from the loft to the optimize layer in issue 27
-    ("ght_cad.loft", "ght_cad.optimize.problems.loft"),
+    ("ght_cad.developables.loft", "ght_cad.optimize.problems.loft"),
 }
 
 

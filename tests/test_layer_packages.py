@@ -129,6 +129,24 @@ def test_old_package_prefix_maps_its_submodules(monkeypatch: pytest.MonkeyPatch)
         monkeypatch.delitem(sys.modules, name)
 
 
+def test_old_package_submodule_first_is_loaded_once() -> None:
+    """Every submodule of a moved package, imported by its old path first in a fresh interpreter,
+    is the one module of the new path (one object per file in sys.modules)."""
+    packages = {old: new for old, new in MOVED if (PACKAGE.parent / Path(*new.split("."))).is_dir()}
+    if not packages:
+        pytest.skip("no package has moved")
+    subs = sorted(f"ght_cad.{old}.{p.stem}" for old, new in packages.items()
+                  for p in (PACKAGE.parent / Path(*new.split("."))).glob("[!_]*.py"))
+    got = run(
+        "import json, sys, importlib\n"
+        f"subs = {subs!r}\n"
+        "mods = [importlib.import_module(s) for s in subs]\n"
+        "files = [m.__file__ for m in set(sys.modules.values()) if getattr(m, '__file__', None)]\n"
+        "print(json.dumps([len(files) == len(set(files)), [m.__name__ for m in mods],\n"
+        "                  [m is sys.modules[m.__name__] for m in mods]]))\n")
+    assert got == [True, [FINDER.target(s) for s in subs], [True] * len(subs)]
+
+
 def test_facade_basis_stays_the_function_after_importing_the_old_module_path() -> None:
     """``import ght_cad.basis`` in a fresh interpreter must not replace the function ``ght_cad.basis``.
 

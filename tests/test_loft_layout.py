@@ -40,7 +40,7 @@ def test_ght_cad_loft_keeps_its_names(name: str) -> None:
     else:
         value = getattr(loft, name)
     if callable(value):  # classes and functions: defined in the package or in the loft problem's module
-        assert value.__module__.startswith(("ght_cad.loft.", "ght_cad.optimize.problems.loft")), value.__module__
+        assert value.__module__.startswith(("ght_cad.developables.loft.", "ght_cad.optimize.problems.loft")), value.__module__
 
 
 @pytest.mark.parametrize("name", OLD_PROBLEMS)
@@ -76,12 +76,12 @@ def test_moved_loft_names_are_deprecated_aliases_of_the_optimize_ones() -> None:
     assert same == [True] * 5 and unique
     names = ("LoftProblem", "LOFT_OBJECTIVES", "LoftGradientFallback", "loft_measures_and_gradients", "LoftProblem")
     for name, m in zip(names, msgs):
-        assert m == [["DeprecationWarning", f"ght_cad.loft.{name} moved to ght_cad.optimize.problems.loft.{name}; "
+        assert m == [["DeprecationWarning", f"ght_cad.developables.loft.{name} moved to ght_cad.optimize.problems.loft.{name}; "
                       "import it from there (the old name goes in the next minor release)"]], m
 
 
 def test_unknown_name_is_an_attribute_error() -> None:
     import ght_cad.loft as loft
 
-    with pytest.raises(AttributeError, match="module 'ght_cad.loft' has no attribute 'LoftSolver'"):
+    with pytest.raises(AttributeError, match="module 'ght_cad.developables.loft' has no attribute 'LoftSolver'"):
         loft.LoftSolver  # noqa: B018

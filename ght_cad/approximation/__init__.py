@@ -31,14 +31,14 @@ Algorithm (all kernel-free, numpy/scipy):
    of the panel's points to the target along its normal; ``f = 0.9``, lowered when step 3 fails).
    The strip's rulings are found fast by Newton on ``F(t, s) = det(a'(t), b'(s), b(s) - a(t)) = 0``
    for every t (with fans ``a(0) -> b(s)``, ``a(t) -> b(0)`` ... where ``s(t)`` leaves [0, 1]),
-   the same equation :func:`ght_cad.loft.developable_loft` traces.
+   the same equation :func:`ght_cad.developables.loft.developable_loft` traces.
 2. **Split the deviation both ways**: every seam is moved off the target along its normal,
    ``r_j(t) = S(t, y_j) + δ_j n(t, y_j)``, by the fixed point
    ``δ_j ← δ_j - (m_{j-1} + m_j) / 2`` (``m_i = (max d + min d) / 2`` of strip i; one neighbour at
    the ends), so each panel's deviation range is centred on the target. Adjacent panels share
    the seam function ``r_j`` exactly (the same callable for both lofts): the seams are watertight up
    to the B-spline fit tolerance of the faces (1e-7 of the size).
-3. **Build and measure**: each strip becomes an exact :func:`ght_cad.loft.developable_loft` between
+3. **Build and measure**: each strip becomes an exact :func:`ght_cad.developables.loft.developable_loft` between
    its rails (a seam that is one point, e.g. the pole of a sphere in longitude/latitude, gives a
    cone with its apex there) and its deviation is measured both ways (panel points projected onto
    the target and target points projected onto the panel, Gauss–Newton). If a panel exceeds

@@ -93,7 +93,7 @@ def _build_panel(frame: _Frame, A: _Seam, B: _Seam) -> Any:
     if A.point:
         return ConeStrip(B.rail(), A.eval(np.array([0.5]), 0)[0][0])
     from ..core.errors import NotDevelopableError
-    from ..loft import developable_loft
+    from ..developables.loft import developable_loft
 
     try:
         return developable_loft(A.rail(), B.rail(), orientation="same", samples=65)

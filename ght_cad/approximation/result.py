@@ -59,7 +59,7 @@ class Panel:
         max_deviation: ``max(max_out, max_in)``.
         theta_max_deg: the developability measure θ_max of the panel (degrees).
         area: 3-D area.
-        exact: the exact developable (a :class:`ght_cad.loft.DevelopableLoft` or :class:`ConeStrip`).
+        exact: the exact developable (a :class:`ght_cad.developables.loft.DevelopableLoft` or :class:`ConeStrip`).
         method: ``"loft"`` (seams centred by the offsets of step 2) or ``"dual"`` (seams = the
             trimmed boundary of the strip's dual fit, :mod:`ght_cad.approximation_dual`).
         choice: how the method was chosen: the sampled deviations of both candidates

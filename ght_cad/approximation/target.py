@@ -137,7 +137,7 @@ def _ruled_jet(surf: RuledSurface) -> _JET:
 
 def as_target(target: Any) -> SurfaceTarget:
     """A :class:`SurfaceTarget` from a GHTSurface, a NurbsSurface, a RuledSurface (e.g. a
-    :class:`ght_cad.loft.DevelopableLoft`), an object with ``jet(u, v, order)`` and ``bounds``, or a
+    :class:`ght_cad.developables.loft.DevelopableLoft`), an object with ``jet(u, v, order)`` and ``bounds``, or a
     build123d/cadquery/OCP face (through :func:`ght_cad.cad.approximate.face_target`).
 
     Raises:

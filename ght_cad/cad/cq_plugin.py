@@ -167,7 +167,7 @@ def developable_loft_cq(rail_a: Any, rail_b: Any, **options: Any) -> Any:
     Args:
         rail_a, rail_b: cadquery/build123d ``Edge``/``Wire``, OCP edges/wires or 3-D GHTCurves.
         **options: ``tol``, ``degree``, ``sew_tol`` and the core options of
-            :func:`ght_cad.loft.developable_loft` (``orientation``, ``branch``, ...).
+            :func:`ght_cad.developables.loft.developable_loft` (``orientation``, ``branch``, ...).
 
     Returns:
         ``cq.Shell`` or ``cq.Face`` with ``.ght_loft`` (the core loft: report, ``unroll``).

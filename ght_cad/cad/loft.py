@@ -2,11 +2,11 @@ r"""build123d / OCP front end of the exact developable loft between two rails (s
 
 :func:`developable_loft` takes two rails as CAD edges (build123d or cadquery ``Edge``/``Wire``,
 OCP ``TopoDS_Edge``/``TopoDS_Wire``, any curve type: B-spline, circle, ellipse, line, ...) or
-:class:`~ght_cad.curves.curve.GHTCurve` objects, runs the core :func:`ght_cad.loft.developable_loft`
+:class:`~ght_cad.curves.curve.GHTCurve` objects, runs the core :func:`ght_cad.developables.loft.developable_loft`
 (the branch ``F(t, s) = det(a'(t), b'(s), b(s) - a(t)) = 0`` traced to round-off, fans at the
 rail ends) and returns its B-rep: one B-spline face per segment (main part and fans, degree 1
 across the rulings, the boundary curves fitted together so pole pair ``i`` spans one ruling:
-:meth:`ght_cad.loft.DevelopableLoft.bspline_data`) sewn along the joint rulings into one
+:meth:`ght_cad.developables.loft.DevelopableLoft.bspline_data`) sewn along the joint rulings into one
 ``Shell`` (a single ``Face`` when the loft has one segment).
 
 Edges become rails through :class:`OCPCurveRail`: ``r(t) = C(p(t))`` with the edge's parameter
@@ -48,7 +48,7 @@ from .occ import is_valid, make_face, shape_class, unwrap
 
 __all__ = ["OCPCurveRail", "rail_of", "developable_loft", "loft_shape", "LOFT_OPTIONS"]
 
-#: keyword options passed on to the core :func:`ght_cad.loft.developable_loft`
+#: keyword options passed on to the core :func:`ght_cad.developables.loft.developable_loft`
 LOFT_OPTIONS = ("orientation", "branch", "max_step", "step_tol", "samples", "boundary_samples")
 
 
@@ -211,7 +211,7 @@ def rail_of(obj: Any, name: str = "rail") -> Any:
     Args:
         obj: build123d/cadquery ``Edge``/``Wire``, OCP ``TopoDS_Edge``/``TopoDS_Wire``, a 3-D
             :class:`~ght_cad.curves.curve.GHTCurve` (exact, no kernel in between), a
-            :class:`ght_cad.loft.CallableRail` or any object with ``evaluate``/``derivative``.
+            :class:`ght_cad.developables.loft.CallableRail` or any object with ``evaluate``/``derivative``.
 
     Raises:
         GHTError: anything else (a face, a solid, a number, ...).
@@ -235,8 +235,8 @@ def _segment_size(loft: Any) -> float:
 
 
 def loft_shape(loft: Any, *, tol: float | None = None, degree: int = 5, sew_tol: float | None = None) -> Any:
-    r"""The B-rep of a core :class:`ght_cad.loft.DevelopableLoft`: one valid B-spline face per
-    segment (:meth:`~ght_cad.loft.DevelopableLoft.bspline_data`) sewn into one ``Shell``, or the
+    r"""The B-rep of a core :class:`ght_cad.developables.loft.DevelopableLoft`: one valid B-spline face per
+    segment (:meth:`~ght_cad.developables.loft.DevelopableLoft.bspline_data`) sewn into one ``Shell``, or the
     single ``Face`` of a one-segment loft.
 
     A loft whose first and last rulings coincide (two closed rails, e.g. the circles of a cone)
@@ -301,7 +301,7 @@ def developable_loft(
     r"""The exact developable loft between two edges as a build123d ``Shell`` (or ``Face``).
 
     The rulings ``a(t)–b(σ(t))`` satisfy ``det(a'(t), b'(σ), b(σ) - a(t)) = 0`` to round-off
-    (spec 5.7, :func:`ght_cad.loft.developable_loft`); fans (cones with apex at a rail end)
+    (spec 5.7, :func:`ght_cad.developables.loft.developable_loft`); fans (cones with apex at a rail end)
     complete the loft so both rails are covered over their whole length. See the module doc for
     the rail adapter and the B-rep (:func:`loft_shape`).
 
@@ -312,7 +312,7 @@ def developable_loft(
         mode: builder combination mode inside ``BuildPart`` (default ``Mode.ADD``: faces join
             the pending faces; ``Mode.PRIVATE``: nothing is added).
         **options: core options ``orientation``, ``branch``, ``max_step``, ``step_tol``,
-            ``samples``, ``boundary_samples`` (:func:`ght_cad.loft.developable_loft`).
+            ``samples``, ``boundary_samples`` (:func:`ght_cad.developables.loft.developable_loft`).
 
     Returns:
         ``Shell`` (several segments, or closed around) or ``Face``, with ``.ght_loft``.
@@ -346,7 +346,7 @@ def loft_between(edge_a: Any, edge_b: Any, *, tol: float | None = None, degree: 
     Raises:
         GHTError: an unknown option (and everything :func:`developable_loft` raises).
     """
-    from ..loft import developable_loft as core_loft
+    from ..developables.loft import developable_loft as core_loft
 
     unknown = sorted(set(options) - set(LOFT_OPTIONS))
     if unknown:

@@ -13,7 +13,7 @@ def lazy_getattr(module: str, table: Mapping[str, str], namespace: dict[str, Any
     takes ``name`` from it and keeps the value in ``namespace`` (the module's ``globals()``).
 
     Used by the facade ``ght_cad`` (heavier modules, and the CAD adapter ``unfold``) and, with
-    ``deprecated=True``, by ``ght_cad.loft`` for the names that moved to
+    ``deprecated=True``, by ``ght_cad.developables.loft`` for the names that moved to
     ``ght_cad.optimize.problems.loft`` (a higher layer): each first use there warns
     (:class:`DeprecationWarning` naming the new path) and is not kept, so every use warns.
 

@@ -36,7 +36,7 @@ __all__ = ["ApproximatedSurface", "approximation_target", "build_approximation",
 
 class ApproximatedSurface:
     """The built ``approximate`` surface of a design: the :class:`~ght_cad.approximation.ApproximationResult`
-    and its panels' exact developables (``parts``: a :class:`~ght_cad.loft.DevelopableLoft` per strip,
+    and its panels' exact developables (``parts``: a :class:`~ght_cad.developables.loft.DevelopableLoft` per strip,
     a :class:`~ght_cad.approximation.ConeStrip` where a seam is one point) and the ``method`` asked for."""
 
     def __init__(self, result: Any, target: Any, method: str = "auto") -> None:

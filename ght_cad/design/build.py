@@ -152,7 +152,7 @@ def make_loft(spec: SurfaceSpec, rail_a: Any, rail_b: Any, **options: Any) -> An
         NotDevelopableError: no developable joins the rails over their whole length (the loft
             core's message).
     """
-    from ..loft import developable_loft
+    from ..developables.loft import developable_loft
 
     return developable_loft(rail_a, rail_b, orientation=spec.orientation, **options)
 

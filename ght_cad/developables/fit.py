@@ -83,7 +83,7 @@ class _RuledInterval(RuledSurface):
 
 def ruled_pieces(surface: RuledSurface) -> list[RuledPiece]:
     r"""The smooth pieces of a ruled surface between its ``breakpoints`` (where a, b are only C0 or
-    C1 in u, e.g. the joint rulings of a :class:`~ght_cad.loft.DevelopableLoft`'s fans).
+    C1 in u, e.g. the joint rulings of a :class:`~ght_cad.developables.loft.DevelopableLoft`'s fans).
 
     The pieces are, in this order of preference: the surface's own ``segments`` when they match
     the breakpoints (a loft: each segment is exact with one-sided jets, ``end_orders`` =

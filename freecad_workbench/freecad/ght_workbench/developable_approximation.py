@@ -317,7 +317,7 @@ class DevelopableApproximationFeature(FeatureProxy):
         set_read_only(obj, OUTPUTS)
 
     def surface(self, obj: Any) -> list[Any]:
-        """The panels' exact developables (:class:`ght_cad.loft.DevelopableLoft` or
+        """The panels' exact developables (:class:`ght_cad.developables.loft.DevelopableLoft` or
         :class:`ght_cad.approximation.ConeStrip`) in FaceN order: the *Flat pattern* feature
         (Source = this feature) unrolls them all onto one sheet, as ``ght-cad approximate`` does.
         They are kept from the last successful recompute (together with the Shape); after a

@@ -1,11 +1,11 @@
 r"""Developable loft between two rails (spec section 5.7): a parametric feature on two edges.
 
 The rails are two linked edges (``RailA``, ``RailB``: an edge of a sketch, of a GHT curve or of
-any Part feature). The core :func:`ght_cad.loft.developable_loft` traces the rulings
+any Part feature). The core :func:`ght_cad.developables.loft.developable_loft` traces the rulings
 ``a(t)–b(σ(t))`` with ``F(t, σ) = det(a'(t), b'(σ), b(σ) - a(t)) = 0`` solved to round-off and adds
 fans (cones with apex at a rail end) so both rails are covered over their whole length. The
 feature's Shape is one B-spline face per segment (main part and fans, degree 1 across the
-rulings, :meth:`ght_cad.loft.DevelopableLoft.bspline_data`) sewn into one shell.
+rulings, :meth:`ght_cad.developables.loft.DevelopableLoft.bspline_data`) sewn into one shell.
 
 Rails: a GHT curve feature gives its exact :class:`ght_cad.GHTCurve` (placed), so its μ, ν, γ
 reshape the loft and the *Optimization* feature (Problem ``Loft``) can optimize them for the fan
@@ -166,8 +166,8 @@ class DevelopableLoftFeature(FeatureProxy):
         return rail_from_link(obj.RailA, f"{obj.Label}.RailA"), rail_from_link(obj.RailB, f"{obj.Label}.RailB")
 
     def surface(self, obj: Any) -> Any:
-        """The core :class:`ght_cad.loft.DevelopableLoft` (the Flat pattern unrolls it)."""
-        from ght_cad.loft import developable_loft
+        """The core :class:`ght_cad.developables.loft.DevelopableLoft` (the Flat pattern unrolls it)."""
+        from ght_cad.developables.loft import developable_loft
 
         if obj.Orientation not in ORIENTATIONS:
             raise GHTError(f"{obj.Label}.Orientation={obj.Orientation!r} is not allowed; use one of {ORIENTATIONS}")
@@ -280,7 +280,7 @@ def make_developable_loft(rail_a: Any, rail_b: Any, *, orientation: str = "auto"
     Args:
         rail_a, rail_b: ``(object, "EdgeN")`` links, or an object whose shape is one edge (a GHT
             curve feature, a single-edge sketch or Part feature).
-        orientation: ``"auto"``, ``"same"`` or ``"reversed"`` (see :func:`ght_cad.loft.developable_loft`).
+        orientation: ``"auto"``, ``"same"`` or ``"reversed"`` (see :func:`ght_cad.developables.loft.developable_loft`).
         tolerance: face deviation (0: 1e-7 of the segment size).
 
     Returns:

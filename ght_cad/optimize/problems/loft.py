@@ -1,7 +1,7 @@
 r"""The developable loft's shape-parameter problem (spec sections 5.7, 8.1): :class:`LoftProblem`
 optimizes the six shape parameters of two GHT rails for the loft's measures (fan share, fairness,
 distance of the edge of regression), with exact gradients through the implicit-function theorem
-(:func:`loft_measures_and_gradients`). Moved here from ``ght_cad.loft``, which still gives these names."""
+(:func:`loft_measures_and_gradients`). Moved here from ``ght_cad.developables.loft``, which still gives these names."""
 
 from __future__ import annotations
 
@@ -15,11 +15,11 @@ from ...core._vec import cross as _cross3
 from ...core._quadrature import gauss_legendre
 from ...curves.curve import GHTCurve
 from ...core.errors import GHTError
-from ...loft.build import developable_loft
-from ...loft.equation import MIN_FAN
-from ...loft.rails import _det, _jet
-from ...loft.surface import DevelopableLoft, LoftSegment
-from ...loft.tracing import _at_corner
+from ...developables.loft.build import developable_loft
+from ...developables.loft.equation import MIN_FAN
+from ...developables.loft.rails import _det, _jet
+from ...developables.loft.surface import DevelopableLoft, LoftSegment
+from ...developables.loft.tracing import _at_corner
 from ...surfaces.ruled import regression_v
 from .base import CurveParameterJets, Problem
 

@@ -8,9 +8,9 @@ from typing import Any, Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..core._validate import as_parameter_array
-from ..curves.curve import GHTCurve
-from ..core.errors import GHTError
+from ...core._validate import as_parameter_array
+from ...curves.curve import GHTCurve
+from ...core.errors import GHTError
 
 
 # ----------------------------------------------------------------------------------------------

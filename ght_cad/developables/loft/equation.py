@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from ..core._quadrature import leggauss
-from ..core.errors import NotDevelopableError
+from ...core._quadrature import leggauss
+from ...core.errors import NotDevelopableError
 from .rails import _det, _jet, as_rail
 
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .equation import _Pair
 from .rails import as_rail
 from .surface import DevelopableLoft
@@ -25,7 +25,7 @@ def plot_loft_sign(rail_a: Any, rail_b: Any, path: Any, *, loft: DevelopableLoft
     Returns:
         The written path.
     """
-    from ..curves.plotting import DPI, _save
+    from ...curves.plotting import DPI, _save
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import ListedColormap
     from matplotlib.figure import Figure

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import NotDevelopableError
+from ...core.errors import NotDevelopableError
 from .equation import CORNER_RADIUS, MIN_FAN, _EPS, _Pair
 
 

@@ -32,7 +32,7 @@ Modules: :mod:`.rails` (rail adapters), :mod:`.equation` (``F`` and its continua
 :mod:`.tracing` (the branch and the corner-to-corner path), :mod:`.surface` (segments, report,
 :class:`DevelopableLoft`), :mod:`.build` (:func:`developable_loft`), :mod:`.plot`
 (:func:`plot_loft_sign`). The optimization problem over the rails' shape parameters and its
-exact gradients live in :mod:`ght_cad.optimize.problems.loft`; ``ght_cad.loft.LoftProblem``,
+exact gradients live in :mod:`ght_cad.optimize.problems.loft`; ``ght_cad.developables.loft.LoftProblem``,
 ``LOFT_OBJECTIVES``, ``LoftGradientFallback`` and ``loft_measures_and_gradients`` are deprecated
 aliases of those (loaded from there on use with a :class:`DeprecationWarning`, so that importing
 the loft never imports the optimize layer; not in ``__all__``).
@@ -40,7 +40,7 @@ the loft never imports the optimize layer; not in ``__all__``).
 
 from __future__ import annotations
 
-from ..core._lazy import lazy_getattr
+from ...core._lazy import lazy_getattr
 from .build import developable_loft
 from .equation import CORNER_RADIUS, CORNER_TOL, MIN_FAN, loft_function
 from .plot import plot_loft_sign

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from ..core._validate import is_real
-from ..core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
+from ...core._validate import is_real
+from ...core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
 from .equation import _Pair
 from .plot import plot_loft_sign
 from .rails import _Reversed, as_rail
@@ -167,7 +167,7 @@ def developable_loft(
         msg = _no_branch_message(ra, rb, size, cands, orients)
         if sign_png is not None:
             path = plot_loft_sign(ra, rb, sign_png)
-            msg = msg.replace("ght_cad.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws", f"{path} shows")
+            msg = msg.replace("ght_cad.developables.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws", f"{path} shows")
         return NotDevelopableError(msg)
 
     if not found:
@@ -236,5 +236,5 @@ def _no_branch_message(ra: Any, rb: Any, size: float, cands: list[dict[str, Any]
             f"from (t, s) = ({c['start'][0]:.6g}, {c['start'][1]:.6g}) [{c['orientation']}]: {c.get('refused', 'refused')}"
             for c in cands
         )
-    return head + tail + ". ght_cad.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws the sign of F over the square."
+    return head + tail + ". ght_cad.developables.loft.plot_loft_sign(rail_a, rail_b, 'sign.png') draws the sign of F over the square."
 

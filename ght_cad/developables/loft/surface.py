@@ -9,10 +9,10 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core._validate import as_parameter_array
-from ..core._quadrature import gauss_legendre
-from ..core.errors import GHTError
-from ..surfaces.ruled import Developability, RuledSurface, regression_v
+from ...core._validate import as_parameter_array
+from ...core._quadrature import gauss_legendre
+from ...core.errors import GHTError
+from ...surfaces.ruled import Developability, RuledSurface, regression_v
 from .equation import MIN_FAN, _EPS, _Pair
 from .rails import _jet
 from .tracing import _Branch, _Path
@@ -338,7 +338,7 @@ class DevelopableLoft(RuledSurface):
 
     def area(self) -> float:
         """3-D area, sum over the segments of ``∫∫ |(a' + v g') × g| dv du``."""
-        from ..unrolling.unroll import ruled_area
+        from ...unrolling.unroll import ruled_area
 
         return float(sum(ruled_area(sg, rtol=1e-13) for sg in self.segments))
 
@@ -375,7 +375,7 @@ class DevelopableLoft(RuledSurface):
         fitted together (compatible poles) with ``max_u |f(u) - F(u)| <= max_deviation <= tol``,
         so the faces' edges lie on the rails within ``max_deviation`` (the certified tolerance) and
         joint rulings are exact end poles."""
-        from ..developables.envelope import developable_bspline
+        from ..envelope import developable_bspline
 
         return [developable_bspline(sg, tol=tol, degree=degree, theta_tol_deg=theta_tol_deg, end_order=sg.end_order)
                 for sg in self.segments]
@@ -400,7 +400,7 @@ class DevelopableLoft(RuledSurface):
     def to_face(self, tol: float | None = None, **kwargs: Any) -> Any:
         """A build123d ``Shell`` of one B-spline face per segment sewn along the joint rulings
         (:func:`ght_cad.cad.developable_faces.composite_shell`; needs build123d)."""
-        from ..core._kernel import adapter
+        from ...core._kernel import adapter
 
         return adapter("composite_shell")(self.segments, tol=tol, **kwargs)
 
@@ -427,8 +427,8 @@ class DevelopableLoft(RuledSurface):
 
     # -- report --------------------------------------------------------------------------
     def _make_report(self, samples: int, candidates: list[dict[str, Any]], area_rtol: float) -> LoftReport:
-        from ..unrolling.unroll import ruled_area
-        from ..surfaces.ruled import _theta
+        from ...unrolling.unroll import ruled_area
+        from ...surfaces.ruled import _theta
 
         size = self._pair.size
         seg_info = []
