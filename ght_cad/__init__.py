@@ -32,6 +32,7 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step")},
     "developable": "ght_cad.developables.envelope",
     "loft": "ght_cad.developables.loft",  # a package: ght_cad.loft.rails is ght_cad.developables.loft.rails
+    "approximation_dual": "ght_cad.approximation.dual",
 }
 
 _aliases.install(__name__, _MOVED)

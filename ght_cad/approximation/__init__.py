@@ -51,7 +51,7 @@ Algorithm (all kernel-free, numpy/scipy):
    (where no developable joins its seams, the finest march with fewer strips is tried instead).
 
 4. **Loft or dual fit per strip** (``method="auto"``, spec 10.1): every strip also gets the dual
-   fit of the target's tangent planes along its middle curve (:mod:`ght_cad.approximation_dual`:
+   fit of the target's tangent planes along its middle curve (:mod:`ght_cad.approximation.dual`:
    a GHT dual curve, spec 5.2, fitted by least squares, its μ, ν, γ optimized by
    :func:`ght_cad.optimize.minimize`), trimmed to the strip: its boundary on the seam rows is a
    seam ``S(x, y_j) + δ(x) n`` of the same family. Strips turn dual greedily where the dual seams
@@ -67,7 +67,8 @@ tries the whole box.
 Modules (issue 27, moved from ``ght_cad/approximation.py``): :mod:`.target` (targets),
 :mod:`.frame` (strip coordinates), :mod:`.seams` (seams, strip rulings), :mod:`.result` (panels and
 the result), :mod:`.splitting` (direction estimate, march, greedy split, offsets), :mod:`.fitting`
-(loft or dual fit per strip, building a panel), :mod:`.deviation` (measuring a panel);
+(loft or dual fit per strip, building a panel), :mod:`.deviation` (measuring a panel), :mod:`.dual`
+(the dual fit of a strip's tangent planes; old path ``ght_cad.approximation_dual``);
 :func:`approximate` stays here and reads the helpers from this module's namespace. Every name
 (private ones included) is importable as ``ght_cad.approximation.<name>``.
 """
@@ -191,7 +192,7 @@ def approximate(
     _check_number("optimizer_budget", optimizer_budget, 1, integer=True)
     _check_number("dual_degree", dual_degree, 3, integer=True)
     if optimizer is not None:
-        from ..approximation_dual import check_optimizer
+        from .dual import check_optimizer
 
         check_optimizer(optimizer)
     from ..developables.envelope import developable_bspline
@@ -231,7 +232,7 @@ def approximate(
             # constant offsets; measured on the cap, the dual seams were 2.3x farther (0.48 vs 0.21)
             choice = [{"dual_ok": False, "dual_reason": "closed strip (a GHT dual curve does not close)"} for _ in range(n)]
         elif method != "loft":
-            from ..approximation_dual import fit_strip
+            from .dual import fit_strip
 
             for A, B in zip(loft_seams[:-1], loft_seams[1:]):
                 try:

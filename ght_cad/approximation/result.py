@@ -61,7 +61,7 @@ class Panel:
         area: 3-D area.
         exact: the exact developable (a :class:`ght_cad.developables.loft.DevelopableLoft` or :class:`ConeStrip`).
         method: ``"loft"`` (seams centred by the offsets of step 2) or ``"dual"`` (seams = the
-            trimmed boundary of the strip's dual fit, :mod:`ght_cad.approximation_dual`).
+            trimmed boundary of the strip's dual fit, :mod:`ght_cad.approximation.dual`).
         choice: how the method was chosen: the sampled deviations of both candidates
             (``deviation_loft``, ``deviation_dual``), the dual fit's μ, ν, γ and its deviation at
             ``μ = ν = γ = 0`` and after optimization (``dual_start``, ``dual_optimized``).

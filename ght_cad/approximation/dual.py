@@ -44,15 +44,15 @@ from typing import Any
 
 import numpy as np
 
-from .curves.basis import basis
+from ..curves.basis import basis
 
 __all__ = ["DualFit", "PlaneSamples", "tangent_planes", "fit_dual_planes", "normal_hits", "fit_strip", "check_optimizer"]
 
 
 def check_optimizer(name: Any) -> None:
     """Raise :class:`ght_cad.core.errors.GHTError` unless ``name`` is a :func:`ght_cad.optimize.minimize` method."""
-    from .core.errors import GHTError
-    from .optimize import METHODS
+    from ..core.errors import GHTError
+    from ..optimize import METHODS
 
     key = str(name).lower().replace("-", "").replace("_", "")
     if not isinstance(name, str) or key not in METHODS:
@@ -249,7 +249,7 @@ class _StripGrid:
 
 def _regression_in_strip(frame: Any, P: np.ndarray, params: tuple[float, float, float], y_lo: float, y_hi: float) -> bool:
     """The edge of regression ``U ∩ U' ∩ U''`` near the target inside the strip (module doc)."""
-    from .surfaces.planes import meet
+    from ..surfaces.planes import meet
 
     x0 = np.linspace(0.0, 1.0, 33)
     t = _t_of_x(x0)
@@ -284,7 +284,7 @@ def fit_strip(frame: Any, y_lo: float, y_hi: float, *, degree: int = 6, optimize
             seams stay closed.
         delta_degree: Chebyshev degree of the trimmed seam offsets.
     """
-    from .optimize.hybrid import _one_blas_thread  # tiny least squares: no BLAS thread waits
+    from ..optimize.hybrid import _one_blas_thread  # tiny least squares: no BLAS thread waits
 
     with _one_blas_thread():
         return _fit_strip(frame, y_lo, y_hi, degree, optimizer, max_nfev, seed, closed, delta_degree)
@@ -330,7 +330,7 @@ def _fit_strip(frame: Any, y_lo: float, y_hi: float, degree: int, optimizer: str
     best_p, best = zero, start
     nfev = 0
     if optimizer is not None:
-        from .optimize import minimize
+        from ..optimize import minimize
 
         def F(Xp: np.ndarray) -> np.ndarray:
             return np.array([min(centred(tuple(float(v) for v in row), 1)[0], 1e300) for row in np.atleast_2d(Xp)])
