@@ -285,7 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     common(sp)
     sp.set_defaults(func=cmd_plot_basis)
 
-    from ..approximate_cli import add_parser as _add_approximate  # issue 24: logic in its own module
+    from .approximate_cli import add_parser as _add_approximate  # issue 24: logic in its own module
 
     _add_approximate(sub, common, _EPILOG)
     return p

@@ -4,6 +4,6 @@ and ``curve`` (:mod:`.curves`), the design-file commands (:mod:`.design`), ``unr
 (:mod:`.unroll`), ``batch`` (:mod:`.batch`) and ``export`` (:mod:`.export`).
 
 :mod:`ght_cad.app.cli` keeps the parser, ``main`` and the signal and stdout handling, and re-imports
-every name moved here. :mod:`ght_cad.app.batch` and :mod:`ght_cad.approximate_cli` take ``dumps`` from
+every name moved here. :mod:`ght_cad.app.batch` and :mod:`ght_cad.app.approximate_cli` take ``dumps`` from
 :mod:`.common`, so neither imports the CLI that runs them (the import cycle through the CLI is gone).
 """

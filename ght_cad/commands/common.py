@@ -2,7 +2,7 @@
 parsers for points and paths, staged output files and the report text.
 
 Moved from :mod:`ght_cad.app.cli` (issue 27; every name stays importable from there). :mod:`ght_cad.app.batch`
-and :mod:`ght_cad.approximate_cli` take :func:`dumps` from here (not from the CLI that runs them).
+and :mod:`ght_cad.app.approximate_cli` take :func:`dumps` from here (not from the CLI that runs them).
 """
 
 from __future__ import annotations

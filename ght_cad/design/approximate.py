@@ -6,7 +6,7 @@ approximate --face``), a GHT patch ``S(u, v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P
 (:class:`ght_cad.surfaces.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.surfaces.nurbs.NurbsSurface`). It is
 covered by :func:`ght_cad.approximate` with the surface's ``tol``, ``max_panels``, ``direction`` and
 ``method``: the same call ``ght-cad approximate``
-(:mod:`ght_cad.approximate_cli`) makes, and both write their
+(:mod:`ght_cad.app.approximate_cli`) makes, and both write their
 outputs through the functions of this module: the panels sewn into one shell
 (:func:`ght_cad.cad.approximate.panels_shell`), their flat patterns on one sheet with seam marks
 (:func:`panel_pattern`), the deviation map (:func:`plot_deviation`), the per-panel report

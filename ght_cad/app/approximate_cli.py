@@ -29,11 +29,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
+from ..design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
                                  plot_deviation, report_markdown)
-from .approximation.target import TRIM_ALLOWED, TrimmedTargetError, trim_words
-from .core.errors import GHTError
-from .design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
+from ..approximation.target import TRIM_ALLOWED, TrimmedTargetError, trim_words
+from ..core.errors import GHTError
+from ..design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
 __all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
            "panel_pattern", "panel_plates"]
@@ -96,13 +96,13 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
     surfaces (:func:`panel_plates`, :func:`panel_pattern`), ``side`` measured on the normal of the
     ``target`` (:func:`panel_sheets`; needed with a sheet); ``method``: the one asked for, recorded
     in the report."""
-    from .cad.approximate import panels_shell
-    from .cad.occ import write_step
-    from .core.io import atomic_write, strict_json
+    from ..cad.approximate import panels_shell
+    from ..cad.occ import write_step
+    from ..core.io import atomic_write, strict_json
 
     sheets = panel_sheets(result, target, sheet)
     if sheets is not None:
-        from .cad.sheet_solid import write_plate_step
+        from ..cad.sheet_solid import write_plate_step
 
         plates = panel_plates(result, sheets, name)
         write_plate_step(plates, folder.path("panels.step"), units=units, product=name)
@@ -130,7 +130,7 @@ def write_outputs(result: Any, folder: Any, *, name: str = "target", units: str 
 def _progress_lines(args: argparse.Namespace) -> Callable[[str], None] | None:
     """The core's ``progress`` callback: each line to stderr with the elapsed time, ``ght-cad run``'s
     convention (a terminal or ``GHT_CAD_PROGRESS=1``, not ``--no-progress``); None otherwise."""
-    from .core.progress import progress_enabled
+    from ..core.progress import progress_enabled
 
     if getattr(args, "no_progress", False) or not progress_enabled():
         return None
@@ -145,10 +145,10 @@ def _progress_lines(args: argparse.Namespace) -> Callable[[str], None] | None:
 
 def cmd_approximate(args: argparse.Namespace) -> int:
     """``ght-cad approximate TARGET.step --tol T --out DIR``."""
-    from .cad.approximate import step_target
-    from .core.outdir import OutputFolder
-    from .approximation import approximate
-    from .sheetmetal.sheet import make_sheet
+    from ..cad.approximate import step_target
+    from ..core.outdir import OutputFolder
+    from ..approximation import approximate
+    from ..sheetmetal.sheet import make_sheet
 
     path = Path(args.target)
     if path.suffix.lower() not in (".step", ".stp"):
@@ -174,7 +174,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
                "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}
     if getattr(args, "json", False):
-        from .commands.common import dumps
+        from ..commands.common import dumps
 
         args._json_out = dumps({"ok": True, **summary})
     else:
