@@ -43,9 +43,9 @@ import numpy as np
 
 from ..core._quadrature import leggauss
 from ..core.errors import GHTError
-from ..faces.directions import ruling_direction
-from ..faces.loops import fd_derivative
-from ..faces.ruled_face import FaceRuledSurface
+from ..unrolling.faces.directions import ruling_direction
+from ..unrolling.faces.loops import fd_derivative
+from ..unrolling.faces.ruled_face import FaceRuledSurface
 from ..pattern.forming import FormingRow, _fmt_r, forming_table_text, plot_roll_chart  # noqa: F401 - moved there (issue 27)
 from ..pattern.model import _inside, romberg_length
 from ..surfaces.ruled import SINGULAR_NORMAL_TOL, RuledSurface

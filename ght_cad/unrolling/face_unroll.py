@@ -41,17 +41,17 @@ from ..pattern.flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, _unit_s
 from ..surfaces.ruled import _theta_parameters
 from .ruled_development import (DEFAULT_TOL_DEG, RuledDevelopment, _check_developable, broadcast_uv, first_nodes,
                                 metric_angles, metric_stencil)
-# Moved to ght_cad.faces (issue 27); every name stays importable from here.
-from ..faces.adapter import (analytic_jet, Bounds, EdgeData, FaceData, jets_agree, RULED_KINDS, surface_jet,
+# Moved to ght_cad.unrolling.faces (issue 27); every name stays importable from here.
+from .faces.adapter import (analytic_jet, Bounds, EdgeData, FaceData, jets_agree, RULED_KINDS, surface_jet,
                             SurfaceAdapter, U_FREE_DENSITY_KINDS)  # noqa: F401
-from ..faces.area import (_edge_nodes, _edge_nodes_at, _edge_nodes_plain, _gauss12, _inner_integrals,
+from .faces.area import (_edge_nodes, _edge_nodes_at, _edge_nodes_plain, _gauss12, _inner_integrals,
                          _inner_integrals_by_pieces, _inner_nodes, _inner_nodes_at, face_area)  # noqa: F401
-from ..faces.directions import (_isoline_points, best_effort_direction, end_isoline_length, isoline_stats,
+from .faces.directions import (_isoline_points, best_effort_direction, end_isoline_length, isoline_stats,
                                ruling_direction)  # noqa: F401
-from ..faces.loops import (_as_shape, _c0_crossings, _check_holes_inside, _edge_sample_uv, _flat1, _loop_points,
+from .faces.loops import (_as_shape, _c0_crossings, _check_holes_inside, _edge_sample_uv, _flat1, _loop_points,
                           _seed_edge_samples, _strided_memo, _with_breaks, chain_loop, clip_rulings_uv, fd_derivative,
                           loop_uv_area, outer_loop_index)  # noqa: F401
-from ..faces.ruled_face import FaceRuledSurface  # noqa: F401
+from .faces.ruled_face import FaceRuledSurface  # noqa: F401
 
 __all__ = [
     "SurfaceAdapter",

@@ -11,8 +11,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core._vec import stack as _stack
-from ..core.errors import GHTError
+from ...core._vec import stack as _stack
+from ...core.errors import GHTError
 
 
 Bounds = tuple[float, float, float, float]

@@ -10,9 +10,9 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core._vec import stack as _stack
-from ..core.errors import DegenerateGeometryError
-from ..pattern.model import _point_in_polygon, _unit_samples, BoundaryEdge
+from ...core._vec import stack as _stack
+from ...core.errors import DegenerateGeometryError
+from ...pattern.model import _point_in_polygon, _unit_samples, BoundaryEdge
 from .area import _edge_nodes
 
 

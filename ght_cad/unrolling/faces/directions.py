@@ -10,7 +10,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..core.errors import DegenerateGeometryError
+from ...core.errors import DegenerateGeometryError
 from .adapter import Bounds, RULED_KINDS, SurfaceAdapter
 
 

@@ -9,9 +9,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..core._vec import unique_inverse
-from ..core.errors import GHTError
-from ..surfaces.ruled import RuledSurface
+from ...core._vec import unique_inverse
+from ...core.errors import GHTError
+from ...surfaces.ruled import RuledSurface
 from .adapter import Bounds, surface_jet, SurfaceAdapter
 from .loops import _flat1
 

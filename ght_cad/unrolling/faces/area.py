@@ -10,9 +10,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..core._cache import readonly_cache
-from ..core._quadrature import leggauss
-from ..core._vec import cross as _cross, norm as _norm, stack as _stack
+from ...core._cache import readonly_cache
+from ...core._quadrature import leggauss
+from ...core._vec import cross as _cross, norm as _norm, stack as _stack
 from .adapter import SurfaceAdapter, U_FREE_DENSITY_KINDS
 
 
