@@ -27,7 +27,7 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.curves.{n}" for n in ("seeds", "basis", "curve", "continuity", "composite", "analysis", "plotting")},
     **{n: f"ght_cad.surfaces.{n}" for n in ("planes", "bspline", "nurbs", "patch", "ruled")},
     **{n: f"ght_cad.unrolling.{n}" for n in ("unroll", "ruled_development", "face_unroll", "faces")},
-    **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels")},
+    **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels", "blank")},
     **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
     **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step", "approximate_cli")},
     "developable": "ght_cad.developables.envelope",

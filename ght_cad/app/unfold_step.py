@@ -1,7 +1,7 @@
 r"""``ght-cad unroll part.step`` for sheet solids: one blank per solid (issue 23).
 
 The application layer over :func:`ght_cad.cad.unfold_solid.sheet_skins` (sheet recognition, OCP)
-and :func:`ght_cad.blank.unfold_skins` (connected unfolding, core). Only what the blank needs is
+and :func:`ght_cad.sheetmetal.blank.unfold_skins` (connected unfolding, core). Only what the blank needs is
 imported (OCP and the core; no build123d, no scipy), so the command's start-up is OCP's.
 """
 
@@ -18,7 +18,7 @@ __all__ = ["StepBlanks", "unfold_step"]
 
 @dataclass
 class StepBlanks:
-    """Result of :func:`unfold_step`: the blanks (:class:`ght_cad.blank.Unfolded`), the units
+    """Result of :func:`unfold_step`: the blanks (:class:`ght_cad.sheetmetal.blank.Unfolded`), the units
     and the file's declared units."""
 
     unfolded: Any
@@ -53,7 +53,7 @@ def unfold_step(
         thickness: must equal the thickness found (to 1e-6 relative) when given.
         k_factor / din_k_factor / k_factor_table: ANSI K, DIN ``k = 2K`` or a table by ``R/T``
             (``ansi``, ``din`` or a file); default K = 0.5.
-        base_face, bend_lines, allow_split, tol_deg, rulings: see :func:`ght_cad.blank.unfold_skin`.
+        base_face, bend_lines, allow_split, tol_deg, rulings: see :func:`ght_cad.sheetmetal.blank.unfold_skin`.
         force: blank options were given: never hand back to the per-face unroll.
 
     Raises:
@@ -61,7 +61,7 @@ def unfold_step(
         BlankError: refusals (no sheet, sharp edge, ambiguous skin, not developable, overlap),
             the message prefixed with the file name.
     """
-    from ..blank import BlankError, k_factor_table as _table, unfold_skins
+    from ..sheetmetal.blank import BlankError, k_factor_table as _table, unfold_skins
     from ..design.step_input import MM_PER_UNIT, STEP_SUFFIXES, _read_step_in, _step_unit
     from ..design.schema import DesignError
 

@@ -10,7 +10,7 @@ For every solid of a shape the faces are sorted into the sheet's two skins and i
 * a face whose rays (most of them) leave at ``T`` through an opposite face is a skin face, others
   are walls (thickness walls, hole walls, cut faces);
 * the faces at T must pair up one way only (faces sharing an edge on one side, a face and the
-  faces its rays reach on opposite sides: :func:`ght_cad.blank.classify_skin`), else the skin is
+  faces its rays reach on opposite sides: :func:`ght_cad.sheetmetal.blank.classify_skin`), else the skin is
   ambiguous (a bar of square section T x T);
 * two skin faces sharing an edge (``TopExp.MapShapesAndAncestors``) must meet tangentially
   (else: a sharp edge, zero bend radius); every skin face must be skin at all its points (else
@@ -18,8 +18,8 @@ For every solid of a shape the faces are sorted into the sheet's two skins and i
   each face's opposite face in the other set; ``T`` must be below a quarter of the square root
   of the smaller skin's area (else the solid is a block, not a sheet).
 
-The smaller skin (or the one holding ``base_face``) goes to :func:`ght_cad.blank.unfold_skins` as
-:class:`ght_cad.blank.SheetSkin` with every face as ``FaceData`` (:func:`ght_cad.cad.unroll_faces.face_data`)
+The smaller skin (or the one holding ``base_face``) goes to :func:`ght_cad.sheetmetal.blank.unfold_skins` as
+:class:`ght_cad.sheetmetal.blank.SheetSkin` with every face as ``FaceData`` (:func:`ght_cad.cad.unroll_faces.face_data`)
 whose edges are named ``E<k>`` by the solid's edge map.
 """
 
@@ -42,7 +42,7 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from ._ocp import TopoDS, TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ..core._vec import cross
-from ..blank import DIST_TOL, BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, classify_skin, k_factor_table, unfold_skins
+from ..sheetmetal.blank import DIST_TOL, BlankError, KFactorTable, SheetSkin, SkinFace, Unfolded, classify_skin, k_factor_table, unfold_skins
 from .occ import unwrap
 from .unroll_faces import _SurfEval, face_data
 
@@ -237,7 +237,7 @@ def unfold(
     r"""One blank per sheet solid of a build123d / cadquery / OCP shape (issue 23).
 
     Each solid's sheet is recognised (module doc), its skin unfolded into one connected flat
-    panel (:func:`ght_cad.blank.unfold_skin`): bends on their neutral surface ``R + K T``,
+    panel (:func:`ght_cad.sheetmetal.blank.unfold_skin`): bends on their neutral surface ``R + K T``,
     flanges as they are, bend lines and a bend table (``BA = (R + K T) A``, ``BD = 2 (R + T)
     tan(A/2) - BA``).
 
@@ -245,7 +245,7 @@ def unfold(
         shape: a Solid/Compound/Part (build123d), a cadquery Workplane's shape, or a TopoDS_Shape.
         k_factor: ANSI K in [0, 1] (default 0.5 unless a table is given).
         k_factor_table: ``"ansi"``, ``"din"``, a file of ``R/T K`` lines, or a
-            :class:`ght_cad.blank.KFactorTable`: K per bend by its ``R / T``.
+            :class:`ght_cad.sheetmetal.blank.KFactorTable`: K per bend by its ``R / T``.
         base_face: 1-based face number (the shape's face order) of the face that keeps its place;
             default: the largest planar face of the smaller skin.
         bend_lines: ``"tangent"`` or ``"centre"``.
@@ -253,10 +253,10 @@ def unfold(
         units: length unit of the shape.
 
     Returns:
-        :class:`ght_cad.blank.Unfolded`: ``pattern`` (one panel per solid), ``blanks``.
+        :class:`ght_cad.sheetmetal.blank.Unfolded`: ``pattern`` (one panel per solid), ``blanks``.
 
     Raises:
-        BlankError: see :func:`sheet_skins` and :func:`ght_cad.blank.unfold_skin`.
+        BlankError: see :func:`sheet_skins` and :func:`ght_cad.sheetmetal.blank.unfold_skin`.
     """
     if k_factor is not None and k_factor_table is not None:
         raise BlankError(f"k_factor={k_factor!r} and k_factor_table={k_factor_table!r} are both given; give one")

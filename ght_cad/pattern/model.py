@@ -344,7 +344,7 @@ class FlatPanel:
     #: sheet forming labels (x, y, text, height, rotation in degrees): layer FORMING (ght_cad.sheet)
     forming_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     #: bend annotations (x, y, text, height, rotation in degrees): layer BEND (a blank's bend
-    #: direction, angle and inside radius, ght_cad.blank)
+    #: direction, angle and inside radius, ght_cad.sheetmetal.blank)
     bend_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     report: DistortionReport | None = None
     area_flat: float = float("nan")

@@ -266,13 +266,13 @@ class FlatPatternFeature(FeatureProxy):
 
     def blank(self, obj: Any) -> Any:
         """The whole Source solid unfolded into one blank per sheet solid
-        (:func:`ght_cad.blank.unfold_skins` on the skins :func:`.sheet_skin.sheet_skins` finds):
+        (:func:`ght_cad.sheetmetal.blank.unfold_skins` on the skins :func:`.sheet_skin.sheet_skins` finds):
         bends on their neutral surface at ``KFactor``, the selected face (if any) as base face.
 
         Raises:
             BlankError: no sheet, a sharp edge, an ambiguous skin, overlapping pieces, a bad face.
         """
-        from ght_cad.blank import BlankError, unfold_skins
+        from ght_cad.sheetmetal.blank import BlankError, unfold_skins
 
         from .sheet_skin import shape_of_source, sheet_skins
 

@@ -1,4 +1,4 @@
-r"""Sheet recognition in FreeCAD solids (the FreeCAD adapter of :mod:`ght_cad.blank`, issue 23).
+r"""Sheet recognition in FreeCAD solids (the FreeCAD adapter of :mod:`ght_cad.sheetmetal.blank`, issue 23).
 
 For every solid of a shape (a ``Part`` feature, a PartDesign Body's tip, an imported STEP) the
 faces are sorted into the sheet's two skins and its walls, as the OCP adapter does
@@ -11,12 +11,12 @@ faces are sorted into the sheet's two skins and its walls, as the OCP adapter do
   point (``(q - p)·(-n) >= (1 - 1e-6) |q - p|``), inside that face (``isPartOfDomain``), whose
   outward normal is opposite (``n_q·n <= -1 + 1e-6``); the nearest such foot is where the ray
   leaves the material, at distance ``d``;
-* the classification is the core's (:func:`ght_cad.blank.classify_skin`, shared with the OCP
+* the classification is the core's (:func:`ght_cad.sheetmetal.blank.classify_skin`, shared with the OCP
   adapter): ``T`` from the largest face whose probes all agree, skin faces
   (most probes at ``T`` through an opposite face), walls, the shared edges of skin faces
   (tangent within 1e-3 degrees, else a sharp edge is refused), exactly two connected skins.
 
-The smaller skin (or the one holding the base face) becomes a :class:`ght_cad.blank.SheetSkin`
+The smaller skin (or the one holding the base face) becomes a :class:`ght_cad.sheetmetal.blank.SheetSkin`
 whose faces are :func:`.face_reader.face_data` with every edge named ``E<k>`` by its index in
 the solid's ``Edges``; faces are numbered by their index in the whole shape's ``Faces`` (1-based,
 the ``FaceN`` names FreeCAD shows).
@@ -31,7 +31,7 @@ import numpy as np
 
 import Part  # noqa: F401  (FreeCAD's geometry: the shapes passed in are Part shapes)
 
-from ght_cad.blank import DIST_TOL, BlankError, SheetSkin, SkinFace, classify_skin
+from ght_cad.sheetmetal.blank import DIST_TOL, BlankError, SheetSkin, SkinFace, classify_skin
 
 from .face_reader import face_data
 

@@ -17,9 +17,9 @@ K_TABLE_ALLOWED = ("'ansi', 'din', a file of 'R/T K' lines (relative to the desi
 
 
 def _k_factor_table(ck: _Checker, value: Any, source: str) -> Any:
-    """``[sheet] k_factor_table`` (:func:`ght_cad.blank.k_factor_table` semantics: a built-in table by
+    """``[sheet] k_factor_table`` (:func:`ght_cad.sheetmetal.blank.k_factor_table` semantics: a built-in table by
     name, a file of ``R/T K`` lines, or inline ``[[R/T, K], ...]`` rows of ANSI K)."""
-    from ...blank import K_TABLES, BlankError, k_factor_rows, k_factor_table
+    from ...sheetmetal.blank import K_TABLES, BlankError, k_factor_rows, k_factor_table
 
     key = "sheet.k_factor_table"
     try:

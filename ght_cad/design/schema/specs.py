@@ -168,7 +168,7 @@ class SheetSpec:
     #: orientation: the first surface's normal carried consistently across the shared rails) or
     #: ``"surface"`` (each surface's own normal); one surface: its own normal either way
     side_reference: str = "shell"
-    #: ``k_factor_table``: a :class:`ght_cad.blank.KFactorTable` giving K by the surface's ``R / T``
+    #: ``k_factor_table``: a :class:`ght_cad.sheetmetal.blank.KFactorTable` giving K by the surface's ``R / T``
     #: (R its smallest inside bending radius, :func:`ght_cad.design.build.table_k_factor`); until a
     #: built surface resolves it, ``k_factor`` is the table's largest K (the strictest neutral offset)
     k_factor_table: Any = None

@@ -29,13 +29,13 @@ The blank's length across a bend is therefore ``Σ flange lengths to the tangent
 
 numpy only at import time; no CAD kernel.
 
-Modules (issue 27, moved from ``ght_cad/blank.py``): :mod:`.model` (:class:`BlankError`, the skin,
+Modules (issue 27, moved from ``ght_cad/sheetmetal/blank.py``): :mod:`.model` (:class:`BlankError`, the skin,
 :class:`Blank`, :func:`bend_row`, :class:`Unfolded`), :mod:`.k_factor` (K-factor tables),
 :mod:`.placement` (rigid motions, the geometry of one face), :mod:`.outline` (merging the faces'
 edges into loops), :mod:`.overlap` (crossings, overlap area), :mod:`.recognition` (sheet
 recognition: :func:`classify_skin`). :func:`unfold_skin` and :func:`unfold_skins` stay here and
 call the helpers through this module's namespace, so every name (private ones included) is
-importable and patchable as ``ght_cad.blank.<name>``.
+importable and patchable as ``ght_cad.sheetmetal.blank.<name>``.
 """
 
 from __future__ import annotations
@@ -107,10 +107,10 @@ def unfold_skin(
         BlankError: a face that is not developable, a bad base face, overlapping pieces (without
             ``allow_split``), a face graph that is not connected.
     """
-    from ..core.errors import NotDevelopableError
-    from ..unrolling.face_unroll import unroll_face_data
-    from ..pattern.flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
-    from ..sheetmetal.sheet import Sheet, SheetError
+    from ...core.errors import NotDevelopableError
+    from ...unrolling.face_unroll import unroll_face_data
+    from ...pattern.flat_pattern import FlatPanel, layout_panels, mark_shared_edges, measure_panel
+    from ..sheet import Sheet, SheetError
 
     if bend_lines not in ("tangent", "centre", "center"):
         raise BlankError(f"bend_lines={bend_lines!r} is not allowed; allowed: 'tangent' or 'centre'")
@@ -145,7 +145,7 @@ def unfold_skin(
         if kind != "plane":
             ruled = "v" if kind in ("cylinder", "cone", "extrusion") else None
             if ruled is None:
-                from ..unrolling.face_unroll import ruling_direction
+                from ...unrolling.face_unroll import ruling_direction
 
                 ruled = ruling_direction(fd.surface, fd.bounds)[0]
                 if ruled is None:
@@ -321,7 +321,7 @@ def unfold_skins(
     Raises:
         BlankError: from :func:`unfold_skin`; a ``base_face`` in none of the skins.
     """
-    from ..pattern.flat_pattern import FlatPattern, layout_panels
+    from ...pattern.flat_pattern import FlatPattern, layout_panels
 
     def holds(s: SheetSkin, n: int) -> bool:
         return any(f.number == n or f.partner == n for f in s.faces)

@@ -1,7 +1,7 @@
 r"""Placing the developed skin faces: rigid motions of the plane, the geometry of one face
 (outward normal, curvature across the rulings, Gaussian curvature, orientation of its development),
-edge chords, bend angles, and moving a face's panel. Moved from ``ght_cad/blank.py`` (issue 27);
-every name is importable from :mod:`ght_cad.blank`."""
+edge chords, bend angles, and moving a face's panel. Moved from ``ght_cad/sheetmetal/blank.py`` (issue 27);
+every name is importable from :mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 
@@ -120,7 +120,7 @@ def _side(a0: np.ndarray, a1: np.ndarray, p: np.ndarray) -> float:
 
 def _panel_point(panel: Any, m: _Motion) -> np.ndarray:
     """An interior point of a placed face: its outline's area centroid (vertex mean if outside)."""
-    from ..pattern.flat_pattern import _centroid
+    from ...pattern.flat_pattern import _centroid
 
     return m(_centroid(panel.loop_polylines()[0]))
 

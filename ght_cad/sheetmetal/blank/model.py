@@ -1,7 +1,7 @@
 r"""The blank's data: the error, the skin an adapter hands over (:class:`SkinFace`,
 :class:`SheetSkin`), one blank (:class:`Blank`), its bend-table rows (:func:`bend_row`) and the
-result of unfolding several skins (:class:`Unfolded`). Moved from ``ght_cad/blank.py`` (issue 27);
-every name is importable from :mod:`ght_cad.blank`."""
+result of unfolding several skins (:class:`Unfolded`). Moved from ``ght_cad/sheetmetal/blank.py`` (issue 27);
+every name is importable from :mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 
 
 class BlankError(GHTError):

@@ -1,6 +1,6 @@
 r"""The blank's outline: the placed faces' boundary edges chained into closed loops (the tree's
-shared edges left out). Moved from ``ght_cad/blank.py`` (issue 27); every name is importable from
-:mod:`ght_cad.blank`."""
+shared edges left out). Moved from ``ght_cad/sheetmetal/blank.py`` (issue 27); every name is importable from
+:mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ def _merge(panels: dict[int, Any], motion: dict[int, _Motion], order: list[int],
            label: str, samples: int) -> list[list[Any]]:
     """The blank's loops: every face's boundary edges except the tree's shared edges, moved into
     place and chained end to start (reversing where needed); the largest loop first."""
-    from ..pattern.flat_pattern import BoundaryEdge, _shoelace
+    from ...pattern.flat_pattern import BoundaryEdge, _shoelace
 
     pieces = []
     for n in order:

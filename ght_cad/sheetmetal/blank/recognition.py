@@ -1,6 +1,6 @@
 r"""Sheet recognition, the kernel-free part shared by the OCP and FreeCAD adapters: the sheet's
-thickness, its two skins and its walls from the adapter's probes. Moved from ``ght_cad/blank.py``
-(issue 27); every name is importable from :mod:`ght_cad.blank`."""
+thickness, its two skins and its walls from the adapter's probes. Moved from ``ght_cad/sheetmetal/blank.py``
+(issue 27); every name is importable from :mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 r"""K-factor tables: ANSI ``K`` as a step function of ``R / T`` (built-in ``ansi`` and DIN 6935,
-text files, design-file rows). Moved from ``ght_cad/blank.py`` (issue 27); every name is importable
-from :mod:`ght_cad.blank`."""
+text files, design-file rows). Moved from ``ght_cad/sheetmetal/blank.py`` (issue 27); every name is importable
+from :mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 

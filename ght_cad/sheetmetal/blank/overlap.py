@@ -1,6 +1,6 @@
 r"""Overlap detection: crossing outline segments, and the overlap area of crossing faces by
-Green's theorem. Moved from ``ght_cad/blank.py`` (issue 27); every name is importable from
-:mod:`ght_cad.blank`."""
+Green's theorem. Moved from ``ght_cad/sheetmetal/blank.py`` (issue 27); every name is importable from
+:mod:`ght_cad.sheetmetal.blank`."""
 
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ def _crossings(segs: np.ndarray, eps: float) -> np.ndarray:
 
 def _oriented(loops: Sequence[np.ndarray]) -> list[np.ndarray]:
     """A region's loops with the outer loop counter-clockwise and the holes clockwise."""
-    from ..pattern.flat_pattern import _shoelace
+    from ...pattern.flat_pattern import _shoelace
 
     out = []
     for i, lp in enumerate(loops):
@@ -55,7 +55,7 @@ def _overlap_area(a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> float:
 
     the boundary segments clipped to the other region (:func:`ght_cad.flat_pattern.clip_segments`).
     Exact for the polygons (the outline polylines of the faces)."""
-    from ..pattern.flat_pattern import clip_segments
+    from ...pattern.flat_pattern import clip_segments
 
     total = 0.0
     for p, q in ((a, b), (b, a)):
@@ -72,7 +72,7 @@ def _overlaps(loops: list[list[Any]], panels: dict[int, Any], motion: dict[int, 
     edges cross of their placed outlines' intersection area (:func:`_overlap_area`, exact for the
     outline polygons); a face crossing only itself is estimated on a 200 x 200 grid over the
     blank's box (cells covered twice)."""
-    from ..pattern.flat_pattern import _inside
+    from ...pattern.flat_pattern import _inside
 
     polys, owner = [], []
     for loop in loops:
