@@ -122,7 +122,7 @@ def _peaks_mb() -> tuple[float, float]:
 def case_faces(step: str, jobs: int) -> dict[str, Any]:
     """One measurement in this process: unroll_step of a STEP file (imports done before the clock)."""
     import ght_cad.app.batch  # noqa: F401 - the modules the workers fork with
-    from ght_cad.design import unroll_step
+    from ght_cad.app.design import unroll_step
 
     unroll_step(Path(step), faces=[1])  # loads OCP, scipy and the unroll code
     base = _start_peak()

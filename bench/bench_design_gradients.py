@@ -2,8 +2,8 @@
 in the same run, on
 
 * the composite duct (``examples/design_duct_two_strips_optimized.toml``, two strips joined G2,
-  6 parameters, objective Σ CVEn): :func:`ght_cad.design.optimize_design` with
-  ``exact_gradients=True`` (:func:`ght_cad.design.composite_value_and_grad`) and ``False``;
+  6 parameters, objective Σ CVEn): :func:`ght_cad.app.design.optimize_design` with
+  ``exact_gradients=True`` (:func:`ght_cad.app.design.composite_value_and_grad`) and ``False``;
   I-GWO (the file's own method) for reference;
 * the hull plate rails loft (``examples/design_hull_plate.toml``, fan share over the rails' 6
   shape parameters): the same, with :meth:`ght_cad.optimize.problems.loft.LoftProblem.gradient_of`.
@@ -32,9 +32,9 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _grad_cost(design, overrides) -> float:
     """Wall time of one value+gradient over one value at the start point (median of 5)."""
-    from ght_cad.design.build import _initial_shape, build_curves
-    from ght_cad.design.optimize import _objective_fn, _value_and_grad_fn
-    from ght_cad.design.schema import OptimizeSpec
+    from ght_cad.app.design.build import _initial_shape, build_curves
+    from ght_cad.app.design.optimize import _objective_fn, _value_and_grad_fn
+    from ght_cad.app.design.schema import OptimizeSpec
 
     curves, _ = build_curves(design)
     spec = OptimizeSpec(**{**design.optimize.__dict__, **overrides})
@@ -61,7 +61,7 @@ def _grad_cost(design, overrides) -> float:
 
 
 def run(path: Path, population: int, reference: str | None) -> None:
-    from ght_cad.design import load_design, optimize_design
+    from ght_cad.app.design import load_design, optimize_design
 
     d = load_design(path)
     ov = {"method": "hybrid", "population": population}

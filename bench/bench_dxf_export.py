@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 import ght_cad
-from ght_cad.design import build_surfaces, load_design, unroll_surfaces
+from ght_cad.app.design import build_surfaces, load_design, unroll_surfaces
 from ght_cad.pattern.outline_arcs import bulge_polygon_area
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -1,5 +1,5 @@
 """Benchmark: the cost of the sheet rule of ``optimize_design`` (a ``[sheet]`` with T > 0: every
-candidate surface checked by :func:`ght_cad.design.check_sheet`, the run's check, 513 rulings).
+candidate surface checked by :func:`ght_cad.app.design.check_sheet`, the run's check, 513 rulings).
 
 Printed, all measured in the same run:
 
@@ -36,7 +36,7 @@ BRACKET_SHEET = '\n[sheet]\nthickness = 6.0\nk_factor = 0.5\n'
 def _designs(transition: bool) -> list[tuple[str, object]]:
     from test_sheet_optimize import QUARTER, TRANSITION, bracket
 
-    from ght_cad.design import parse_design_text
+    from ght_cad.app.design import parse_design_text
 
     out = [
         ("bracket rails 60x40 (T=6)", parse_design_text(bracket(BRACKET_SHEET), "bracket.toml")),
@@ -55,8 +55,8 @@ def _designs(transition: bool) -> list[tuple[str, object]]:
 
 def _candidates(design, n: int):
     """(shape, surface, plain time) of n random candidates that build."""
-    from ght_cad.design.build import _initial_shape, build_curves
-    from ght_cad.design.optimize import _objective_fn
+    from ght_cad.app.design.build import _initial_shape, build_curves
+    from ght_cad.app.design.optimize import _objective_fn
     from ght_cad.core.errors import GHTError
 
     curves, _ = build_curves(design)
@@ -90,7 +90,7 @@ def _candidates(design, n: int):
 
 
 def cost_per_candidate(designs, n: int) -> None:
-    from ght_cad.design import SHEET_MARGIN, check_sheet
+    from ght_cad.app.design import SHEET_MARGIN, check_sheet
     from ght_cad.sheetmetal.sheet import Sheet, SheetError
 
     print(f"\n1. cost per candidate ({n} random candidates per design; median ms)")
@@ -115,7 +115,7 @@ def cost_per_candidate(designs, n: int) -> None:
 def sample_study(designs, n: int) -> None:
     import math
 
-    from ght_cad.design import sheet_parts
+    from ght_cad.app.design import sheet_parts
     from ght_cad.sheetmetal.sheet import Sheet, check_offset
 
     print(f"\n2. rulings checked per candidate ({n} candidates per design): largest relative overestimate of "
@@ -144,7 +144,7 @@ def sample_study(designs, n: int) -> None:
 
 
 def runs(designs) -> None:
-    from ght_cad.design import optimize_design
+    from ght_cad.app.design import optimize_design
 
     print("\n3. whole optimizations, with and without the sheet")
     print(f"{'design':48s} {'method':>7s} {'sheet':>5s} {'best':>12s} {'nfev':>5s} {'time s':>7s} {'refused':>9s} {'r/|KT|':>9s}")

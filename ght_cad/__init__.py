@@ -29,7 +29,8 @@ _MOVED: dict[str, str] = {
     **{n: f"ght_cad.unrolling.{n}" for n in ("unroll", "ruled_development", "face_unroll", "faces")},
     **{n: f"ght_cad.sheetmetal.{n}" for n in ("sheet", "plate", "join_panels", "blank")},
     **{n: f"ght_cad.pattern.{n}" for n in ("flat_pattern", "outline_arcs")},
-    **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step", "approximate_cli")},
+    **{n: f"ght_cad.app.{n}" for n in ("cli", "batch", "sweep", "demo", "unfold_step", "approximate_cli", "design",
+                                       "commands")},
     "developable": "ght_cad.developables.envelope",
     "loft": "ght_cad.developables.loft",  # a package: ght_cad.loft.rails is ght_cad.developables.loft.rails
     "approximation_dual": "ght_cad.approximation.dual",

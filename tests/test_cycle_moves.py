@@ -33,12 +33,12 @@ def test_importing_batch_does_not_load_the_design_package() -> None:
     """``ght_cad.app.batch`` gives ``map_step_faces`` on first use only (the design package stays unloaded)."""
     code = (
         "import sys, json, ght_cad.app.batch as b\n"
-        "before = 'ght_cad.design' in sys.modules\n"
+        "before = 'ght_cad.app.design' in sys.modules\n"
         "f = b.map_step_faces\n"
-        "print(json.dumps([before, 'ght_cad.design.step_input' in sys.modules, f.__module__]))\n"
+        "print(json.dumps([before, 'ght_cad.app.design.step_input' in sys.modules, f.__module__]))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
-    assert json.loads(out.stdout) == [False, True, "ght_cad.design.step_input"]
+    assert json.loads(out.stdout) == [False, True, "ght_cad.app.design.step_input"]
 
 
 def test_sheet_forming_names_resolve_from_sheet() -> None:

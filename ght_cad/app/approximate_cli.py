@@ -29,11 +29,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
+from .design.approximate import (approximation_report, panel_pattern, panel_plates, panel_sheets,  # noqa: F401
                                  plot_deviation, report_markdown)
 from ..approximation.target import TRIM_ALLOWED, TrimmedTargetError, trim_words
 from ..core.errors import GHTError
-from ..design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
+from .design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
 __all__ = ["add_parser", "cmd_approximate", "write_outputs", "plot_deviation", "report_markdown", "approximation_report",
            "panel_pattern", "panel_plates"]
@@ -174,7 +174,7 @@ def cmd_approximate(args: argparse.Namespace) -> int:
                "tol": report["tol"],
                "max_deviation": report["max_deviation"], "out": str(args.out), "files": report["files"]}
     if getattr(args, "json", False):
-        from ..commands.common import dumps
+        from .commands.common import dumps
 
         args._json_out = dumps({"ok": True, **summary})
     else:

@@ -1,7 +1,7 @@
 r"""``ght-cad batch``: many designs (and sweep variants) in parallel processes or on a Dask cluster.
 
 Every design goes through exactly the pipeline of ``ght-cad run``
-(:func:`ght_cad.design.run_design`). A worker (a local process from
+(:func:`ght_cad.app.design.run_design`). A worker (a local process from
 :class:`concurrent.futures.ProcessPoolExecutor`, or a ``dask.distributed`` worker on any machine)
 runs it into a private temporary folder and sends back the report and the bytes of every file;
 the calling process then writes them into ``DIR/<name>/`` through run's own staging
@@ -125,7 +125,7 @@ def collect_jobs(paths: Sequence[str | os.PathLike]) -> tuple[list[BatchJob], li
     """Read and validate every design file; expand ``[sweep]`` tables (:func:`ght_cad.app.sweep.expand_sweep`).
 
     A file that cannot be read, is not TOML, has a bad ``[sweep]`` or fails validation
-    (:func:`ght_cad.design.parse_design`) becomes a job with ``error`` set (reported ``bad
+    (:func:`ght_cad.app.design.parse_design`) becomes a job with ``error`` set (reported ``bad
     input``); the others go on. Two designs with the same folder name: the later is refused.
 
     Returns:
@@ -133,7 +133,7 @@ def collect_jobs(paths: Sequence[str | os.PathLike]) -> tuple[list[BatchJob], li
     """
     import tomllib
 
-    from ..design import parse_design
+    from .design import parse_design
     from .sweep import expand_sweep
 
     jobs: list[BatchJob] = []
@@ -198,7 +198,7 @@ def _where() -> dict[str, Any]:
 
 
 def run_task(task: dict[str, Any]) -> dict[str, Any]:
-    """Run one design through :func:`ght_cad.design.run_design` into a private temporary folder.
+    """Run one design through :func:`ght_cad.app.design.run_design` into a private temporary folder.
 
     Runs in a worker (local process or Dask worker). ``task`` holds ``folder``, ``source``,
     ``data`` (the parsed TOML) and ``chord_tol`` (over the file's; None: the file's), optionally ``marker`` (a file written with the pid on start, so the
@@ -213,7 +213,7 @@ def run_task(task: dict[str, Any]) -> dict[str, Any]:
         Path(task["marker"]).write_text(str(os.getpid()))
     out: dict[str, Any] = {"status": OK, "error": None, "report": None, "files": {}, **_where()}
     try:
-        from ..design import parse_design, run_design
+        from .design import parse_design, run_design
 
         design = parse_design(task["data"], task["source"])
         # beside the marker: in the caller's private folder, removed with it even if this process is killed
@@ -235,7 +235,7 @@ def _commit(target: Path, result: dict[str, Any]) -> None:
     """Write a worker's files into ``target`` through run's staging (all files or none)."""
     import json
 
-    from ..design import FILE_NAMES, report_markdown
+    from .design import FILE_NAMES, report_markdown
     from ..core.outdir import OutputFolder
 
     report = dict(result["report"] or {})
@@ -292,7 +292,7 @@ def _row(job: BatchJob, status: str, error: str | None, result: dict[str, Any] |
 
 #: Modules a design run imports on first use (OCP through build123d, matplotlib, scipy.optimize:
 #: several seconds, against well under a second per design once loaded).
-_RUN_MODULES = ("ght_cad.design", "ght_cad.design.run", "ght_cad.design.outputs", "ght_cad.cad.occ",
+_RUN_MODULES = ("ght_cad.app.design", "ght_cad.app.design.run", "ght_cad.app.design.outputs", "ght_cad.cad.occ",
                 "ght_cad.cad.developable_faces", "ght_cad.curves.plotting", "ght_cad.developables.envelope",
                 "ght_cad.unrolling.unroll", "scipy.optimize", "matplotlib.figure", "matplotlib.backends.backend_agg", "build123d")
 
@@ -503,7 +503,7 @@ def _write_summary(result: BatchResult, stage_cls: Any) -> None:
         for s in result.sweeps:
             plot_sweep(s, [r for r in result.rows if (r.get("sweep") or {}).get("base") == s.base],
                        stage.path(pngs[s.base]))
-        from ..commands.common import dumps
+        from .commands.common import dumps
 
         stage.path(out / "batch.json").write_text(dumps(result.as_dict()) + "\n", encoding="utf-8")
         stage.path(out / "batch.md").write_text(batch_markdown(result), encoding="utf-8")
@@ -551,11 +551,11 @@ def batch_markdown(result: BatchResult) -> str:
 
 
 def __getattr__(name: str) -> Any:
-    """``ght_cad.app.batch.map_step_faces``: moved to :func:`ght_cad.design.step_input.map_step_faces`
+    """``ght_cad.app.batch.map_step_faces``: moved to :func:`ght_cad.app.design.step_input.map_step_faces`
     (issue 27: the STEP input no longer imports this module), still importable from here; imported
     on first use, so ``import ght_cad.app.batch`` does not load the design package."""
     if name == "map_step_faces":
-        from ..design.step_input import map_step_faces
+        from .design.step_input import map_step_faces
 
         return map_step_faces
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

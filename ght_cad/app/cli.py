@@ -39,17 +39,17 @@ import sys
 import traceback
 from typing import Any, Sequence
 
-# The subcommands' handlers and helpers live in ght_cad.commands (issue 27); every name stays
+# The subcommands' handlers and helpers live in ght_cad.app.commands (issue 27); every name stays
 # importable from here (and the parser reads the handlers from this module's namespace).
-from ..commands.batch import cmd_batch  # noqa: F401
-from ..commands.common import (_check_same_dimension, _check_suffix, _chord_tol, _clean, _emit, _fmt_point,
+from .commands.batch import cmd_batch  # noqa: F401
+from .commands.common import (_check_same_dimension, _check_suffix, _chord_tol, _clean, _emit, _fmt_point,
                               _json_default, _out_path, _outputs_text, _parse_floats, _parse_points, _Parser, _PNG,
                               _progress, _report_text, _STEP, _wait_args, _wants_json, _write_staged, add_wait_options,
                               dumps, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, PROG, UsageError)  # noqa: F401
-from ..commands.curves import (cmd_curve, cmd_plot_basis)  # noqa: F401
-from ..commands.design import (_load, cmd_demo, cmd_optimize, cmd_run, cmd_surface)  # noqa: F401
-from ..commands.export import (_EXPORT_SUFFIXES, cmd_export)  # noqa: F401
-from ..commands.unroll import (_emit_blanks, _errors_dict, _sheet_result, _sheet_text, _unroll_step, _write_pattern,
+from .commands.curves import (cmd_curve, cmd_plot_basis)  # noqa: F401
+from .commands.design import (_load, cmd_demo, cmd_optimize, cmd_run, cmd_surface)  # noqa: F401
+from .commands.export import (_EXPORT_SUFFIXES, cmd_export)  # noqa: F401
+from .commands.unroll import (_emit_blanks, _errors_dict, _sheet_result, _sheet_text, _unroll_step, _write_pattern,
                               cmd_unroll)  # noqa: F401
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAILURE", "EXIT_USAGE", "EXIT_INTERRUPTED"]

@@ -1,7 +1,7 @@
 """``ght-cad demo``: the whole pipeline on the embedded default design.
 
 The default design (``ght_cad/data/default_design.toml``) is run through
-:func:`ght_cad.design.run_design`; see that function for the list of outputs.
+:func:`ght_cad.app.design.run_design`; see that function for the list of outputs.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool =
         progress: draw progress on stderr when it is a terminal.
         quick: fewer optimizer iterations (smoke tests).
         wait, timeout: wait (at most ``timeout`` s) while another process writes ``out_dir``
-            instead of refusing (see :func:`ght_cad.design.run_design`).
+            instead of refusing (see :func:`ght_cad.app.design.run_design`).
         chord_tol: DXF/SVG outline chord tolerance in mm (None: 1e-3 mm).
 
     Returns:
@@ -40,7 +40,7 @@ def run_demo(out_dir: str | os.PathLike, *, progress: bool = True, quick: bool =
         GHTError: the embedded design is invalid (a bug), its geometry degenerates, or ``chord_tol``
             is not > 0.
     """
-    from ..design import parse_design_text, run_design
+    from .design import parse_design_text, run_design
 
     design = parse_design_text(default_design_text(), source=f"<embedded {DEFAULT_DESIGN}>")
     if quick and design.optimize is not None:

@@ -62,8 +62,8 @@ def unfold_step(
             the message prefixed with the file name.
     """
     from ..sheetmetal.blank import BlankError, k_factor_table as _table, unfold_skins
-    from ..design.step_input import MM_PER_UNIT, STEP_SUFFIXES, _read_step_in, _step_unit
-    from ..design.schema import DesignError
+    from .design.step_input import MM_PER_UNIT, STEP_SUFFIXES, _read_step_in, _step_unit
+    from .design.schema import DesignError
 
     p = Path(path)
     if p.suffix.lower() not in STEP_SUFFIXES or not p.is_file():

@@ -1,10 +1,10 @@
 """Worker processes shared by ``ght-cad batch`` (:mod:`ght_cad.app.batch`) and the parallel STEP unroll
-(:func:`ght_cad.design.step_input.map_step_faces`): BLAS/OpenMP threads per worker, the Dask client,
+(:func:`ght_cad.app.design.step_input.map_step_faces`): BLAS/OpenMP threads per worker, the Dask client,
 one-line error text.
 
 Moved from :mod:`ght_cad.app.batch` (issue 27) with the parallel STEP unroll moved into
-:mod:`ght_cad.design.step_input`, so that the STEP input no longer imports ``ght_cad.app.batch``
-(which runs designs through ``ght_cad.design``: the cycle batch -> design -> step_input -> batch).
+:mod:`ght_cad.app.design.step_input`, so that the STEP input no longer imports ``ght_cad.app.batch``
+(which runs designs through ``ght_cad.app.design``: the cycle batch -> design -> step_input -> batch).
 ``ght_cad.app.batch`` imports these names back.
 """
 

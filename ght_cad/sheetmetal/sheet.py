@@ -75,7 +75,7 @@ class SheetError(GHTError):
     """A bad sheet value (thickness, K-factor, side) or a thickness the surface cannot carry.
 
     A refusal of :func:`check_offset` also says which rule refused, for callers that weigh
-    refusals (the optimizer of ``ght_cad.design`` keeps the best refused candidate):
+    refusals (the optimizer of ``ght_cad.app.design`` keeps the best refused candidate):
 
     Attributes:
         constraint: ``"radius"`` (``|K T| >= |ρ_0|``), ``"centre"`` (the material reaches a centre

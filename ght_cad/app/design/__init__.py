@@ -22,16 +22,16 @@ functions that need them.
 
 The package follows the pipeline, one module per stage:
 
-* :mod:`~ght_cad.design.schema`: the dataclasses and :func:`parse_design` / :func:`load_design`;
-* :mod:`~ght_cad.design.build`: curves (joins applied and measured) and the surface(s);
-* :mod:`~ght_cad.design.objectives` and :mod:`~ght_cad.design.optimize`: fairness / developability
+* :mod:`~ght_cad.app.design.schema`: the dataclasses and :func:`parse_design` / :func:`load_design`;
+* :mod:`~ght_cad.app.design.build`: curves (joins applied and measured) and the surface(s);
+* :mod:`~ght_cad.app.design.objectives` and :mod:`~ght_cad.app.design.optimize`: fairness / developability
   objectives and :func:`optimize_design`;
-* :mod:`~ght_cad.design.outputs`: B-rep, STEP, flat pattern and :func:`export_files`;
-* :mod:`~ght_cad.design.report`: ``report.md``;
-* :mod:`~ght_cad.design.run`: :func:`run_design`, the whole pipeline into one output folder;
-* :mod:`~ght_cad.design.step_input`: :func:`unroll_step`.
+* :mod:`~ght_cad.app.design.outputs`: B-rep, STEP, flat pattern and :func:`export_files`;
+* :mod:`~ght_cad.app.design.report`: ``report.md``;
+* :mod:`~ght_cad.app.design.run`: :func:`run_design`, the whole pipeline into one output folder;
+* :mod:`~ght_cad.app.design.step_input`: :func:`unroll_step`.
 
-Every name is re-exported here; import from ``ght_cad.design``.
+Every name is re-exported here; import from ``ght_cad.app.design``.
 """
 
 from __future__ import annotations

@@ -152,7 +152,7 @@ def _check_suffix(option: str, value: str | os.PathLike | None, allowed: Sequenc
 
 
 def _progress(total: int | None, label: str) -> Any:
-    from ..core.progress import Progress
+    from ...core.progress import Progress
 
     return Progress(total, label)
 
@@ -179,7 +179,7 @@ def _write_staged(outputs: Sequence[tuple[str, str | None, Callable[[Path], Any]
     folders a later run can tell from a live one's) and moved into place only when every writer
     succeeded (a failure leaves no new file and every existing target as it was).
     """
-    from ..core.outdir import StagedFiles
+    from ...core.outdir import StagedFiles
 
     wanted = [(kind, Path(target), writer) for kind, target, writer in outputs if target]
     if not wanted:
@@ -202,7 +202,7 @@ def _chord_tol(args: argparse.Namespace) -> float | None:
 
 
 def _wait_args(args: argparse.Namespace) -> dict[str, Any]:
-    """``wait``/``timeout`` for :func:`ght_cad.design.run_design` from ``--wait``/``--wait-timeout``."""
+    """``wait``/``timeout`` for :func:`ght_cad.app.design.run_design` from ``--wait``/``--wait-timeout``."""
     timeout = getattr(args, "wait_timeout", None)
     if timeout is not None and not (math.isfinite(timeout) and timeout >= 0):
         raise UsageError(f"--wait-timeout {timeout:g} is not allowed; allowed: a number of seconds >= 0")

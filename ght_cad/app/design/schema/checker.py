@@ -1,6 +1,6 @@
 r"""Typed getters of a parsed TOML table (:class:`_Checker`) whose errors name the file, the key and
-what is allowed; value and type names for the messages. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+what is allowed; value and type names for the messages. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations

@@ -102,7 +102,7 @@ def _unroll_step(args: argparse.Namespace) -> int:
                                  ("--bend-lines", args.bend_lines), ("--allow-split", args.allow_split or None),
                                  ("--plate-step", args.plate_step)) if v is not None]
     if not args.face and not args.best_effort and args.jobs is None and not args.scheduler:
-        from ..app.unfold_step import unfold_step
+        from ..unfold_step import unfold_step
 
         blanks = unfold_step(args.design, units=args.units, thickness=args.thickness, k_factor=args.k_factor,
                              din_k_factor=args.din_k_factor, k_factor_table=args.k_factor_table,
@@ -191,8 +191,8 @@ def _emit_blanks(args: argparse.Namespace, res: Any) -> int:
         plot_pattern(pattern, path, title=name)
 
     def plate(path: Path) -> None:
-        from ..cad.occ import write_step
-        from ..cad.unfold_solid import blank_plates
+        from ...cad.occ import write_step
+        from ...cad.unfold_solid import blank_plates
 
         write_step(blank_plates(unf), path, units=res.units)
 

@@ -1,6 +1,6 @@
 r"""``[sheet]`` validation shared by the surfaces: the K-factor table (a built-in name, a file or
-inline rows) and a surface's ``[surfaces.sheet]`` override. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+inline rows) and a surface's ``[surfaces.sheet]`` override. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ K_TABLE_ALLOWED = ("'ansi', 'din', a file of 'R/T K' lines (relative to the desi
 def _k_factor_table(ck: _Checker, value: Any, source: str) -> Any:
     """``[sheet] k_factor_table`` (:func:`ght_cad.sheetmetal.blank.k_factor_table` semantics: a built-in table by
     name, a file of ``R/T K`` lines, or inline ``[[R/T, K], ...]`` rows of ANSI K)."""
-    from ...sheetmetal.blank import K_TABLES, BlankError, k_factor_rows, k_factor_table
+    from ....sheetmetal.blank import K_TABLES, BlankError, k_factor_rows, k_factor_table
 
     key = "sheet.k_factor_table"
     try:

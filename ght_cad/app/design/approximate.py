@@ -1,6 +1,6 @@
 r"""Design-file surfaces of ``type = "approximate"`` (issue 24): developable panels covering a target.
 
-The target of ``[[surfaces]] type = "approximate"`` (``[surfaces.target]``, :class:`~ght_cad.design.schema.TargetSpec`)
+The target of ``[[surfaces]] type = "approximate"`` (``[surfaces.target]``, :class:`~ght_cad.app.design.schema.TargetSpec`)
 is a face of a STEP file (path relative to the design file, 1-based face number, as ``ght-cad
 approximate --face``), a GHT patch ``S(u, v) = Σ_i Σ_j b_{i,m}(u) b_{j,n}(v) P_ij``
 (:class:`ght_cad.surfaces.patch.GHTSurface`) or a NURBS patch (:class:`ght_cad.surfaces.nurbs.NurbsSurface`). It is
@@ -12,7 +12,7 @@ outputs through the functions of this module: the panels sewn into one shell
 (:func:`panel_pattern`), the deviation map (:func:`plot_deviation`), the per-panel report
 (:func:`approximation_report`, :func:`report_markdown`) and, with a sheet, one plate solid per panel
 (:func:`panel_plates`; a design's ``[sheet]`` plates the panels as any other surface's parts,
-:func:`ght_cad.design.build.sheet_parts`) with the neutral surfaces' flat patterns.
+:func:`ght_cad.app.design.build.sheet_parts`) with the neutral surfaces' flat patterns.
 
 The CAD kernel is imported only inside the functions that need it (a STEP target, plates).
 """
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .schema import DesignError, SurfaceSpec
 
 __all__ = ["ApproximatedSurface", "approximation_target", "build_approximation", "is_approximation",
@@ -72,7 +72,7 @@ def approximation_target(spec: SurfaceSpec, source: str) -> Any:
         DesignError: a missing or unreadable STEP file, a face number past the file's faces, or a
             degenerate target (naming the file and the key).
     """
-    from ..approximation import as_target
+    from ...approximation import as_target
 
     t = spec.target
     key = f"{spec.key}.target"
@@ -86,14 +86,14 @@ def approximation_target(spec: SurfaceSpec, source: str) -> Any:
         if not p.is_file():
             raise _fail(source, f"{key}.step", f"{str(p)!r} does not exist; allowed: a STEP file, its path relative "
                         "to the design file")
-        from ..cad.approximate import step_target
+        from ...cad.approximate import step_target
 
         try:
             tgt = step_target(p, t.face - 1)
         except GHTError as exc:
             raise _fail(source, f"{key}.face" if "face=" in str(exc) else f"{key}.step",
                         " ".join(str(exc).split())) from None
-        from ..approximation.target import TRIM_ALLOWED, is_trimmed, trim_words
+        from ...approximation.target import TRIM_ALLOWED, is_trimmed, trim_words
 
         if is_trimmed(tgt.trim) and not spec.untrimmed:
             raise _fail(source, key, f"face {t.face} of {t.step!r} is {trim_words(tgt.trim['covered'], tgt.trim['holes'])}; "
@@ -112,12 +112,12 @@ def _patch(t: Any) -> Any:
     """The GHTSurface or NurbsSurface of an inline target."""
     net = np.asarray(t.control_points, dtype=float)
     if t.kind == "ght":
-        from ..surfaces.patch import GHTSurface
+        from ...surfaces.patch import GHTSurface
 
         s = t.shape
         return GHTSurface(net, s.get("mu_u", 0.0), s.get("nu_u", 0.0), s.get("gamma_u", 0.0),
                           s.get("mu_v", 0.0), s.get("nu_v", 0.0), s.get("gamma_v", 0.0))
-    from ..surfaces.nurbs import NurbsSurface
+    from ...surfaces.nurbs import NurbsSurface
 
     return NurbsSurface.from_poles(t.knots_u, t.knots_v, t.degree_u, t.degree_v, net, t.weights)
 
@@ -150,7 +150,7 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
         GHTError: no approximation within ``tol`` with ``max_panels`` panels (the message names the
             best deviation reached; the caller adds the file and key).
     """
-    from ..approximation import approximate
+    from ...approximation import approximate
 
     tgt = approximation_target(spec, source)
     with np.errstate(all="ignore"):
@@ -165,7 +165,7 @@ def build_approximation(spec: SurfaceSpec, source: str) -> ApproximatedSurface:
 def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = None) -> Path:
     """PNG (900 × 700 px) of the signed deviation (panel minus target along the target normal)
     over the target's (u, v), seams drawn as lines."""
-    from ..curves.plotting import _figure, _save
+    from ...curves.plotting import _figure, _save
 
     fig = _figure("surface")
     ax = fig.add_subplot(1, 1, 1)
@@ -175,7 +175,7 @@ def plot_deviation(result: Any, path: str | os.PathLike, *, title: str | None = 
     sc = ax.scatter(uv[:, 0], uv[:, 1], c=d, s=6, cmap="coolwarm", vmin=-lim, vmax=lim)
     fig.colorbar(sc, ax=ax, label="deviation (panel - target, along the normal)")
     u0, u1, v0, v1 = result.info.get("bounds", (uv[:, 0].min(), uv[:, 0].max(), uv[:, 1].min(), uv[:, 1].max()))
-    from ..approximation.frame import strip_uv
+    from ...approximation.frame import strip_uv
 
     for s in result.seams:  # every seam is a segment in (u, v), a point at a box corner
         su, sv = strip_uv(result.direction, (u0, u1, v0, v1), np.array([0.0, 1.0]), np.full(2, s["y"]))
@@ -246,7 +246,7 @@ def panel_sheets(result: Any, target: Any, sheet: Any) -> list[Any] | None:
     material of every panel on the target's normal side."""
     if sheet is None or sheet.is_zero:
         return None
-    from ..approximation.frame import strip_uv
+    from ...approximation.frame import strip_uv
 
     u0, u1, v0, v1 = target.bounds
     out = []
@@ -276,7 +276,7 @@ def panel_plates(result: Any, sheets: Any, name: str = "panel") -> list[Any]:
     exact developable with its sheet of :func:`panel_sheets`), labelled ``<name> part <i>`` in
     messages and named ``P<i>`` (faces ``P<i>.inside``, ``P<i>.outside``, ``P<i>.edgeN`` in STEP), as
     the panels of the flat pattern."""
-    from ..cad.sheet_solid import plate_solid
+    from ...cad.sheet_solid import plate_solid
 
     parts = [p.exact if p.exact is not None else p.surface for p in result.panels]
     plates = [plate_solid(s, sh, label=f"{name} part {i + 1}") for i, (s, sh) in enumerate(zip(parts, sheets))]

@@ -2,7 +2,7 @@ r"""Shape-parameter optimization of a design's surface (spec sections 7, 8) thro
 
 **Sheet rule.** A design with a ``[sheet]`` of thickness ``T > 0`` is optimized over the shape
 parameters the sheet can be made from: every candidate surface gets the check the run applies
-to the built surface (:func:`ght_cad.design.build.check_sheet`: :func:`ght_cad.sheet.check_offset`
+to the built surface (:func:`ght_cad.app.design.build.check_sheet`: :func:`ght_cad.sheet.check_offset`
 on every part, 513 rulings, both ends of each), on the sheet of thickness ``(1 + SHEET_MARGIN) T``
 (same K, same side), and a refused candidate gets ``+inf`` like a degenerate one. With
 ``T' = (1 + m) T`` the accepted candidates satisfy, at every checked ruling end,
@@ -29,7 +29,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .build import (_initial_shape, _joined_curves, _make_composite, _make_surface, build_curves, build_surface, check_sheet,
                     make_loft)
 from .objectives import _gauss_legendre, composite_dual_objectives, composite_dual_objectives_grad, dual_curve_objectives
@@ -113,7 +113,7 @@ def _composite_candidate(design: Design, shape: dict[str, float]) -> Any:
     Raises:
         GHTError: a singular join, a degenerate strip, or a joint below its requested order.
     """
-    from ..core.errors import SingularJoinError
+    from ...core.errors import SingularJoinError
 
     comp = _make_composite(design, shape)
     for row in _composite_joint_rows(design, comp):
@@ -174,8 +174,8 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
 
         return fc
     if surf.type == "planes":
-        from ..curves.curve import GHTCurve
-        from ..surfaces.planes import normalize_planes
+        from ...curves.curve import GHTCurve
+        from ...surfaces.planes import normalize_planes
 
         U = normalize_planes(np.asarray(surf.planes, dtype=float))
         w = np.asarray(spec.weights, dtype=float)
@@ -195,7 +195,7 @@ def _objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSpec,
     rejoin = bool({str(surf.curve_a), str(surf.curve_b)} & {j.second for j in design.joins})
     if surf.type == "rails":
         return _rails_objective_fn(design, curves, spec, rejoin, accept)
-    from ..surfaces.ruled import developability_from_jets
+    from ...surfaces.ruled import developability_from_jets
 
     t, wq = _gauss_legendre(64)
 
@@ -216,7 +216,7 @@ def composite_value_and_grad(design: Design, shape: dict[str, float], names: Seq
                              accept: Acceptor | None = None) -> tuple[float, np.ndarray]:
     r""":func:`composite_objective` and its exact gradient with respect to the shape parameters
     ``names`` (``"<segment>.mu|nu|gamma"``), the joins differentiated as re-solved for every
-    candidate (:func:`ght_cad.design.objectives.composite_dual_objectives_grad`, spec 8.1).
+    candidate (:func:`ght_cad.app.design.objectives.composite_dual_objectives_grad`, spec 8.1).
 
     Args:
         design, shape, objective, weights, accept: as in :func:`composite_objective`.
@@ -286,7 +286,7 @@ def _rails_value_and_grad_fn(design: Design, curves: dict[str, Any], spec: Optim
     ``(+inf, 0)``. The forward-difference neighbours of a fallback are objective values only (no
     sheet check: they are gradient probes, not candidates).
     """
-    from ..optimize.problems.loft import LOFT_OBJECTIVES, LoftGradientFallback, LoftProblem
+    from ...optimize.problems.loft import LOFT_OBJECTIVES, LoftGradientFallback, LoftProblem
 
     surf = design.surface
     assert surf is not None
@@ -362,7 +362,7 @@ def _rails_objective_fn(design: Design, curves: dict[str, Any], spec: OptimizeSp
     ``∫ max(0, 1 - c/margin)² dλ`` (c the distance of the edge-of-regression parameter ``v*`` from
     [0, 1]), or ``weighted`` = ``w0 fan_share + w1 fairness + w2 regression``. A candidate without a
     loft, or one ``accept`` refuses (the sheet rule), raises (``+inf`` in :func:`optimize_design`)."""
-    from ..optimize.problems.loft import LOFT_OBJECTIVES, LoftProblem
+    from ...optimize.problems.loft import LOFT_OBJECTIVES, LoftProblem
 
     surf = design.surface
     assert surf is not None
@@ -406,7 +406,7 @@ class _SheetGuard:
     """
 
     def __init__(self, design: Design, sheet: Any) -> None:
-        from ..sheetmetal.sheet import Sheet
+        from ...sheetmetal.sheet import Sheet
 
         self.design = design
         self.sheet = sheet
@@ -419,7 +419,7 @@ class _SheetGuard:
         self._tie = itertools.count()
 
     def __call__(self, surface: Any, shape: dict[str, float]) -> float:
-        from ..sheetmetal.sheet import SheetError
+        from ...sheetmetal.sheet import SheetError
 
         self.checked += 1
         try:
@@ -455,7 +455,7 @@ class _SheetGuard:
 
 
 def _run_surface(design: Design, curves: dict[str, Any], shape: dict[str, float]) -> Any:
-    """The surface of ``shape`` as :func:`ght_cad.design.run_design` builds the result (the curves of
+    """The surface of ``shape`` as :func:`ght_cad.app.design.run_design` builds the result (the curves of
     a ``curves``/``rails`` strip rebuilt with the shape parameters, joins re-applied)."""
     assert design.surface is not None
     cv = build_curves(design, shape)[0] if design.surface.type in ("curves", "rails") else curves
@@ -496,7 +496,7 @@ def thickness_factor(design: Design, surface: Any, *, rtol: float = 1e-4, upto: 
         SheetError: the sheet itself is refused (``f < 1``).
         GHTError: ``rtol`` not in (0, 1) or ``upto`` not a finite number > 2.
     """
-    from ..sheetmetal.sheet import Sheet, SheetError
+    from ...sheetmetal.sheet import Sheet, SheetError
 
     if not (isinstance(rtol, (int, float)) and 0.0 < rtol < 1.0):
         raise GHTError(f"rtol={rtol!r} is not allowed; it must be a number in (0, 1)")
@@ -537,7 +537,7 @@ def _fmt_shape(shape: dict[str, float], names: Sequence[str]) -> str:
 def _sheet_infeasible(design: Design, spec: OptimizeSpec, guard: _SheetGuard, names: Sequence[str],
                       start: dict[str, Any], rejected_results: int = 0) -> GHTError:
     """The one-line error when no candidate passed the sheet rule (or none passed the final check)."""
-    from ..sheetmetal.sheet import SheetError
+    from ...sheetmetal.sheet import SheetError
 
     sh = guard.sheet
     kt = abs(sh.neutral_offset)
@@ -574,8 +574,8 @@ def _check_start(design: Design, curves: dict[str, Any], shape: dict[str, float]
     A refused start is said at once on a terminal (one ``note`` line on stderr) when ``progress``."""
     import sys
 
-    from ..core.progress import progress_enabled
-    from ..sheetmetal.sheet import SheetError
+    from ...core.progress import progress_enabled
+    from ...sheetmetal.sheet import SheetError
 
     try:
         r = _verified_radius(design, curves, shape)
@@ -670,8 +670,8 @@ def optimize_design(design: Design, overrides: dict[str, Any] | None = None, *, 
             names the limiting rule and the closest candidate's radius against ``|K T|``).
         GHTError: no admissible shape parameters found.
     """
-    from ..optimize import minimize
-    from ..core.progress import Progress
+    from ...optimize import minimize
+    from ...core.progress import Progress
 
     if design.surface is None:
         if design.surfaces:

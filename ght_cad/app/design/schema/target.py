@@ -1,6 +1,6 @@
 r"""``type = "approximate"`` surfaces: their keys and ``[surfaces.target]`` (a STEP face or an
-inline GHT/NURBS patch) with its control net. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+inline GHT/NURBS patch) with its control net. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ from .common import (_check_suffix, _emit, _fmt_point, _outputs_text, _parse_flo
 # ---------------------------------------------------------------------------------------------
 def cmd_plot_basis(args: argparse.Namespace) -> int:
     """``ght-cad plot-basis``: PNG of ``b_{i,m}(t; μ,ν,γ)`` (or a derivative), one panel per triple."""
-    from ..curves.plotting import SIZES, plot_basis
+    from ...curves.plotting import SIZES, plot_basis
 
     _check_suffix("--out", args.out, _PNG)
     params = []
@@ -44,14 +44,14 @@ def cmd_curve(args: argparse.Namespace) -> int:
     """``ght-cad curve``: properties of ``P(t) = Σ b_{i,m}(t) P_i``; optional STEP edge and plots."""
     import numpy as np
 
-    from ..curves.curve import GHTCurve
+    from ...curves.curve import GHTCurve
 
     if args.points is None:
         raise UsageError("--points is required, e.g. --points '0,0 1,2 3,2 4,0'")
     _check_suffix("--step", args.step, _STEP)
     _check_suffix("--plot", args.plot, _PNG)
     _check_suffix("--curvature-plot", args.curvature_plot, _PNG)
-    from ..curves.curve import curvature_from_derivatives
+    from ...curves.curve import curvature_from_derivatives
 
     curve = GHTCurve(_parse_points(args.points), args.mu, args.nu, args.gamma)
     t = np.linspace(0.0, 1.0, 513)
@@ -80,20 +80,20 @@ def cmd_curve(args: argparse.Namespace) -> int:
                          "point, not an edge; allowed: control points that are not all equal")
 
     def write_step_edge(path: Path) -> None:
-        from ..surfaces.bspline import curve_to_bspline
-        from ..cad.occ import make_edge, write_step
+        from ...surfaces.bspline import curve_to_bspline
+        from ...cad.occ import make_edge, write_step
 
         data = curve_to_bspline(curve)
         write_step(make_edge(data), path)
         result["bspline"] = {"degree": data.degree, "poles": int(data.poles.shape[0]), "max_deviation": data.max_deviation}
 
     def write_curve_png(path: Path) -> None:
-        from ..curves.plotting import plot_curve
+        from ...curves.plotting import plot_curve
 
         plot_curve(curve, path)
 
     def write_curvature_png(path: Path) -> None:
-        from ..curves.plotting import plot_curvature
+        from ...curves.plotting import plot_curvature
 
         plot_curvature(curve, path)
 

@@ -21,7 +21,7 @@ def _load(args: argparse.Namespace) -> Any:
 
 def cmd_demo(args: argparse.Namespace) -> int:
     """``ght-cad demo``: :func:`ght_cad.app.demo.run_demo` into ``--out``."""
-    from ..app.demo import run_demo
+    from ..demo import run_demo
 
     report = run_demo(args.out, progress=not args.no_progress, quick=args.quick, chord_tol=_chord_tol(args),
                       **_wait_args(args))
@@ -30,7 +30,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """``ght-cad run``: validate a design file, then :func:`ght_cad.design.run_design`."""
+    """``ght-cad run``: validate a design file, then :func:`ght_cad.app.design.run_design`."""
     from ..design import load_design, run_design
 
     design = load_design(args.design)
@@ -56,7 +56,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
         export_step(built, path)
 
     def write_surface_png(path: Path) -> None:
-        from ..curves.plotting import plot_surface
+        from ...curves.plotting import plot_surface
 
         plot_surface(surface_view(built), path, title=design.name)
 
@@ -73,7 +73,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
 
 
 def cmd_optimize(args: argparse.Namespace) -> int:
-    """``ght-cad optimize``: :func:`ght_cad.design.optimize_design` with command-line overrides."""
+    """``ght-cad optimize``: :func:`ght_cad.app.design.optimize_design` with command-line overrides."""
     from ..design import optimize_design
 
     _check_suffix("--plot", args.plot, _PNG)
@@ -83,7 +83,7 @@ def cmd_optimize(args: argparse.Namespace) -> int:
                                  progress=not args.no_progress)
     result = {"command": "optimize", "name": design.name, **result_opt.summary(), "outputs": {}}
     if args.plot:
-        from ..curves.plotting import plot_convergence
+        from ...curves.plotting import plot_convergence
 
         result["outputs"]["convergence_png"] = str(
             plot_convergence({result["method"]: result_opt.history}, args.plot, title=f"{design.name}: {result['objective']}")

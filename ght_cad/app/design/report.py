@@ -1,4 +1,4 @@
-r"""Markdown report of :func:`ght_cad.design.run_design` (``report.md``).
+r"""Markdown report of :func:`ght_cad.app.design.run_design` (``report.md``).
 """
 
 from __future__ import annotations
@@ -152,7 +152,7 @@ def _surface_section(s: dict[str, Any], r: dict[str, Any], title: str, initial: 
 
 def _strips_section(s: dict[str, Any]) -> list[str]:
     """The strips and joints tables of a composite surface, the panel table of an approximation
-    (:func:`ght_cad.design.approximate.report_markdown`); nothing for other types."""
+    (:func:`ght_cad.app.design.approximate.report_markdown`); nothing for other types."""
     L: list[str] = []
     if s.get("approximation"):
         from .approximate import report_markdown as approximation_markdown

@@ -17,7 +17,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .build import (GHT_DEFINITION, _developability_dict, _is_approximation, _is_composite, build_curves, build_surface, build_surfaces,
                     check_sheet, surface_summary, surface_view, surfaces_summary)
 from .optimize import optimize_design
@@ -31,7 +31,7 @@ from .schema import FIGURE_NAMES, FILE_NAMES, SHAPE_NAMES, Design
 def _versions() -> dict[str, str]:
     import platform
 
-    from .. import __version__
+    from ... import __version__
 
     out = {"ght_cad": __version__, "python": platform.python_version(), "numpy": np.__version__}
     try:
@@ -45,7 +45,7 @@ def _versions() -> dict[str, str]:
 
 def _curve_max_curvature(c: Any) -> float | None:
     """Largest curvature over 513 parameters where it is defined (``P' != 0``); None for a point."""
-    from ..curves.curve import curvature_from_derivatives
+    from ...curves.curve import curvature_from_derivatives
 
     t = np.linspace(0, 1, 513)
     kappa = curvature_from_derivatives(c.derivative(t, 1), c.derivative(t, 2))
@@ -85,7 +85,7 @@ def _shell_plate_report(design: Design, builts: list[Any], plates: list[Any], sh
     """``report["plate"]`` of a ``[[surfaces]]`` design with a ``[sheet]``: the totals, per surface
     its sheet, which way its material goes, its plates' volumes against the closed form
     ``T A + σ (T²/2) ∫ 2H dA``, and per shared rail how the plates meet
-    (:func:`ght_cad.design.shell_sheet.rail_joints`)."""
+    (:func:`ght_cad.app.design.shell_sheet.rail_joints`)."""
     from .shell_sheet import rail_joints
 
     rows = []
@@ -159,8 +159,8 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     """
     import sys
 
-    from ..core.outdir import OutputFolder
-    from ..core.progress import progress_enabled
+    from ...core.outdir import OutputFolder
+    from ...core.progress import progress_enabled
 
     t_start = time.perf_counter()
     if not os.fspath(out_dir).strip():  # Path("") would be the current folder
@@ -168,7 +168,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
     out = Path(out_dir)
     want_files = set(design.outputs.files)
     chord_tol = design.outputs.chord_tol if chord_tol is None else chord_tol  # --chord-tol over the file
-    from ..cad import KERNEL_HINT, kernel_available
+    from ...cad import KERNEL_HINT, kernel_available
 
     # without a kernel (core-only: FreeCAD's Python) everything but the B-rep and STEP is computed
     use_kernel = kernel_available()
@@ -262,7 +262,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 report["brep"] = {"skipped": f"the B-rep {KERNEL_HINT}"}
             else:
                 face = brep_shapes(builts)
-                from ..cad.occ import is_valid
+                from ...cad.occ import is_valid
 
                 valid = is_valid(face)
                 nfaces = len(face.faces()) if hasattr(face, "faces") else 1
@@ -271,7 +271,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                     report["brep"]["shape"] = "shell"
                     report["brep"]["shared_edges"] = shared_edge_count(face)
                 if built is not None and _is_composite(built.surface):
-                    from ..cad.developable_faces import joint_normal_deviation
+                    from ...cad.developable_faces import joint_normal_deviation
 
                     report["brep"]["joint_normal_deviation_deg"] = [float(x) for x in joint_normal_deviation(face)]
                 if not valid:
@@ -291,12 +291,12 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                                        **built.design.sheet.to_sheet().as_dict(), **_table_entry(built.design.sheet)}
                 if "step" in want_files:
                     if plates:
-                        from ..cad.sheet_solid import write_plate_step
+                        from ...cad.sheet_solid import write_plate_step
 
                         write_plate_step(plates, stage.path(FILE_NAMES["step"]), units=design.units, extra=edges,
                                          product=design.name)
                     else:
-                        from ..cad.occ import write_step
+                        from ...cad.occ import write_step
 
                         write_step([face] + edges, stage.path(FILE_NAMES["step"]), units=design.units, product=design.name)
             # 6. flat pattern
@@ -316,13 +316,13 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         else:
             pattern = None
             if "step" in want_files and curves:
-                from ..cad.occ import write_step
+                from ...cad.occ import write_step
 
                 write_step(curve_edges(curves), stage.path(FILE_NAMES["step"]), units=design.units, product=design.name)
 
         # 7. figures
         step("figures")
-        from ..curves import plotting as P
+        from ...curves import plotting as P
 
         if "basis" in want_figs:
             if built is not None and design.surface is not None and design.surface.type == "composite":
@@ -376,7 +376,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         report["versions"] = _versions()
         report["elapsed_s"] = time.perf_counter() - t_start
         report = _jsonable(report)
-        from ..core.io import write_text_atomic
+        from ...core.io import write_text_atomic
         import json
 
         if "json" in want_files:

@@ -14,9 +14,9 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..core.errors import GHTError
-from ..core._validate import is_real
-from ..core.workers import _dask_client, _limit_threads, _worker_threads
+from ...core.errors import GHTError
+from ...core._validate import is_real
+from ...core.workers import _dask_client, _limit_threads, _worker_threads
 from .schema import DesignError
 
 
@@ -90,7 +90,7 @@ def _read_step_in(path: Path, units: str | None) -> tuple[Any, str, str | None]:
     Raises:
         DesignError: unreadable, hostile or crashing file; a reader past the time limit.
     """
-    from ..core.step_guard import check_step_numbers
+    from ...core.step_guard import check_step_numbers
 
     try:
         check_step_numbers(path)  # absurd or overflowing reals: refused before OCCT sees them (it hung)
@@ -173,9 +173,9 @@ def _transfer_step(path: Path, units: str | None) -> tuple[Any, str, str | None]
     """OCCT's STEP reader and transfer in this process (see :func:`_read_step_in`)."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_Reader
-    from ..cad._ocp import TColStd_SequenceOfAsciiString
+    from ...cad._ocp import TColStd_SequenceOfAsciiString
 
-    from ..cad.occ import quiet_occt
+    from ...cad.occ import quiet_occt
 
     with quiet_occt():
         reader = STEPControl_Reader()
@@ -253,7 +253,7 @@ def unroll_step(
             ``best_effort``); the one-line message names the file, the face number and the
             measured ``θ_max`` and ``DD``.
     """
-    from ..pattern.flat_pattern import FlatPattern, layout_panels, mark_shared_edges
+    from ...pattern.flat_pattern import FlatPattern, layout_panels, mark_shared_edges
 
     p = Path(path)
     if p.suffix.lower() not in STEP_SUFFIXES:
@@ -269,7 +269,7 @@ def unroll_step(
     if isinstance(rulings, bool) or not isinstance(rulings, (int, np.integer)) or not 0 <= rulings <= 1000:
         raise DesignError(f"{p}: rulings={rulings!r} is out of range; allowed: an integer in [0, 1000]")
     shape, unit, file_unit = _read_step_in(p, units)
-    from ..cad.unroll_faces import shape_faces
+    from ...cad.unroll_faces import shape_faces
 
     try:
         all_faces = shape_faces(shape)
@@ -322,7 +322,7 @@ def _face_names_once(p: Path) -> Callable[[], dict[int, str]]:
 
     def names() -> dict[int, str]:
         if not memo:
-            from ..cad.sheet_solid import read_step_face_names
+            from ...cad.sheet_solid import read_step_face_names
 
             memo.append(read_step_face_names(p)[1])
         return memo[0]
@@ -343,14 +343,14 @@ def _step_plates(p: Path, shape: Any, faces: Sequence[int] | None, thickness: An
     Raises:
         SheetError: a given ``thickness`` that differs from a plate's.
     """
-    from ..sheetmetal.sheet import make_sheet
+    from ...sheetmetal.sheet import make_sheet
 
     if faces or (thickness is None and k_factor is None and din_k_factor is None and side is None) or thickness == 0:
         return None
     from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
-    from ..cad.sheet_solid import _faces, plate_faces
+    from ...cad.sheet_solid import _faces, plate_faces
 
     solids = []
     exp = TopExp_Explorer(shape, TopAbs_SOLID)
@@ -386,7 +386,7 @@ def _check_plate_thickness(p: Path, thickness: Any, k_factor: Any, din_k_factor:
     Raises:
         SheetError: a bad value, or one that does not match ``found`` (naming ``what`` and its faces).
     """
-    from ..sheetmetal.sheet import SheetError, make_sheet
+    from ...sheetmetal.sheet import SheetError, make_sheet
 
     if thickness is None:
         return
@@ -402,13 +402,13 @@ def _step_sheet(p: Path, shape: Any, faces: Sequence[int] | None, thickness: Any
                 din_k_factor: Any, side: str | None,
                 face_names: Callable[[], dict[int, str]]) -> tuple[Any, dict[str, Any] | None]:
     """The sheet of :func:`unroll_step` and the plate found in the file (see there)."""
-    from ..sheetmetal.sheet import SheetError, make_sheet
+    from ...sheetmetal.sheet import SheetError, make_sheet
 
     if thickness is None and k_factor is None and din_k_factor is None and side is None:
         return None, None
     plate = None
     if not faces and thickness != 0:
-        from ..cad.sheet_solid import plate_faces
+        from ...cad.sheet_solid import plate_faces
 
         from OCP.TopAbs import TopAbs_SOLID
         from OCP.TopExp import TopExp_Explorer
@@ -444,8 +444,8 @@ def unroll_step_face(p: Path, face: Any, k: int, n: int, *, best_effort: bool, t
         NotDevelopableError: the face is not developable within ``tol_deg`` (and not ``best_effort``).
         GHTError: any other refusal, the message prefixed with the file and face number.
     """
-    from ..core.errors import NotDevelopableError
-    from ..unrolling.unroll import unroll
+    from ...core.errors import NotDevelopableError
+    from ...unrolling.unroll import unroll
 
     kw = dict(tol_deg=tol_deg, rulings=rulings, units=unit, label=f"F{k}")
     try:
@@ -526,7 +526,7 @@ def _portable(panels: list[Any]) -> list[Any]:
 def _step_faces_task(spec: dict[str, Any], data: bytes | None = None) -> list[tuple[Any, ...]]:
     """Unroll some faces of one STEP file in a worker: per face ``("ok", panels, row)`` or
     ``("error", exception)`` (the file is read once per process, :data:`_STEP_FACES`)."""
-    from ..cad.unroll_faces import shape_faces
+    from ...cad.unroll_faces import shape_faces
 
     key = (spec["key"], spec["unit"])
     if key not in _STEP_FACES:

@@ -7,9 +7,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..core._cache import readonly_cache
-from ..core._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
-from ..core.errors import GHTError
+from ...core._cache import readonly_cache
+from ...core._quadrature import gauss_legendre_unit as _gauss_legendre  # noqa: F401  (the name design re-exports)
+from ...core.errors import GHTError
 from .schema import PLANE_OBJECTIVES
 
 
@@ -74,7 +74,7 @@ def composite_dual_objectives(composite: Any, objective: str = "CVEn", weights: 
 @readonly_cache(maxsize=16)
 def _population_basis(nodes: int, degree: int) -> Any:
     """Cached :class:`ght_cad.optimize.problems.PopulationBasis` on ``nodes`` Gauss–Legendre nodes."""
-    from ..optimize.problems import PopulationBasis
+    from ...optimize.problems import PopulationBasis
 
     return PopulationBasis(_gauss_legendre(nodes)[0], degree)
 
@@ -82,7 +82,7 @@ def _population_basis(nodes: int, degree: int) -> Any:
 @readonly_cache(maxsize=16)
 def _end_basis(degree: int) -> Any:
     """Cached :class:`ght_cad.optimize.problems.PopulationBasis` at the two ends ``t = 0, 1``."""
-    from ..optimize.problems import PopulationBasis
+    from ...optimize.problems import PopulationBasis
 
     return PopulationBasis(np.array([0.0, 1.0]), degree)
 
@@ -90,7 +90,7 @@ def _end_basis(degree: int) -> Any:
 def _target_coefficients(continuity: Any, k: float, beta2: float, beta3: float) -> list[list[float]]:
     r"""``T_r = Σ_j c[r][j] U^(j)(1)`` of :func:`ght_cad.curves.continuity.join_targets`, r = 1..order
     (C: ``T_r = U^(r)(1)``; G1 ``k U'``, G2 ``k² U'' + β2 U'``, G3 ``k³ U''' + 3kβ2 U'' + β3 U'``)."""
-    from ..curves.continuity import Continuity
+    from ...curves.continuity import Continuity
 
     cont = Continuity.parse(continuity)
     r = cont.order

@@ -1,6 +1,6 @@
 r"""The design schema's allowed values and limits: outputs and their file names, optimizers and
-objectives, surface types, joins, continuities, units, size limits. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+objectives, surface types, joins, continuities, units, size limits. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 r"""The dataclasses of a validated design (:class:`Design` and its curve, join, surface, target,
-optimize, unroll, output and sheet specs) and :class:`DesignError`. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+optimize, unroll, output and sheet specs) and :class:`DesignError`. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ...core.errors import GHTError
+from ....core.errors import GHTError
 from .constants import FIGURE_OUTPUTS, FILE_OUTPUTS, SHAPE_NAMES
 
 
@@ -169,7 +169,7 @@ class SheetSpec:
     #: ``"surface"`` (each surface's own normal); one surface: its own normal either way
     side_reference: str = "shell"
     #: ``k_factor_table``: a :class:`ght_cad.sheetmetal.blank.KFactorTable` giving K by the surface's ``R / T``
-    #: (R its smallest inside bending radius, :func:`ght_cad.design.build.table_k_factor`); until a
+    #: (R its smallest inside bending radius, :func:`ght_cad.app.design.build.table_k_factor`); until a
     #: built surface resolves it, ``k_factor`` is the table's largest K (the strictest neutral offset)
     k_factor_table: Any = None
     #: ``R / T`` the table was read at (set with ``k_factor`` when a built surface resolves it)
@@ -177,7 +177,7 @@ class SheetSpec:
 
     def to_sheet(self) -> Any:
         """The :class:`ght_cad.sheet.Sheet`."""
-        from ...sheetmetal.sheet import Sheet
+        from ....sheetmetal.sheet import Sheet
 
         return Sheet(self.thickness, self.k_factor, self.side)
 

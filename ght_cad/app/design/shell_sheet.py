@@ -36,7 +36,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .build import BuiltSurface, sheet_parts, table_k_factor
 from .schema import Design, DesignError, SheetSpec
 
@@ -243,7 +243,7 @@ def surface_sheets(design: Design, builts: Sequence[BuiltSurface]) -> tuple[list
     Raises:
         DesignError: ``side_reference = "shell"`` on a shell that cannot be oriented.
     """
-    from ..sheetmetal.sheet import ruling_normal
+    from ...sheetmetal.sheet import ruling_normal
 
     assert design.sheet is not None
     rails = shared_rails(builts)
@@ -279,7 +279,7 @@ def apply_sheets(builts: Sequence[BuiltSurface], sheets: Sequence[SurfaceSheet])
 
 
 def check_surface_sheets(design: Design, builts: Sequence[BuiltSurface]) -> list[float]:
-    """:func:`ght_cad.design.check_sheet` on every surface (each with its own sheet); a refusal
+    """:func:`ght_cad.app.design.check_sheet` on every surface (each with its own sheet); a refusal
     names the file, ``surfaces[i]`` and the surface.
 
     Returns:
@@ -303,7 +303,7 @@ def rail_joints(builts: Sequence[BuiltSurface], sheets: Sequence[SurfaceSheet], 
     (``m_i · w_j > 0``, ``w_j`` the unit direction into surface ``j`` across the rail), ``gap``
     where it turns away, ``flush`` within 1e-9 (points on a zero-length ruling, a pointed end, have
     no direction across the rail and are left out of the kind)."""
-    from ..sheetmetal.sheet import ruling_normal
+    from ...sheetmetal.sheet import ruling_normal
 
     out = []
     for r in rails:

@@ -1,6 +1,6 @@
 r"""``[surface]`` / ``[[surfaces]]`` validation: one surface of any type, composites and their
-segments, the objectives and shape parameters a surface type allows. Moved from ``ght_cad/design/schema.py`` (issue 27); every name is importable from
-:mod:`ght_cad.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.design`).
+segments, the objectives and shape parameters a surface type allows. Moved from ``ght_cad/app/design/schema.py`` (issue 27); every name is importable from
+:mod:`ght_cad.app.design.schema` (and, as before, the re-exported ones from :mod:`ght_cad.app.design`).
 """
 
 from __future__ import annotations

@@ -22,8 +22,8 @@ def _ruled_face(surface: Any, tol: float) -> Any:
     ``a`` and ``b`` are fitted together as one 6-D function (one knot vector, pole i of each at
     the same parameter), so the face is ``(1-v) A(u) + v B(u)`` with ``|A - a|, |B - b| <= tol``.
     """
-    from ..surfaces.bspline import BSplineSurfaceData, fit_function
-    from ..cad.occ import make_face
+    from ...surfaces.bspline import BSplineSurfaceData, fit_function
+    from ...cad.occ import make_face
 
     fit = fit_function(lambda t: np.hstack([surface.a(t), surface.b(t)]), tol=tol, degree=5)
     poles = np.stack([fit.poles[:, :3], fit.poles[:, 3:]], axis=1)
@@ -51,11 +51,11 @@ def brep_shape(built: BuiltSurface, tol: float | None = None) -> Any:
     of one B-spline face per strip sewn along the joint rulings
     (:func:`ght_cad.cad.developable_faces.composite_shell`)."""
     if _is_composite(built.surface):
-        from ..cad.developable_faces import composite_shell
+        from ...cad.developable_faces import composite_shell
 
         return composite_shell(built.surface, tol=tol)
     if _is_approximation(built.surface):  # the shell ght-cad approximate writes
-        from ..cad.approximate import panels_shell
+        from ...cad.approximate import panels_shell
 
         return panels_shell(built.surface.result)
     return brep_face(built, tol)
@@ -83,11 +83,11 @@ def sew_shell(shapes: Sequence[Any], sew_tol: float | None = None) -> Any:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
     from OCP.TopAbs import TopAbs_SHELL
     from OCP.TopExp import TopExp_Explorer
-    from ..cad._ocp import TopoDS
+    from ...cad._ocp import TopoDS
 
-    from ..cad.developable_faces import shell_faces
-    from ..cad.occ import is_valid, unwrap
-    from ..core.errors import ConversionError
+    from ...cad.developable_faces import shell_faces
+    from ...cad.occ import is_valid, unwrap
+    from ...core.errors import ConversionError
 
     faces = [f for sh in shapes for f in shell_faces(sh)]
     if sew_tol is None:
@@ -115,9 +115,9 @@ def shared_edge_count(shape: Any) -> int:
     """Number of edges of a B-rep shared by two or more of its faces (``TopExp`` edge→face map)."""
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
-    from ..cad._ocp import TopTools_IndexedDataMapOfShapeListOfShape
+    from ...cad._ocp import TopTools_IndexedDataMapOfShapeListOfShape
 
-    from ..cad.occ import unwrap
+    from ...cad.occ import unwrap
 
     m = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(unwrap(shape), TopAbs_EDGE, TopAbs_FACE, m)
@@ -126,8 +126,8 @@ def shared_edge_count(shape: Any) -> int:
 
 def curve_edges(curves: dict[str, Any]) -> list[Any]:
     """Certified B-spline edges (``curve_to_bspline``) of the 2-D/3-D curves."""
-    from ..surfaces.bspline import curve_to_bspline
-    from ..cad.occ import make_edge
+    from ...surfaces.bspline import curve_to_bspline
+    from ...cad.occ import make_edge
 
     return [make_edge(curve_to_bspline(c)) for c in curves.values() if c.dim in (2, 3)]
 
@@ -137,13 +137,13 @@ def export_step(built: BuiltSurface | Sequence[BuiltSurface], path: str | os.Pat
     """Write the surface face(s) (:func:`brep_shapes`: several surfaces as one sewn shell) and the
     design's curves as edges to one STEP file, atomically; with a ``[sheet]`` of thickness > 0 the
     plate solid(s) instead of the face (:func:`plate_solids`, faces named inside/outside/edgeN)."""
-    from ..cad.occ import write_step
+    from ...cad.occ import write_step
 
     builts = list(built) if isinstance(built, (list, tuple)) else [built]
     edges = curve_edges(builts[0].curves) if with_curves else []
     plates = plate_solids(builts[0]) if len(builts) == 1 else design_plates(builts)[0]
     if plates:
-        from ..cad.sheet_solid import write_plate_step
+        from ...cad.sheet_solid import write_plate_step
 
         write_plate_step(plates, path, units=builts[0].design.units, extra=edges, product=builts[0].design.name)
         return Path(path)
@@ -159,7 +159,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
     panel per strip (``"per-surface"``). A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
     distortion is then in the pattern's errors.
     """
-    from ..unrolling.unroll import unroll
+    from ...unrolling.unroll import unroll
 
     d = built.design
     sheet = d.sheet.to_sheet() if d.sheet is not None else None  # [sheet]: the neutral surface (spec 6.1)
@@ -169,7 +169,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
         return panel_pattern(built.surface.result, built.surface.part_sheets(sheet), tol_deg=d.unroll.tol_deg,
                              rulings=d.unroll.rulings, samples=d.unroll.samples, units=d.units)
     if _is_composite(built.surface):
-        from ..unrolling.unroll import unroll_composite
+        from ...unrolling.unroll import unroll_composite
 
         return unroll_composite(built.surface.segments, tol_deg=d.unroll.tol_deg, rulings=d.unroll.rulings,
                                 samples=d.unroll.samples, units=d.units, labels=[g.name for g in d.surface.segments or []],
@@ -185,7 +185,7 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
     d = built.design
     if d.sheet is None or d.sheet.thickness == 0:
         return []
-    from ..cad.sheet_solid import plate_solid
+    from ...cad.sheet_solid import plate_solid
 
     sheet = d.sheet.to_sheet()
     if _is_approximation(built.surface):  # the plates of ght-cad approximate --thickness (P1.inside, ...)
@@ -198,7 +198,7 @@ def plate_solids(built: BuiltSurface) -> list[Any]:
 
 def design_plates(builts: Sequence[BuiltSurface]) -> tuple[list[Any], Any]:
     """The plates of a ``[[surfaces]]`` design with a ``[sheet]``: every surface's
-    :func:`plate_solids` with its own sheet (:func:`ght_cad.design.shell_sheet.surface_sheets`:
+    :func:`plate_solids` with its own sheet (:func:`ght_cad.app.design.shell_sheet.surface_sheets`:
     the material on one side of the shell), each named after its surface (``<surface>`` or
     ``<surface>.<strip>``; faces ``<name>.inside``, ...). Returns ``(plates, (sheets, rails, builts))``
     with the resolved per-surface sheets and the shared rails (None when ``builts`` carry their
@@ -224,8 +224,8 @@ def design_plates(builts: Sequence[BuiltSurface]) -> tuple[list[Any], Any]:
 
 
 def resolve_design_sheets(builts: Sequence[BuiltSurface]) -> tuple[list[Any], list[Any], list[BuiltSurface]]:
-    """Per-surface sheets of a ``[[surfaces]]`` design (:func:`ght_cad.design.shell_sheet.surface_sheets`),
-    checked on every surface (:func:`~ght_cad.design.shell_sheet.check_surface_sheets`), the
+    """Per-surface sheets of a ``[[surfaces]]`` design (:func:`ght_cad.app.design.shell_sheet.surface_sheets`),
+    checked on every surface (:func:`~ght_cad.app.design.shell_sheet.check_surface_sheets`), the
     shared rails, and the built surfaces carrying their own sheet."""
     from .shell_sheet import apply_sheets, check_surface_sheets, surface_sheets
 
@@ -250,7 +250,7 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     blank (:func:`ght_cad.join_panels.join_panels`); sharp chines stay separate panels with marks."""
     if len(builts) == 1:
         return unroll_surface(builts[0])
-    from ..unrolling.unroll import unroll_composite
+    from ...unrolling.unroll import unroll_composite
 
     d = builts[0].design
     if d.sheet is not None and not all(b.sheet_resolved for b in builts):
@@ -314,7 +314,7 @@ def pattern_errors(pattern: Any) -> dict[str, float]:
 
 def plot_pattern(pattern: Any, path: str | os.PathLike, title: str | None = None) -> Path:
     """Fixed-size PNG (900 x 700) of a flat pattern: outlines and bend lines."""
-    from ..curves.plotting import plot_flat_pattern
+    from ...curves.plotting import plot_flat_pattern
 
     e = pattern.errors
     t = (title + ": " if title else "") + f"flat pattern, max rel. error {e['max']:.1e}"
@@ -363,7 +363,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
         for f in files:
             if f.suffix.lower() in (".dxf", ".svg"):
                 raise DesignError(f"{design.source}: key 'surface': missing; {f} needs a [surface] table")
-    from ..core.outdir import StagedFiles
+    from ...core.outdir import StagedFiles
 
     with StagedFiles(files) as stage:  # locked targets, staging folders with pid + lock
         out: dict[str, str] = {}
@@ -381,14 +381,14 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
     """Write the content for ``target`` (chosen by its suffix) into ``tmp``; returns the flat pattern."""
     import json
 
-    from ..core.io import write_text_atomic
+    from ...core.io import write_text_atomic
 
     suf = target.suffix.lower()
     if suf in (".step", ".stp"):
         if builts:
             export_step(builts, tmp)
         else:
-            from ..cad.occ import write_step
+            from ...cad.occ import write_step
 
             write_step(curve_edges(curves), tmp, units=design.units, product=design.name)
     elif suf in (".dxf", ".svg"):
@@ -403,7 +403,7 @@ def _export_one(design: Design, curves: dict[str, Any], builts: list[BuiltSurfac
             summ["flat_pattern"] = pattern_report(pattern)
         write_text_atomic(tmp, json.dumps(_jsonable(summ), indent=2) + "\n")
     else:
-        from ..curves.plotting import plot_curve, plot_surface
+        from ...curves.plotting import plot_curve, plot_surface
 
         if builts:
             plot_surface(surface_view(builts), tmp, title=design.name)

@@ -13,7 +13,7 @@ from .common import _chord_tol, dumps, EXIT_OK, PROG, UsageError
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """``ght-cad batch``: :func:`ght_cad.app.batch.run_batch`; exit 0 all ok, 2 any bad input, 1 any failed."""
-    from ..app.batch import run_batch
+    from ..batch import run_batch
 
     if args.jobs is not None and args.scheduler:
         raise UsageError("--jobs and --scheduler exclude each other: --jobs runs local processes, "

@@ -9,7 +9,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..core.errors import GHTError
+from ...core.errors import GHTError
 from .objectives import dual_curve_objectives
 from .schema import SHAPE_NAMES, Design, DesignError, SurfaceSpec
 
@@ -42,7 +42,7 @@ def build_curves(design: Design, shape: dict[str, float] | None = None) -> tuple
 
 def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: bool) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """:func:`build_curves`; ``measure=False`` skips the join reports (optimizer candidates)."""
-    from ..curves.curve import GHTCurve
+    from ...curves.curve import GHTCurve
 
     side_of: dict[str, str] = {}
     if shape and design.surface is not None and design.surface.type in ("curves", "rails"):
@@ -56,7 +56,7 @@ def _joined_curves(design: Design, shape: dict[str, float] | None, *, measure: b
         curves[c.name] = GHTCurve(c.control_points, sh["mu"], sh["nu"], sh["gamma"])
     reports = []
     for i, j in enumerate(design.joins):
-        from ..curves.continuity import join, measure_continuity
+        from ...curves.continuity import join, measure_continuity
 
         a, b = curves[j.first], curves[j.second]
         if a.dim != b.dim:
@@ -100,7 +100,7 @@ class BuiltSurface:
     curves: dict[str, Any]
     shape: dict[str, float]
     #: ``design.sheet`` is this surface's own sheet of a ``[[surfaces]]`` design (side on its own
-    #: normal, overrides applied: :func:`ght_cad.design.shell_sheet.apply_sheets`)
+    #: normal, overrides applied: :func:`ght_cad.app.design.shell_sheet.apply_sheets`)
     sheet_resolved: bool = False
 
 
@@ -124,7 +124,7 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
     spec = design.surface
     assert spec is not None
     if spec.type == "planes":
-        from ..developables.envelope import developable_from_planes
+        from ...developables.envelope import developable_from_planes
 
         return developable_from_planes(
             spec.planes, spec.boundary_planes, shape["mu"], shape["nu"], shape["gamma"], normalize=spec.normalize
@@ -139,7 +139,7 @@ def _make_surface(design: Design, curves: dict[str, Any], shape: dict[str, float
     cb = curves[spec.curve_b].with_shape(shape["b.mu"], shape["b.nu"], shape["b.gamma"])
     if spec.type == "rails":
         return make_loft(spec, ca, cb)
-    from ..surfaces.ruled import CurvePairRuledSurface
+    from ...surfaces.ruled import CurvePairRuledSurface
 
     return CurvePairRuledSurface(ca, cb)
 
@@ -152,7 +152,7 @@ def make_loft(spec: SurfaceSpec, rail_a: Any, rail_b: Any, **options: Any) -> An
         NotDevelopableError: no developable joins the rails over their whole length (the loft
             core's message).
     """
-    from ..developables.loft import developable_loft
+    from ...developables.loft import developable_loft
 
     return developable_loft(rail_a, rail_b, orientation=spec.orientation, **options)
 
@@ -168,8 +168,8 @@ def _make_composite(design: Design, shape: dict[str, float]) -> Any:
     Raises:
         GHTError: a join that cannot be solved or a degenerate strip, naming the segment.
     """
-    from ..developables.envelope import CompositeDevelopable, developable_from_planes, join_developable
-    from ..surfaces.planes import normalize_planes
+    from ...developables.envelope import CompositeDevelopable, developable_from_planes, join_developable
+    from ...surfaces.planes import normalize_planes
 
     spec = design.surface
     assert spec is not None and spec.segments
@@ -228,8 +228,8 @@ def inside_radius(surface: Any, side: str, thickness: float, *, samples: int = 5
     the smaller one, ``R = min(|ρ_0|, |ρ_0 + σ T|)``; apex ends (a stationary boundary, the point of
     a cone or fan) are skipped as in ``check_offset``. ``inf`` for a flat surface.
     """
-    from ..surfaces.ruled import SINGULAR_NORMAL_TOL
-    from ..sheetmetal.sheet import bending_radius
+    from ...surfaces.ruled import SINGULAR_NORMAL_TOL
+    from ...sheetmetal.sheet import bending_radius
 
     sigma = 1.0 if side == "normal" else -1.0
     u = np.linspace(0.0, 1.0, samples)
@@ -255,7 +255,7 @@ def table_k_factor(sheet: Any, surface: Any) -> Any:
     the sheet unchanged when it has no table or ``T = 0``.
 
     Args:
-        sheet: a :class:`ght_cad.design.schema.SheetSpec`; surface: the built surface.
+        sheet: a :class:`ght_cad.app.design.schema.SheetSpec`; surface: the built surface.
 
     Returns:
         The SheetSpec with ``k_factor = table(R/T)`` and ``k_factor_ratio = R/T``.
@@ -290,7 +290,7 @@ def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int
         SheetError: the first part the sheet cannot be made on (the message names the part, the
             ruling, its radius and the bound; ``constraint``, ``radius``, ``limit`` as attributes).
     """
-    from ..sheetmetal.sheet import check_offset
+    from ...sheetmetal.sheet import check_offset
 
     if sheet is None:
         if design.sheet is None:
@@ -435,7 +435,7 @@ def surface_area(surface: Any) -> float:
 
 def ruled_area(surface: Any, nodes: int = 64) -> float:
     r"""Area ``∫_0^1 ∫_0^1 |X_u × X_v| dv du`` of a ruled surface (Gauss–Legendre, both directions)."""
-    from ..curves.curve import gauss_legendre
+    from ...curves.curve import gauss_legendre
 
     t, w = gauss_legendre(nodes)
     v, wv = gauss_legendre(16)
@@ -488,7 +488,7 @@ def surface_summary(built: BuiltSurface) -> dict[str, Any]:
 def _approximation_summary(built: BuiltSurface) -> dict[str, Any]:
     """``report["surface"]`` and ``report["developability"]`` of an ``approximate`` surface: area,
     ruling lengths, the worst panel's developability and ``surface.approximation``
-    (:func:`ght_cad.design.approximate.approximation_report`: per panel max deviation out/in,
+    (:func:`ght_cad.app.design.approximate.approximation_report`: per panel max deviation out/in,
     θ_max, area; the panel count and largest deviation)."""
     from .approximate import approximation_report
 
@@ -531,7 +531,7 @@ def _worst(ds: Sequence[dict[str, float]]) -> dict[str, float]:
 
 
 def _composite_summary(built: BuiltSurface) -> dict[str, Any]:
-    from ..unrolling.unroll import ruled_area as exact_area
+    from ...unrolling.unroll import ruled_area as exact_area
 
     comp = built.surface
     spec = built.design.surface

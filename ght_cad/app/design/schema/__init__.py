@@ -4,12 +4,12 @@ Every check names the file, the key and the allowed values and raises :class:`De
 (a :class:`~ght_cad.core.errors.GHTError`, so ``ght-cad`` exits with code 2). The schema is documented
 in ``docs/design-files.md``.
 
-Modules (issue 27, moved from ``ght_cad/design/schema.py``): :mod:`.constants` (allowed values
+Modules (issue 27, moved from ``ght_cad/app/design/schema.py``): :mod:`.constants` (allowed values
 and limits), :mod:`.specs` (the dataclasses, :class:`DesignError`), :mod:`.checker` (typed getters
 naming file and key), :mod:`.sheet` (K-factor tables, per-surface sheet overrides), :mod:`.target`
 (``approximate`` surfaces and their targets), :mod:`.surfaces` (surfaces of every type,
 composites); :func:`parse_design`, :func:`parse_design_text` and :func:`load_design` stay here. Every
-name (private ones included) is importable as ``ght_cad.design.schema.<name>``.
+name (private ones included) is importable as ``ght_cad.app.design.schema.<name>``.
 """
 
 from __future__ import annotations
