@@ -1,4 +1,4 @@
-"""Import direction of the layered package (issue 27): sub-packages for the low layers, the rest flat.
+"""Import direction of the layered package (issue 27): every module of ``ght_cad`` in a layer package.
 
 Every import of every module of ``ght_cad`` and of the FreeCAD workbench is read with ``ast``
 (function-local imports included: they are the ones that break the layering quietly) and resolved
@@ -6,18 +6,28 @@ to a module. Each module has a layer, lowest first:
 
 =========  ====================================================================================
 core       ``ght_cad.core``: errors, validation, small vector kernels, quadrature, caches, atomic
-           files, output folders, progress, the STEP text guard, worker helpers, the kernel registry
+           files, output folders, progress, the STEP text guard, worker helpers, the kernel
+           registry, the old module paths' import hook
 curves     ``ght_cad.curves``: seeds, basis, curves, continuity, composites, analysis, plotting
-surfaces   ``ght_cad.surfaces`` (planes, B-splines, NURBS, patches, ruled surfaces); developables,
-           the loft, sheet, plate, unrolling, flat patterns
-optimize   ``ght_cad.optimize`` (optimizers, problems, Pareto, pipeline)
+surfaces   ``ght_cad.surfaces`` (planes, B-splines, NURBS, patches, ruled surfaces),
+           ``ght_cad.pattern`` (flat patterns and their writers), ``ght_cad.developables``
+           (envelope, tangent, rectifying, canal developables, joints, the rails loft),
+           ``ght_cad.unrolling`` (unroll, ruled development, CAD faces) and ``ght_cad.sheetmetal``
+           (sheet, plate, joined panels, blanks of bent parts)
+optimize   ``ght_cad.optimize`` (optimizers, problems, Pareto, pipeline) and
+           ``ght_cad.approximation`` (developable panels for a double-curved target)
 kernel     CAD adapters: ``ght_cad.cad`` (OCP/build123d/cadquery)
 facade     the package ``ght_cad`` itself: the public namespace re-exports every layer below it,
            the CAD adapters' ``unfold`` included (on first use, so ``import ght_cad`` loads no kernel)
 workbench  the FreeCAD workbench (``ght_workbench``: FreeCAD ``Part`` adapters, features, commands):
            a front end on the public ``ght_cad`` namespace, never on the OCP adapters or ``design``
-app        ``ght_cad.app`` (CLI, batch, sweeps, demo, STEP unfold); command handlers, design files
+app        ``ght_cad.app`` (CLI, batch, sweeps, demo, STEP unfold, the approximate command; the
+           command handlers ``app.commands`` and design files ``app.design``)
 =========  ====================================================================================
+
+The surfaces layer holds five packages, not one: ``developables``, ``unrolling`` and
+``sheetmetal`` use each other's modules (no module cycle, but package-level ones, e.g. the sheet's
+neutral surface in ``unrolling.unroll`` and the ruled development in ``sheetmetal.sheet``).
 
 A module is in the layer of its first package below ``ght_cad`` (:data:`_LAYER_OF`). The old
 path of a moved module (``ght_cad.curve``, an alias of the module ``ght_cad.curves.curve`` in
@@ -33,10 +43,10 @@ the kernel hook is not an edge of it). The failure names every cycle's modules a
 them, one of its imports of another module of the cycle with ``file:line``. Break a cycle the way
 the three cycles of before were broken (issue 27): move what both sides use into a module below
 both and import it back where it was (the STEP input's parallel faces into
-``ght_cad.design.step_input`` and the worker helpers into ``ght_cad.core.workers``; the FreeCAD face
+``ght_cad.app.design.step_input`` and the worker helpers into ``ght_cad.core.workers``; the FreeCAD face
 reader into ``ght_workbench.face_reader``; the forming rows' presentation into
 ``ght_cad.pattern.forming`` and the development of one ruled surface into
-``ght_cad.ruled_development``), not by hiding the import (``importlib``, strings).
+``ght_cad.unrolling.ruled_development``), not by hiding the import (``importlib``, strings).
 """
 
 from __future__ import annotations
@@ -55,15 +65,14 @@ WORKBENCH = ROOT / "freecad_workbench" / "freecad"
 LAYERS = ("core", "curves", "surfaces", "optimize", "kernel", "facade", "workbench", "app")
 
 _LAYER_OF = {
-    # the layer packages of issue 27 are named after their layer; a few modules stay top-level
+    # the layer packages of issue 27; ght_cad/ holds nothing else (test_top_level_holds_only_layer_packages)
     "core": ["core"],
     "curves": ["curves"],
-    "surfaces": ["surfaces", "unrolling", "sheetmetal", "pattern", "developable", "loft", "faces", "developables",
-                 "blank"],
+    "surfaces": ["surfaces", "pattern", "developables", "unrolling", "sheetmetal"],
     # the approximation fits and optimizes panels (the dual fit's μ, ν, γ through ght_cad.optimize)
-    "optimize": ["optimize", "approximation", "approximation_dual"],
+    "optimize": ["optimize", "approximation"],
     "kernel": ["cad"],
-    "app": ["app", "commands", "design", "approximate_cli"],
+    "app": ["app"],
 }
 
 #: The core's one way to the kernel layer: ``ght_cad.core._kernel.load_kernel`` imports ``ght_cad.cad``,
@@ -274,6 +283,16 @@ def test_every_module_has_a_layer(graph: dict[str, set[str]]) -> None:
     assert len(graph) > 60, "the module reader found too few modules"
     for m in graph:
         layer(m)
+
+
+def test_top_level_holds_only_layer_packages() -> None:
+    """``ght_cad/`` is the facade's ``__init__``, the package data and the layer packages of
+    :data:`_LAYER_OF`, nothing else: a new module goes into the package of its layer."""
+    top = ROOT / "ght_cad"
+    packages = sorted(p.name for p in top.iterdir() if (p / "__init__.py").is_file())
+    modules = sorted(p.name for p in top.glob("*.py") if p.name != "__init__.py")
+    assert modules == [], f"modules at the top of ght_cad/ (move them into a layer package): {modules}"
+    assert packages == sorted(n for members in _LAYER_OF.values() for n in members)
 
 
 def test_no_new_upward_import(graph: dict[str, set[str]]) -> None:
