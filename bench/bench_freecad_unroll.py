@@ -1,7 +1,7 @@
 r"""Flat-pattern unrolling inside FreeCAD: the core NURBS evaluator vs FreeCAD's point-by-point path.
 
 The workbench's Flat pattern feature unrolls a Part face by
-``ght_cad.face_unroll.unroll_face_data(flat_pattern.face_data(face), rulings=8, samples=65)``.
+``ght_cad.unrolling.face_unroll.unroll_face_data(flat_pattern.face_data(face), rulings=8, samples=65)``.
 ``face_data(face, fast=True)`` reads B-spline/Bézier surfaces and line/circle/B-spline/Bézier
 pcurves and edge curves into :mod:`ght_cad.surfaces.nurbs` (vectorized, exact pcurve derivatives);
 ``fast=False`` is the old path (``value``/``getDN``/``valueAt`` point by point, pcurve derivatives

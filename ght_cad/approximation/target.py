@@ -24,7 +24,7 @@ class SurfaceTarget:
     r"""A target surface as the approximation sees it: ``jet(u, v, order)`` and its parameter box.
 
     ``jet(u, v, order)`` returns ``[S, S_u, S_v]`` (order 1) or ``[S, S_u, S_v, S_uu, S_vv, S_uv]``
-    (order 2) at 1-D arrays of parameters, each (n, 3) — the :class:`ght_cad.face_unroll.SurfaceAdapter`
+    (order 2) at 1-D arrays of parameters, each (n, 3) — the :class:`ght_cad.unrolling.face_unroll.SurfaceAdapter`
     convention.
 
     Args:

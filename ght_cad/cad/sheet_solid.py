@@ -5,7 +5,7 @@ r"""The sheet as a solid plate (spec 6.1) through OCCT, and plates read back fro
 * A developable :class:`~ght_cad.surfaces.ruled.RuledSurface` (``method="exact"``, the default) gets its
   plate built exactly: the region ``{X(u, v) + t n(u), t between 0 and σT}`` (n is constant along
   each ruling) is bounded by six ruled B-spline faces from ONE joint fit of the four boundary
-  curves ``a, b, a + σT n, b + σT n`` (:func:`ght_cad.plate.plate_bspline`, tolerance
+  curves ``a, b, a + σT n, b + σT n`` (:func:`ght_cad.sheetmetal.plate.plate_bspline`, tolerance
   ``3e-7 T``): ``inside`` (the design surface), ``outside`` (the offset ``S + σT n``, again
   developable with the same rulings), the two rail walls ``c(u) + t n(u)`` (over a fan's apex
   ``P`` the cone patch between ``P`` and the arc ``P + σT n(u)``) and the two planar end walls.
@@ -25,7 +25,7 @@ r"""The sheet as a solid plate (spec 6.1) through OCCT, and plates read back fro
 
 A fit deviation ``d`` changes the volume by about ``d / T`` relative, so a thin plate needs a fit
 far tighter than the surface's size; measured (:attr:`PlateSolid.volume` against
-:func:`ght_cad.plate.plate_volume`): the exact plates of quarter cylinders, a cone frustum and the
+:func:`ght_cad.sheetmetal.plate.plate_volume`): the exact plates of quarter cylinders, a cone frustum and the
 demo strips within 2e-10 to 2.3e-9, the thickened ones within 3e-8 to 1.4e-6; building is 1.3-2x
 the time of thickening (30-70 ms against 15-70 ms per plate).
 
@@ -80,7 +80,7 @@ class PlateSolid:
         edges: the side faces (exact plate: ``[wall_a, end1, wall_b, end0]``, the walls over
             boundary a, the end ruling u = 1, boundary b and the end ruling u = 0).
         sheet: the sheet.
-        data: the exact plate's :class:`ght_cad.plate.PlateBSplineData` (None when thickened by
+        data: the exact plate's :class:`ght_cad.sheetmetal.plate.PlateBSplineData` (None when thickened by
             OCCT).
         surface: the exact plate's design surface (None when thickened by OCCT).
     """
@@ -114,7 +114,7 @@ class PlateSolid:
     @property
     def closed_form_volume(self) -> float | None:
         r"""``V = T A + σ (T²/2) ∫ 2H dA`` of the exact plate's design surface
-        (:func:`ght_cad.plate.plate_volume`); None for a thickened face."""
+        (:func:`ght_cad.sheetmetal.plate.plate_volume`); None for a thickened face."""
         if self.surface is None:
             return None
         from ..sheetmetal.plate import plate_volume
@@ -158,7 +158,7 @@ def _distance_to_surface(face: TopoDS_Face, point: np.ndarray) -> float:
 
 
 def _face_sheet_check(face: TopoDS_Face, sheet: Sheet, label: str) -> None:
-    """The core's curvature check on a CAD face (:class:`ght_cad.sheet.FaceSheet`)."""
+    """The core's curvature check on a CAD face (:class:`ght_cad.sheetmetal.sheet.FaceSheet`)."""
     from ..sheetmetal.sheet import FaceSheet
     from .unroll_faces import _open_face, face_data
 
@@ -180,13 +180,13 @@ def plate_solid(
 
     For a RuledSurface with ``method="exact"`` the solid is the region
     ``{X(u, v) + t n(u) : t between 0 and σT}`` bounded by its six exact faces, volume
-    ``V = T A + σ (T²/2) ∫ 2H dA`` (:func:`ght_cad.plate.plate_volume`).
+    ``V = T A + σ (T²/2) ∫ 2H dA`` (:func:`ght_cad.sheetmetal.plate.plate_volume`).
 
     Args:
         surface_or_face: a developable :class:`~ght_cad.surfaces.ruled.RuledSurface` (fans and other
             breakpoints included) or a build123d/cadquery/OCP face (thickened by OCCT).
         sheet: the sheet, or give ``thickness``, ``k_factor``, ``side``
-            (:func:`ght_cad.sheet.make_sheet`; K does not change the solid).
+            (:func:`ght_cad.sheetmetal.sheet.make_sheet`; K does not change the solid).
         label: name for messages.
         method: for a RuledSurface: ``"exact"`` (the six faces built and sewn, module doc) or
             ``"offset"`` (OCCT's thickening of its single B-spline face; fails on a loft with
@@ -195,11 +195,11 @@ def plate_solid(
     Returns:
         :class:`PlateSolid` (``BRepCheck_Analyzer`` valid); for the exact plate
         ``edges = [wall_a, end1, wall_b, end0]`` and ``data`` its
-        :class:`ght_cad.plate.PlateBSplineData`.
+        :class:`ght_cad.sheetmetal.plate.PlateBSplineData`.
 
     Raises:
         SheetError: no thickness, T = 0, or a thickness beyond a bending radius or on the concave
-            side of an apex (:func:`ght_cad.sheet.check_offset`, before OCCT runs).
+            side of an apex (:func:`ght_cad.sheetmetal.sheet.check_offset`, before OCCT runs).
         GHTError: an unknown ``method``; OCCT failed to make a valid solid.
     """
     if method not in PLATE_METHODS:
@@ -273,7 +273,7 @@ def _offset_plate(face: TopoDS_Face, sheet: Sheet, label: str) -> PlateSolid:
 
 def _exact_plate(surface: RuledSurface, sheet: Sheet, label: str) -> PlateSolid:
     """The exact plate of a developable (module doc): the six B-spline faces of
-    :func:`ght_cad.plate.plate_bspline`, sewn, made a solid and oriented."""
+    :func:`ght_cad.sheetmetal.plate.plate_bspline`, sewn, made a solid and oriented."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
     from OCP.ShapeFix import ShapeFix_Solid
     from OCP.TopAbs import TopAbs_SHELL

@@ -19,9 +19,9 @@ Holes and trimmed boundaries are kept: every wire of the face is traversed in or
 3-D area by Green's theorem in (u, v) with Gauss–Legendre quadrature (:func:`face_area`;
 OCCT's ``BRepGProp`` is only ~1e-8 accurate on extrusions).
 
-This module is the OCP adapter of the kernel-free implementation :mod:`ght_cad.face_unroll`
+This module is the OCP adapter of the kernel-free implementation :mod:`ght_cad.unrolling.face_unroll`
 (shared with the FreeCAD workbench): it describes a ``TopoDS_Face`` as a
-:class:`ght_cad.face_unroll.FaceData` (surface evaluator from ``BRepAdaptor_Surface``, pcurves
+:class:`ght_cad.unrolling.face_unroll.FaceData` (surface evaluator from ``BRepAdaptor_Surface``, pcurves
 from ``BRepAdaptor_Curve2d``, 3-D lengths from ``GCPnts_AbscissaPoint``).
 """
 
@@ -114,7 +114,7 @@ _KINDS = {
 
 
 class _SurfEval(SurfaceAdapter):
-    """A BRepAdaptor_Surface as :class:`ght_cad.face_unroll.SurfaceAdapter`: kind, radius and
+    """A BRepAdaptor_Surface as :class:`ght_cad.unrolling.face_unroll.SurfaceAdapter`: kind, radius and
     semi-angle from OCCT, read once.
 
     Planes, cylinders and cones are evaluated in numpy from their (located) ``gp_Ax3`` position
@@ -201,7 +201,7 @@ class _SurfEval(SurfaceAdapter):
 
     def _analytic(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
         """[S, S_u, S_v, S_uu, S_vv, S_uv] (up to ``order``) of a plane, cylinder or cone
-        (:func:`ght_cad.face_unroll.analytic_jet`)."""
+        (:func:`ght_cad.unrolling.face_unroll.analytic_jet`)."""
         return _core.analytic_jet(self.kind, self._ax, self.radius, self.semi_angle, u, v, order)  # type: ignore[arg-type]
 
     def value(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -246,7 +246,7 @@ class _SurfEval(SurfaceAdapter):
     @property
     def fast_density_grid(self) -> bool:
         """:meth:`density_grid` works on the tensor grid (a B-spline read into the core), not point
-        by point: :func:`ght_cad.face_unroll.face_area` then puts whole pieces on grids."""
+        by point: :func:`ght_cad.unrolling.face_unroll.face_area` then puts whole pieces on grids."""
         return self._ax is None and self._nurbs is not None and self._nurbs.patches is not None
 
     def density_grid(self, s: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -310,7 +310,7 @@ def _array1(arr: Any) -> np.ndarray:
 
 class FaceRuledSurface(_core.FaceRuledSurface):
     r"""The ruled surface of a face whose ``ruled``-isolines are straight lines
-    (:class:`ght_cad.face_unroll.FaceRuledSurface` of a ``BRepAdaptor_Surface``).
+    (:class:`ght_cad.unrolling.face_unroll.FaceRuledSurface` of a ``BRepAdaptor_Surface``).
 
     With ``ruled == "v"`` (rulings along v): ``a(t) = S(u0 + t Δu, v0)``, ``b(t) = S(u0 + t Δu, v1)``,
     ``a^(r)(t) = Δu^r ∂_u^r S``; with ``ruled == "u"`` the roles of u and v swap. ``breakpoints``
@@ -354,7 +354,7 @@ def face_ruling_direction(face: Any) -> tuple[str | None, dict[str, float]]:
 
     Returns:
         ``("v", info)`` when the v-isolines are straight (deviation ``max dist(p, line) / L``
-        < 1e-9, see :func:`ght_cad.face_unroll.isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
+        < 1e-9, see :func:`ght_cad.unrolling.face_unroll.isoline_stats`; a closed isoline deviates by ``1/(2π)``), ``"u"``
         likewise, ``None`` when neither. ``info`` holds ``deviation_u``, ``deviation_v`` (finite,
         relative to the isoline length) and ``openness_u``, ``openness_v`` (smallest chord /
         length; 0 for closed isolines). Planes, cylinders, cones and extrusions return ``"v"``.
@@ -549,16 +549,16 @@ def unroll_face(
     label: str = "P1",
     sheet: Any = None,
 ) -> FlatPattern:
-    """Unroll one build123d/cadquery/OCP face by :func:`ght_cad.face_unroll.unroll_face_data`
+    """Unroll one build123d/cadquery/OCP face by :func:`ght_cad.unrolling.face_unroll.unroll_face_data`
     (closed forms for plane/cylinder/cone, quadrature along the rulings otherwise; see module doc).
 
     Args:
         face: a Face (build123d, cadquery) or TopoDS_Face (or a shape holding exactly one face).
         best_effort, tol_deg, rulings, samples, units, label: as for
-            :func:`ght_cad.face_unroll.unroll_face_data` (flatten a non-developable face with a
+            :func:`ght_cad.unrolling.face_unroll.unroll_face_data` (flatten a non-developable face with a
             distortion report; largest θ_max in degrees; bend lines; points per edge; length
             unit; panel label).
-        sheet: a :class:`ght_cad.sheet.Sheet`: unroll the face's neutral surface (side relative
+        sheet: a :class:`ght_cad.sheetmetal.sheet.Sheet`: unroll the face's neutral surface (side relative
             to the face's normal, orientation included).
 
     Returns:
@@ -585,7 +585,7 @@ def unroll_face(
 
 def face_data(f: TopoDS_Face, ev: _SurfEval, bounds: tuple[float, float, float, float],
               edge_name: Callable[[Any], str] | None = None) -> FaceData:
-    """The face as :class:`ght_cad.face_unroll.FaceData`: every wire (outer first) traversed by
+    """The face as :class:`ght_cad.unrolling.face_unroll.FaceData`: every wire (outer first) traversed by
     ``BRepTools_WireExplorer``, each edge's pcurve, 3-D curve and length (:func:`_edge_samples`);
     edges named ``edge<k>`` in wire order, or ``edge_name(edge)`` (e.g. the solid's edge key,
     the same in both faces sharing an edge)."""

@@ -2,7 +2,7 @@
 
 Modules: :mod:`~ght_cad.developables.envelope` (the envelope of control planes, tangent, rectifying
 and composite developables and their joints, spec 5.2-5.4 and 5.6; old path
-``ght_cad.developable``), :mod:`~ght_cad.developables.canal` (canal surfaces, 5.5),
+``ght_cad.developables.envelope``), :mod:`~ght_cad.developables.canal` (canal surfaces, 5.5),
 :mod:`~ght_cad.developables.fit` (the certified B-spline fit of a ruled surface),
 :mod:`~ght_cad.developables.jets` and :mod:`~ght_cad.developables.checks` (jets and argument
 checks, which need none of the surfaces). ``envelope`` re-imports every name of ``canal``, ``fit``,

@@ -87,7 +87,7 @@ def ruled_pieces(surface: RuledSurface) -> list[RuledPiece]:
 
     The pieces are, in this order of preference: the surface's own ``segments`` when they match
     the breakpoints (a loft: each segment is exact with one-sided jets, ``end_orders`` =
-    ``segment.end_order``); for an :class:`~ght_cad.sheet.OffsetRuledSurface` the offsets of its
+    ``segment.end_order``); for an :class:`~ght_cad.sheetmetal.sheet.OffsetRuledSurface` the offsets of its
     base's pieces (the same δ); otherwise the surface restricted to ``[λ_k, λ_{k+1}]``
     (``end_orders`` 2 at the surface's ends, 0 at interior breakpoints, where only the value is
     one-sided).

@@ -49,7 +49,7 @@ class DesignResult:
         after: ``problem.report`` at the optimum.
         object: the optimized curve or surface.
         shape: its build123d ``Face`` (surface) or ``Edge`` (curve), when ``cad=True``.
-        flat: the :class:`~ght_cad.flat_pattern.FlatPattern` of a surface, when ``flat=True``.
+        flat: the :class:`~ght_cad.pattern.flat_pattern.FlatPattern` of a surface, when ``flat=True``.
         files: written files by kind (``"step"``, ``"dxf"``, ``"png"``, ``"json"``).
         notes: skipped steps and warnings, in words.
     """

@@ -159,7 +159,7 @@ class FlatPattern:
         return None
 
     def forming_table(self) -> str:
-        """Plain-text forming tables (one per panel unrolled with a thickness; :mod:`ght_cad.sheet`,
+        """Plain-text forming tables (one per panel unrolled with a thickness; :mod:`ght_cad.sheetmetal.sheet`,
         :func:`ght_cad.pattern.forming.forming_table_text`)."""
         out = []
         for p in self.panels:

@@ -1,12 +1,12 @@
 r"""Forming data of a flat pattern's bend lines, as the pattern presents it: the row of one bend line
 (:class:`FormingRow`), the plain-text forming table and the roll-bending chart PNG.
 
-The rows are computed from the sheet's neutral surface by :func:`ght_cad.sheet.forming_rows`
-(spec section 6.1); the pattern (:meth:`ght_cad.flat_pattern.FlatPattern.forming_table`,
+The rows are computed from the sheet's neutral surface by :func:`ght_cad.sheetmetal.sheet.forming_rows`
+(spec section 6.1); the pattern (:meth:`ght_cad.pattern.flat_pattern.FlatPattern.forming_table`,
 ``plot_roll_chart``) only reads them back from ``panel.info["sheet"]``. Moved from
-:mod:`ght_cad.sheet` (issue 27) so that the flat pattern no longer imports the sheet, which
+:mod:`ght_cad.sheetmetal.sheet` (issue 27) so that the flat pattern no longer imports the sheet, which
 unrolls into flat patterns (the import cycle flat_pattern -> sheet -> flat_pattern);
-:mod:`ght_cad.sheet` imports every name back.
+:mod:`ght_cad.sheetmetal.sheet` imports every name back.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Laying flat panels out on a sheet, and the matching marks of the edges two panels share.
 
-Moved from :mod:`ght_cad.flat_pattern` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.pattern.flat_pattern` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

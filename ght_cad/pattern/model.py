@@ -1,7 +1,7 @@
 r"""Flat-pattern model: boundary edges, panels, the distortion report and the geometry they use.
 
-Moved from :mod:`ght_cad.flat_pattern` (issue 27; every name stays importable from there). The
-distortion measures are defined in the docstring of :mod:`ght_cad.flat_pattern` (spec section 6).
+Moved from :mod:`ght_cad.pattern.flat_pattern` (issue 27; every name stays importable from there). The
+distortion measures are defined in the docstring of :mod:`ght_cad.pattern.flat_pattern` (spec section 6).
 """
 
 from __future__ import annotations
@@ -341,7 +341,7 @@ class FlatPanel:
     offset: np.ndarray = field(default_factory=lambda: np.zeros(2))
     marks: list[np.ndarray] = field(default_factory=list)
     texts: list[tuple[float, float, str, float]] = field(default_factory=list)
-    #: sheet forming labels (x, y, text, height, rotation in degrees): layer FORMING (ght_cad.sheet)
+    #: sheet forming labels (x, y, text, height, rotation in degrees): layer FORMING (ght_cad.sheetmetal.sheet)
     forming_texts: list[tuple[float, float, str, float, float]] = field(default_factory=list)
     #: bend annotations (x, y, text, height, rotation in degrees): layer BEND (a blank's bend
     #: direction, angle and inside radius, ght_cad.sheetmetal.blank)
@@ -352,9 +352,9 @@ class FlatPanel:
         default_factory=dict, init=False, repr=False, compare=False)
 
     def loop_arcs(self, chord_tol: float) -> list[tuple[np.ndarray, np.ndarray, list[str]]]:
-        """Closed loops as lines and circular arcs (:mod:`ght_cad.outline_arcs`), offset applied.
+        """Closed loops as lines and circular arcs (:mod:`ght_cad.pattern.outline_arcs`), offset applied.
 
-        Every boundary edge becomes an :class:`~ght_cad.outline_arcs.ArcChain`: one exact line or
+        Every boundary edge becomes an :class:`~ght_cad.pattern.outline_arcs.ArcChain`: one exact line or
         arc when its development is one (within ``1e-12`` of the panel's size), else arcs through
         three points of the exact edge within ``chord_tol`` of it. Corners are the development's
         edge end points.

@@ -19,7 +19,7 @@ piece is developed exactly as on its own and the next one is placed by the motio
 The outer loops are merged into one loop (the parent's edges after the shared edge round to
 before it, then the child's, traversed the way that keeps one orientation), the joint becomes a
 bend line (a straight joint: a ruling) or a row of marks (a curved joint), and the joined panel
-is measured again (:func:`ght_cad.flat_pattern.measure_panel`: its flat area is the sum of the
+is measured again (:func:`ght_cad.pattern.flat_pattern.measure_panel`: its flat area is the sum of the
 pieces' to rounding, the shared edges' contributions cancel). Pieces meeting at an angle (a sharp
 chine, G0) are not joined: the angle between the inward conormal of one piece and the outward
 conormal of the other, ``max_k ∠(m_i, -m_j)`` over the edge, must be at most ``tol_deg``. The
@@ -249,7 +249,7 @@ def join_panels(
 
     Args:
         panels: measured panels (outline edges with 3-D points; the edges' ``xyz`` are what is
-            matched, :func:`ght_cad.flat_pattern.shared_edge_pairs`).
+            matched, :func:`ght_cad.pattern.flat_pattern.shared_edge_pairs`).
         conormals: per panel, the inward conormals of its edges (:func:`ruled_conormals`) or None
             (the panel is never joined).
         tol_deg: largest angle between the pieces' tangent half-planes at a joint still joined.

@@ -1,7 +1,7 @@
 r"""The exact plate of a developable design surface as B-spline data (spec 6.1), no CAD kernel.
 
 A sheet of thickness ``T`` on a developable ``X(u, v) = (1-v) a(u) + v b(u)`` (unit normal
-``n(u)``, constant along each ruling; :func:`ght_cad.sheet.ruling_normal`) fills the region
+``n(u)``, constant along each ruling; :func:`ght_cad.sheetmetal.sheet.ruling_normal`) fills the region
 
     P = { X(u, v) + t n(u) : u, v ∈ [0, 1], t between 0 and σT }        (σ = +1 "normal", -1 "reverse")
 
@@ -9,7 +9,7 @@ bounded by six ruled faces, all of degree 1 in their second parameter:
 
 * ``inside``: the design surface ``X`` (net ``[A, B]``);
 * ``outside``: the offset ``X + σT n`` (net ``[A', B']``; again developable with the same
-  rulings, :class:`ght_cad.sheet.OffsetRuledSurface`);
+  rulings, :class:`ght_cad.sheetmetal.sheet.OffsetRuledSurface`);
 * ``wall_a``, ``wall_b``: the walls over the boundary curves, ``c(u) + t n(u)`` for ``c = a, b``
   (nets ``[A, A']``, ``[B, B']``); over a fan whose apex ``P`` is on that boundary the wall is the
   cone patch between the point ``P`` (a collapsed pole row) and the arc ``P + σT n(u)``;
@@ -17,7 +17,7 @@ bounded by six ruled faces, all of degree 1 in their second parameter:
   ``a(e), b(e), b(e) + σT n(e), a(e) + σT n(e)`` (e = 0, 1; a bilinear 2 x 2 net). At a
   **pointed end** (the end ruling has zero length: the boundaries meet at ``P``, a bow) the
   parallelogram collapses to the segment ``P .. P + σT n(e)`` (``n(e)`` the limit normal,
-  :func:`ght_cad.sheet.ruling_normal`): there is no end face, ``inside`` and ``outside`` end in a
+  :func:`ght_cad.sheetmetal.sheet.ruling_normal`): there is no end face, ``inside`` and ``outside`` end in a
   collapsed pole column (a degenerate edge) and the walls ``wall_a``, ``wall_b`` meet along that
   segment (their end pole columns are snapped to the same points).
 
@@ -31,7 +31,7 @@ Every two faces that meet share their boundary curve pole for pole, so a kernel 
 apex) gets its exact point as every pole of that piece.
 
 Volume (the closed form the solid is checked against): with ``e = n × d``, ``d = g/|g|``,
-``ω = n'·e`` (:func:`ght_cad.sheet.bending_radius`: ``ρ_0 = (X_u·e)/ω``) the area element of the
+``ω = n'·e`` (:func:`ght_cad.sheetmetal.sheet.bending_radius`: ``ρ_0 = (X_u·e)/ω``) the area element of the
 offset at ``t`` is ``dA_t = (1 + t/ρ_0) dA``, and ``(1/ρ_0) dA = sgn(X_u·e) ω |g| du dv``, so
 
     V = T A + σ (T²/2) ∫∫ 2H dA = T A + σ (T²/2) ∫_0^1 sgn(X_u·e) ω(u) |g(u)| du
@@ -142,13 +142,13 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
     r"""The six faces of the exact plate of thickness ``T`` on a developable (module doc).
 
     Does not check the sheet against the surface's curvature: call
-    :func:`ght_cad.sheet.check_offset` first (a thickness beyond a bending radius gives a
+    :func:`ght_cad.sheetmetal.sheet.check_offset` first (a thickness beyond a bending radius gives a
     self-intersecting offset).
 
     Args:
         surface: the developable design surface (a :class:`~ght_cad.surfaces.ruled.RuledSurface`, with or
             without ``breakpoints``).
-        sheet: the :class:`ght_cad.sheet.Sheet` (``outside_offset = σ T``; K does not change the
+        sheet: the :class:`ght_cad.sheetmetal.sheet.Sheet` (``outside_offset = σ T``; K does not change the
             solid).
         tol: deviation bound of the 12-D fit at matched parameters; default
             ``max(3e-7 T, 64 ulp × size)`` (a deviation ``d`` changes the volume by about
@@ -160,7 +160,7 @@ def plate_bspline(surface: RuledSurface, sheet: Any, *, tol: float | None = None
 
     Raises:
         GHTError: not a ruled surface, no sheet thickness, bad ``tol``/``degree``; a
-            :class:`ght_cad.sheet.SheetError` where the normal is undefined (a zero ruling).
+            :class:`ght_cad.sheetmetal.sheet.SheetError` where the normal is undefined (a zero ruling).
         ConversionError: the fit did not reach ``tol``.
     """
     from ..developables.envelope import _size, ruled_pieces
@@ -223,11 +223,11 @@ def plate_volume(surface: RuledSurface, sheet: Any, *, rtol: float = 1e-13) -> f
 
     ``A`` the surface's area (:func:`ght_cad.unroll.ruled_area`), ``ω = n'·e``, ``e = n × d``,
     ``X_u`` at mid-ruling; both integrals by adaptive Gauss–Legendre piecewise between the
-    ``breakpoints``. Valid while the offset is regular (:func:`ght_cad.sheet.check_offset`).
+    ``breakpoints``. Valid while the offset is regular (:func:`ght_cad.sheetmetal.sheet.check_offset`).
 
     Args:
         surface: the developable.
-        sheet: the :class:`ght_cad.sheet.Sheet` (thickness > 0).
+        sheet: the :class:`ght_cad.sheetmetal.sheet.Sheet` (thickness > 0).
         rtol: relative tolerance of the quadratures.
 
     Raises:

@@ -254,7 +254,7 @@ def ruling_normal(surface: RuledSurface, u: Any, order: int = 1) -> list[np.ndar
         n(u0) = s M/|M|,   n'(u0) = (s M' - n (n·s M')) / |M|,
 
     ``s = +1`` at u0 = 0 and ``-1`` at u0 = 1 (u approaches from inside the strip). ``n''`` there
-    is the one-sided difference of n' (:func:`ght_cad.face_unroll.fd_derivative`).
+    is the one-sided difference of n' (:func:`ght_cad.unrolling.face_unroll.fd_derivative`).
 
     Raises:
         SheetError: a ruling where the normal is undefined (``m = 0`` on a ruling of positive
@@ -489,10 +489,10 @@ class OffsetRuledSurface(RuledSurface):
         return self.base.ruling(u, derivative)
 
 
-# -- faces (kernel-free adapters of ght_cad.face_unroll) -----------------------------------------
+# -- faces (kernel-free adapters of ght_cad.unrolling.face_unroll) -----------------------------------------
 class OffsetSurfaceAdapter:
     r"""``S + δ n`` of a face's surface (``n = o N/|N|``, ``N = S_u × S_v``, ``o = -1`` for a face
-    whose orientation is reversed), as a :class:`ght_cad.face_unroll.SurfaceAdapter`.
+    whose orientation is reversed), as a :class:`ght_cad.unrolling.face_unroll.SurfaceAdapter`.
 
     ``n_u = (N_u - n (n·N_u)) / |N|`` with ``N_u = S_uu × S_v + S_u × S_uv`` (likewise ``n_v``);
     the second derivatives of the offset (only used for ruled-surface second derivatives) by
@@ -713,7 +713,7 @@ def sheet_info(sheet: Sheet, edges: list[EdgeLengths], rows: list[FormingRow], c
 __all__ += ["EdgeLengths", "offset_length", "sheet_info"]
 
 
-# -- unrolling hooks (called by ght_cad.unroll and ght_cad.face_unroll for T > 0) --------------
+# -- unrolling hooks (called by ght_cad.unroll and ght_cad.unrolling.face_unroll for T > 0) --------------
 def _label_height(panel: Any) -> float:
     lo, hi = panel.bbox()
     return 0.012 * float(np.max(hi - lo))
@@ -745,7 +745,7 @@ def unroll_ruled_sheet(surface: RuledSurface, sheet: Sheet, *, label: str = "P1"
     r"""Flat pattern of the neutral offset ``S + δ n`` of a ruled surface (module doc).
 
     Checks the offset (:func:`check_offset`), unrolls :class:`OffsetRuledSurface` by
-    :func:`ght_cad.ruled_development.unroll_ruled_surface`, and puts into ``panel.info["sheet"]`` the sheet, the
+    :func:`ght_cad.unrolling.ruled_development.unroll_ruled_surface`, and puts into ``panel.info["sheet"]`` the sheet, the
     inside/neutral/outside lengths of the four boundary edges (``Σ_k ∫_{u_k}^{u_{k+1}} |a' + t n'| du``
     by adaptive Gauss–Legendre on every smooth piece between the surface's ``breakpoints``,
     ``t = 0, δ, σT``; rulings keep their length), the forming rows of the bend
@@ -790,11 +790,11 @@ def unroll_ruled_sheet(surface: RuledSurface, sheet: Sheet, *, label: str = "P1"
 
 
 class FaceSheet:
-    r"""The sheet hook of :func:`ght_cad.face_unroll.unroll_face_data` for one face.
+    r"""The sheet hook of :func:`ght_cad.unrolling.face_unroll.unroll_face_data` for one face.
 
     The neutral surface is :class:`OffsetSurfaceAdapter` (``δ = σ K T`` along the face normal,
     orientation included); curvature checks and forming data use the base face's ruled surface
-    (:class:`ght_cad.face_unroll.FaceRuledSurface` along its ruling direction).
+    (:class:`ght_cad.unrolling.face_unroll.FaceRuledSurface` along its ruling direction).
 
     Raises:
         SheetError: a thickness beyond a bending radius (:func:`check_offset`).

@@ -178,7 +178,7 @@ def unroll_face_data(
     first); the rulings' ends and 3-D lengths (:func:`_ruling_ends`, :func:`_ruling_lengths_3d`)
     and the bend lines clipped in (u, v) (:func:`_bend_rulings_uv`); one batched evaluation of the
     map (:class:`_MapBatch`) for the outline samples, the rulings and the metric stencil; the
-    panel measured (:func:`ght_cad.flat_pattern.measure_panel`) and placed at the origin.
+    panel measured (:func:`ght_cad.pattern.flat_pattern.measure_panel`) and placed at the origin.
 
     Args:
         face: the face's surface, bounds and wires.
@@ -192,9 +192,9 @@ def unroll_face_data(
         samples: points per boundary edge in the outline polylines.
         units: length unit of the model.
         label: panel label.
-        sheet: a :class:`ght_cad.sheet.Sheet` with ``T > 0``: the face's neutral offset
+        sheet: a :class:`ght_cad.sheetmetal.sheet.Sheet` with ``T > 0``: the face's neutral offset
             ``S + σ K T n`` (n the face normal, orientation included) is unrolled instead
-            (:class:`ght_cad.sheet.FaceSheet`: cylinders/cones keep their closed forms with the
+            (:class:`ght_cad.sheetmetal.sheet.FaceSheet`: cylinders/cones keep their closed forms with the
             offset radius); ``panel.info["sheet"]`` holds edge lengths and forming data.
 
     Returns:

@@ -16,13 +16,13 @@ panels by Chebyshev interpolants of degree 24 (first-kind nodes) and integrated 
 ``1e-13`` of the pattern size, which gives positions to near machine precision — not the O(h²) of
 a triangle strip. The result is checked (not assumed): ruling lengths, boundary lengths (Romberg
 extrapolated chord sums), area (Green's theorem, Romberg) and the angles of the first fundamental
-form are compared with their 3-D values in :class:`ght_cad.flat_pattern.DistortionReport`.
+form are compared with their 3-D values in :class:`ght_cad.pattern.flat_pattern.DistortionReport`.
 
 This module holds the development of one ruled surface (no sheet, no CAD face):
 :class:`RuledDevelopment`, the checks of the result and :func:`unroll_ruled_surface`; the public
 entry points (:func:`ght_cad.unroll.unroll`, :func:`ght_cad.unroll.unroll_ruled` with a sheet,
 :func:`ght_cad.unroll.unroll_composite`) are in :mod:`ght_cad.unroll`, which imports every name
-back. Moved from :mod:`ght_cad.unroll` (issue 27) so that the sheet (:mod:`ght_cad.sheet`), the
+back. Moved from :mod:`ght_cad.unrolling.unroll` (issue 27) so that the sheet (:mod:`ght_cad.sheetmetal.sheet`), the
 face unrolling and the panel joiner use the development without importing ``ght_cad.unroll``,
 which uses them (the import cycle unroll -> sheet -> unroll, unroll -> join_panels -> unroll).
 numpy only.
@@ -232,7 +232,7 @@ def _panel_nodes(edges: np.ndarray) -> np.ndarray:
 
 def first_nodes(breakpoints: Sequence[float] = ()) -> np.ndarray:
     """The parameters where :class:`RuledDevelopment` with these ``breakpoints`` first evaluates
-    its surface (a caller evaluating boundary jets ahead, :meth:`ght_cad.face_unroll.
+    its surface (a caller evaluating boundary jets ahead, :meth:`ght_cad.unrolling.face_unroll.
     FaceRuledSurface.prefetch`, gives it these)."""
     return _panel_nodes(_initial_edges(breakpoints))
 

@@ -1,10 +1,10 @@
 r"""Unrolling developable surfaces and faces into flat patterns (spec 6): the entry points.
 
 :func:`unroll` takes a ruled surface (developed by quadrature along the rulings,
-:mod:`ght_cad.ruled_development`, where the formulas are), a CAD face, or a list of them
-(:func:`unroll_composite`, one panel per part or joined blanks, :mod:`ght_cad.join_panels`); with
-a sheet the neutral surface is developed (:func:`ght_cad.sheet.unroll_ruled_sheet`). The names of
-:mod:`ght_cad.ruled_development` (``RuledDevelopment``, ``ruled_area``, ``DEFAULT_TOL_DEG``,
+:mod:`ght_cad.unrolling.ruled_development`, where the formulas are), a CAD face, or a list of them
+(:func:`unroll_composite`, one panel per part or joined blanks, :mod:`ght_cad.sheetmetal.join_panels`); with
+a sheet the neutral surface is developed (:func:`ght_cad.sheetmetal.sheet.unroll_ruled_sheet`). The names of
+:mod:`ght_cad.unrolling.ruled_development` (``RuledDevelopment``, ``ruled_area``, ``DEFAULT_TOL_DEG``,
 ``metric_angles`` ...) were defined here before issue 27 and are still importable from here.
 
 Non-ruled input (build123d / OCP faces) is handed to :mod:`ght_cad.cad.unroll_faces` (imported
@@ -24,7 +24,7 @@ from ..core.errors import GHTError
 from ..core._validate import is_real
 from ..pattern.flat_pattern import BoundaryEdge, FlatPanel, FlatPattern, measure_panel  # noqa: F401
 from ..surfaces.ruled import RuledSurface
-# the development of one ruled surface moved to ght_cad.ruled_development (issue 27); every name is still given here
+# the development of one ruled surface moved to ght_cad.unrolling.ruled_development (issue 27); every name is still given here
 from .ruled_development import (_EDGES0, _INT, _K, _N, _ONES, _V, _VI, _X, DEFAULT_TOL_DEG, RULED_EDGE_UV,  # noqa: F401
                                 RuledDevelopment, _PanelSeries, _check_developable, _cheb_rows_of, _chebint, _clenshaw,
                                 _coefficients, _fd5, _frame, _initial_edges, _metric_samples, _panel_nodes, _ruled_edges,
@@ -61,8 +61,8 @@ def unroll_ruled(
         surface: the ruled surface (u, v ∈ [0, 1]).
         best_effort, tol_deg, rulings, samples, units, label: as in :func:`unroll`.
         breakpoints: parameters where a, b are not smooth (B-spline knots).
-        sheet: a :class:`ght_cad.sheet.Sheet` with ``T > 0``: the pattern is the development of
-            the neutral offset ``S + σ K T n`` (:func:`ght_cad.sheet.unroll_ruled_sheet`); None
+        sheet: a :class:`ght_cad.sheetmetal.sheet.Sheet` with ``T > 0``: the pattern is the development of
+            the neutral offset ``S + σ K T n`` (:func:`ght_cad.sheetmetal.sheet.unroll_ruled_sheet`); None
             or ``T = 0``: the surface itself.
 
     Returns:
@@ -116,8 +116,8 @@ def unroll(
         samples: points per boundary edge in the outline polylines.
         units: length unit of the coordinates ("mm", "cm", "m", "in", "ft"); DXF $INSUNITS.
         label: panel label.
-        sheet: a :class:`ght_cad.sheet.Sheet` (thickness, K-factor, side), or give
-        thickness, k_factor, din_k_factor, side: the sheet's values (:func:`ght_cad.sheet.make_sheet`;
+        sheet: a :class:`ght_cad.sheetmetal.sheet.Sheet` (thickness, K-factor, side), or give
+        thickness, k_factor, din_k_factor, side: the sheet's values (:func:`ght_cad.sheetmetal.sheet.make_sheet`;
             K default 0.5, DIN k = 2K, side "normal" = material along the surface normal or
             "reverse"). With ``T > 0`` the pattern is the development of the neutral surface
             ``S + δ n``, ``δ = ±K T`` (spec 6.1), ``panel.info["sheet"]`` holds the inside, neutral
@@ -181,7 +181,7 @@ _UNITS = ("mm", "cm", "m", "in", "ft", "unitless")
 
 
 def _sheet_arg(sheet: Any, thickness: Any, k_factor: Any, din_k_factor: Any, side: str) -> Any:
-    """The Sheet of ``sheet=`` or of the loose values (:func:`ght_cad.sheet.make_sheet`); None
+    """The Sheet of ``sheet=`` or of the loose values (:func:`ght_cad.sheetmetal.sheet.make_sheet`); None
     when neither is given. Giving both is refused."""
     loose = thickness is not None or k_factor is not None or din_k_factor is not None or side != "normal"
     if sheet is None and not loose:
@@ -238,7 +238,7 @@ def unroll_composite(
         labels: panel labels (default P1, P2, ...).
         gap: spacing between panels in model units.
         best_effort, tol_deg, rulings, samples, units: as in :func:`unroll`.
-        sheet: one :class:`ght_cad.sheet.Sheet` for every part, or a sequence of them (one per
+        sheet: one :class:`ght_cad.sheetmetal.sheet.Sheet` for every part, or a sequence of them (one per
             part, None for none): each panel is its part's neutral surface.
         marks_on: ``"pattern"``: edges are matched on the panels' own 3-D edges (the neutral
             surfaces' with a sheet); ``"design"``: on the design surfaces' edges at the same
@@ -247,7 +247,7 @@ def unroll_composite(
             marks, at the same rail points (ruled parts; faces keep their own edges).
         join: ruled parts that share a whole boundary edge and meet there at G1 or smoother
             (tangent half-planes within ``tol_deg`` of each other, on opposite sides) become one
-            panel (:func:`ght_cad.join_panels.join_panels`: every part developed as on its own,
+            panel (:func:`ght_cad.sheetmetal.join_panels.join_panels`: every part developed as on its own,
             placed by the rigid motion that continues its neighbour across the shared edge, the
             joint a bend line or marks); parts meeting at an angle (chines) stay apart with marks.
         join_label: the label of a blank made of all parts (default: the labels joined by ``+``).

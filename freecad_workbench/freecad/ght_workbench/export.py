@@ -211,7 +211,7 @@ def write_svg(path: str | os.PathLike, layers: dict[str, list[list[tuple[float, 
 
 
 def export_flat_pattern_dxf(obj: Any, path: str | os.PathLike, deflection: float = 1e-3) -> str:
-    """DXF of a flat pattern feature, written by the core (:meth:`ght_cad.flat_pattern.FlatPattern.export_dxf`).
+    """DXF of a flat pattern feature, written by the core (:meth:`ght_cad.pattern.flat_pattern.FlatPattern.export_dxf`).
 
     The same file as ``ght-cad unroll --dxf``: layers OUTLINE (every loop one closed polyline),
     BEND (bend lines, linetype DASHED), LABELS and MARKS, ``$INSUNITS`` millimetres; R12 ASCII in

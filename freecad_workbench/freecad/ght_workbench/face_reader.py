@@ -1,4 +1,4 @@
-r"""FreeCAD faces as the core's face data (:class:`ght_cad.face_unroll.FaceData`): the reader shared by
+r"""FreeCAD faces as the core's face data (:class:`ght_cad.unrolling.face_unroll.FaceData`): the reader shared by
 the Flat pattern feature (:mod:`.flat_pattern`) and the sheet-skin reader (:mod:`.sheet_skin`).
 
 FreeCAD's ``face.Surface`` (B-spline and Bézier surfaces read into the core's :mod:`ght_cad.surfaces.nurbs`,
@@ -142,7 +142,7 @@ def _placement(s: Any, kind: str) -> tuple[np.ndarray, ...] | None:
 
 
 class FreeCADSurface(SurfaceAdapter):
-    """A FreeCAD ``face.Surface`` as :class:`ght_cad.face_unroll.SurfaceAdapter`.
+    """A FreeCAD ``face.Surface`` as :class:`ght_cad.unrolling.face_unroll.SurfaceAdapter`.
 
     ``kind`` from the surface's Python type, ``radius`` (``Radius``) and ``semi_angle``
     (``SemiAngle``) for cylinders and cones, ``ruled_hint`` for B-spline/Bézier surfaces of degree
@@ -150,7 +150,7 @@ class FreeCADSurface(SurfaceAdapter):
     vectorized evaluator (:func:`read_surface`, :class:`ght_cad.surfaces.nurbs.NurbsSurface`) when it
     agrees with FreeCAD's ``value``/``getDN`` at four points to 1e-12 of the size (derivatives
     relative to their own size); planes, cylinders and cones are evaluated in numpy by OCCT's
-    formulas (:func:`ght_cad.face_unroll.analytic_jet`) from their placement (``Center`` or
+    formulas (:func:`ght_cad.unrolling.face_unroll.analytic_jet`) from their placement (``Center`` or
     ``Position``, ``Rotation``), after the same agreement check. ``path`` says which evaluation is
     used: ``"nurbs"``, ``"analytic"`` or ``"freecad"`` (points by ``value(u, v)`` and partials by
     ``getDN(u, v, i, j)`` one by one; location included: ``face.Surface`` is already placed).
@@ -293,7 +293,7 @@ class _Edge:
     evaluated in numpy (:func:`read_curve`) with exact pcurve derivatives; ``paths`` says which
     (``{"pcurve": "line" | "circle" | "bspline" | "freecad", "curve3d": ...}``). Other curves (and
     ``fast=False``): point by point, pcurve derivatives by finite differences between knots
-    (:func:`ght_cad.face_unroll.fd_derivative`: FreeCAD 0.20.2 has no pcurve derivative binding).
+    (:func:`ght_cad.unrolling.face_unroll.fd_derivative`: FreeCAD 0.20.2 has no pcurve derivative binding).
     """
 
     def __init__(self, face: "Part.Face", edge: "Part.Edge", surface: FreeCADSurface, fast: bool = True) -> None:
@@ -372,13 +372,13 @@ class _Edge:
 
 
 def face_data(face: "Part.Face", fast: bool = True, edge_name: Callable[[Any], str] | None = None) -> FaceData:
-    """A FreeCAD face as :class:`ght_cad.face_unroll.FaceData` (the adapter of this workbench).
+    """A FreeCAD face as :class:`ght_cad.unrolling.face_unroll.FaceData` (the adapter of this workbench).
 
     Wires: ``face.OuterWire`` first, then the other wires of ``face.Wires`` (holes), each in
     ``OrderedEdges`` order, edges named ``edge<k>`` in wire order or ``edge_name(edge)`` (a solid's
     edge key, :mod:`.sheet_skin`); every edge's pcurve is traversed in its orientation and, on periodic
     surfaces, shifted by whole periods so each loop is continuous in (u, v)
-    (:func:`ght_cad.face_unroll.chain_loop`) and lies in ``face.ParameterRange``.
+    (:func:`ght_cad.unrolling.face_unroll.chain_loop`) and lies in ``face.ParameterRange``.
 
     Raises:
         GHTError: an edge without a pcurve.

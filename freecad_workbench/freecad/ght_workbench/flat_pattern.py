@@ -5,7 +5,7 @@ by :func:`ght_cad.unroll`, quadrature along the rulings) or any face of any Free
 surface is developable: the lateral face of a ``Part::Cylinder`` / ``Part::Cone`` (closed-form
 maps), a plane, a surface of extrusion, a ruled B-spline or Bézier face (``Part::RuledSurface``,
 re-imported STEP), trimmed or with holes. Faces go through the kernel-free
-:func:`ght_cad.face_unroll.unroll_face_data` (the same code that unrolls build123d/OCP faces)
+:func:`ght_cad.unrolling.face_unroll.unroll_face_data` (the same code that unrolls build123d/OCP faces)
 via the adapter :mod:`.face_reader` (:func:`face_data`): FreeCAD's ``face.Surface`` (B-spline and
 Bézier surfaces read into the core's :mod:`ght_cad.surfaces.nurbs`, others evaluated with
 ``value``/``getDN``), every wire (``OuterWire`` first) in ``OrderedEdges`` order with its pcurve
@@ -15,7 +15,7 @@ isolines' deviation or θ_max / DD unless ``BestEffort``.
 
 Sheet metal (spec 6.1): with ``Thickness`` T > 0, ``KFactor`` K and ``Side`` (material along the
 face/surface normal or against it) the pattern is the development of the neutral surface
-``S ± K T n`` (:mod:`ght_cad.sheet`); with Thickness 0 and a face of a solid plate (a SheetMetal
+``S ± K T n`` (:mod:`ght_cad.sheetmetal.sheet`); with Thickness 0 and a face of a solid plate (a SheetMetal
 base bend, ``Part::Thickness``, ``makeThickness``, a GHT Plate) the thickness, inside face and side
 are read from the solid (:func:`plate_partner`; a GHT Plate, :mod:`.plate`, gives its inside face,
 exact thickness and K-factor; as Source without a face it stands for its inside face). ``FormingTable`` lists each bend line's neutral bending
@@ -54,7 +54,7 @@ __all__ = [
     "plate_partner",
 ]
 
-#: the Side property's values (ght_cad.sheet.SIDES): material along / against the face normal
+#: the Side property's values (ght_cad.sheetmetal.sheet.SIDES): material along / against the face normal
 SIDES = ["normal", "reverse"]
 
 def face_of_source(obj: Any) -> "Part.Face | None":
@@ -247,7 +247,7 @@ class FlatPatternFeature(FeatureProxy):
         return None, face
 
     def pattern(self, obj: Any) -> Any:
-        """The core :class:`ght_cad.flat_pattern.FlatPattern` of the source."""
+        """The core :class:`ght_cad.pattern.flat_pattern.FlatPattern` of the source."""
         from ght_cad import unroll
 
         if int(obj.BendLines) < 0:

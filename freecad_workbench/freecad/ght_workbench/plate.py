@@ -3,7 +3,7 @@ r"""The exact solid plate of a developable feature (spec 6.1): six B-spline face
 A sheet of thickness ``T`` on the core surface ``X(u, v)`` of a developable feature of this
 workbench (``Source``: from planes, joined, loft, spine/geodesic) fills
 ``{X(u, v) + t n(u) : t between 0 and σT}`` (``σ = +1`` for ``Side = normal``, -1 for ``reverse``;
-n is constant along a ruling). :func:`ght_cad.plate.plate_bspline` gives its six ruled faces as
+n is constant along a ruling). :func:`ght_cad.sheetmetal.plate.plate_bspline` gives its six ruled faces as
 plain B-spline data (``inside`` = the design surface, ``outside`` = the offset ``X + σT n``, the
 walls over the two boundary curves and the two planar end walls; degree 1 across, faces that meet
 share their boundary poles exactly); here they become ``Part.BSplineSurface`` faces
@@ -13,7 +13,7 @@ of 12 shared edges, made a ``Part.Solid``, oriented outwards (``Volume > 0``) an
 (``isValid()``). This is not OCCT's thickening (``Part::Thickness``), which is approximate and
 fails on lofts with fans (cone apexes).
 
-Volumes. ``ClosedFormVolume`` is :func:`ght_cad.plate.plate_volume`,
+Volumes. ``ClosedFormVolume`` is :func:`ght_cad.sheetmetal.plate.plate_volume`,
 ``V = T A + σ (T²/2) ∫ 2H dA``. FreeCAD's ``Shape.Volume`` (``ShapeVolume``) integrates each
 B-spline face with ONE Gauss rule over its whole parameter box (OCCT's default rule), which reads
 the C0 joint rulings of a loft with fans about 1.5e-3 low. ``Volume`` is therefore FreeCAD's
@@ -82,7 +82,7 @@ def sew_tolerance(size: float, thickness: float) -> float:
 
 
 def plate_shape(data: Any, thickness: float, what: str = "the plate") -> tuple["Part.Solid", list["Part.BSplineSurface"]]:
-    """The solid of :class:`ght_cad.plate.PlateBSplineData` (module doc) and its six surfaces.
+    """The solid of :class:`ght_cad.sheetmetal.plate.PlateBSplineData` (module doc) and its six surfaces.
 
     Raises:
         GHTError: a face that is not a valid B-rep, a shell that does not close, an invalid or
@@ -163,7 +163,7 @@ class PlateFeature(FeatureProxy):
         return proxy.surface(src)
 
     def sheet(self, obj: Any) -> Any:
-        """The :class:`ght_cad.sheet.Sheet` of the properties (T > 0).
+        """The :class:`ght_cad.sheetmetal.sheet.Sheet` of the properties (T > 0).
 
         Raises:
             SheetError: T <= 0, K outside [0, 1], an unknown side (naming the property).

@@ -242,7 +242,7 @@ def panel_sheets(result: Any, target: Any, sheet: Any) -> list[Any] | None:
     can point the other way: the strips run along the target's u, v or a diagonal (``direction``), and a cone
     panel with its apex on the strip's first seam has its rail as ``a``; where
     ``n · (X_u × X_v) < 0`` at the panel's middle (``u = v = 1/2``, the target at the middle of its
-    strip) the panel gets :meth:`ght_cad.sheet.Sheet.flipped`, so ``side = "normal"`` puts the
+    strip) the panel gets :meth:`ght_cad.sheetmetal.sheet.Sheet.flipped`, so ``side = "normal"`` puts the
     material of every panel on the target's normal side."""
     if sheet is None or sheet.is_zero:
         return None

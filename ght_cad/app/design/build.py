@@ -222,8 +222,8 @@ def inside_radius(surface: Any, side: str, thickness: float, *, samples: int = 5
     r"""The smallest inside bending radius of a sheet on the surface (spec 6.1).
 
     Over :func:`sheet_parts`, at ``samples`` rulings and both ruling ends (the grid of
-    :func:`ght_cad.sheet.check_offset`): the design surface has the signed bending radius
-    ``ρ_0 = (X_u·e)/ω`` (:func:`ght_cad.sheet.bending_radius`), the other skin ``ρ_0 + σ T``
+    :func:`ght_cad.sheetmetal.sheet.check_offset`): the design surface has the signed bending radius
+    ``ρ_0 = (X_u·e)/ω`` (:func:`ght_cad.sheetmetal.sheet.bending_radius`), the other skin ``ρ_0 + σ T``
     (``σ = +1`` for ``side="normal"``, -1 for ``"reverse"``), and the inside radius of the bend is
     the smaller one, ``R = min(|ρ_0|, |ρ_0 + σ T|)``; apex ends (a stationary boundary, the point of
     a cone or fan) are skipped as in ``check_offset``. ``inf`` for a flat surface.
@@ -269,7 +269,7 @@ def table_k_factor(sheet: Any, surface: Any) -> Any:
 def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int = 513) -> float:
     r"""The sheet check the run applies to a built surface (spec 6.1), on every part.
 
-    For each part of :func:`sheet_parts` :func:`ght_cad.sheet.check_offset` (the rule the plate
+    For each part of :func:`sheet_parts` :func:`ght_cad.sheetmetal.sheet.check_offset` (the rule the plate
     solid and the flat pattern of ``ght-cad run`` apply, with their default ``samples = 513``
     rulings, both ends of each): refused when the neutral offset reaches a bending radius,
     ``|K T| >= |ρ_0|``, when the material reaches a centre of curvature, ``ρ_0 (ρ_0 + σ T) <= 0``, or
@@ -278,7 +278,7 @@ def check_sheet(design: Design, surface: Any, *, sheet: Any = None, samples: int
     Args:
         design: the design (its ``[sheet]`` and its name for the messages).
         surface: the design's built surface (``BuiltSurface.surface``).
-        sheet: a :class:`ght_cad.sheet.Sheet` to check instead of the design's (the optimizer
+        sheet: a :class:`ght_cad.sheetmetal.sheet.Sheet` to check instead of the design's (the optimizer
             passes the sheet with its margin); None: the design's ``[sheet]``.
         samples: rulings per part (>= 2).
 

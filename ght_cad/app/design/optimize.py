@@ -2,7 +2,7 @@ r"""Shape-parameter optimization of a design's surface (spec sections 7, 8) thro
 
 **Sheet rule.** A design with a ``[sheet]`` of thickness ``T > 0`` is optimized over the shape
 parameters the sheet can be made from: every candidate surface gets the check the run applies
-to the built surface (:func:`ght_cad.app.design.build.check_sheet`: :func:`ght_cad.sheet.check_offset`
+to the built surface (:func:`ght_cad.app.design.build.check_sheet`: :func:`ght_cad.sheetmetal.sheet.check_offset`
 on every part, 513 rulings, both ends of each), on the sheet of thickness ``(1 + SHEET_MARGIN) T``
 (same K, same side), and a refused candidate gets ``+inf`` like a degenerate one. With
 ``T' = (1 + m) T`` the accepted candidates satisfy, at every checked ruling end,
@@ -616,7 +616,7 @@ def _sheet_summary(guard: _SheetGuard, start: dict[str, Any], rmin: float, rejec
     }
 
 
-#: the rules of :func:`ght_cad.sheet.check_offset` in words
+#: the rules of :func:`ght_cad.sheetmetal.sheet.check_offset` in words
 _RULE_TEXT = {
     "radius": "the neutral offset |K*T| reaching a bending radius",
     "centre": "the material reaching a centre of curvature",

@@ -155,7 +155,7 @@ def unroll_surface(built: BuiltSurface) -> Any:
     """Flat pattern of the built surface (:func:`ght_cad.unroll`).
 
     A composite's strips (joined G1..G3) are one blank labelled with the design's name
-    (``[unroll] panels = "joined"``, the default; :func:`ght_cad.join_panels.join_panels`) or one
+    (``[unroll] panels = "joined"``, the default; :func:`ght_cad.sheetmetal.join_panels.join_panels`) or one
     panel per strip (``"per-surface"``). A ``curves`` strip is flattened with ``best_effort=True`` (it is only quasi-developable); its
     distortion is then in the pattern's errors.
     """
@@ -247,7 +247,7 @@ def unroll_surfaces(builts: Sequence[BuiltSurface]) -> Any:
     (:func:`ght_cad.unroll.unroll_composite`: panels laid side by side, matching edge marks ``E<k>``
     on the edges two panels share in 3-D, e.g. a common rail). With ``[unroll] panels = "joined"``
     (the default) surfaces and strips meeting at G1 or smoother along a whole shared edge are one
-    blank (:func:`ght_cad.join_panels.join_panels`); sharp chines stay separate panels with marks."""
+    blank (:func:`ght_cad.sheetmetal.join_panels.join_panels`); sharp chines stay separate panels with marks."""
     if len(builts) == 1:
         return unroll_surface(builts[0])
     from ...unrolling.unroll import unroll_composite
@@ -340,7 +340,7 @@ def export_files(design: Design, files: Iterable[str | os.PathLike], chord_tol: 
         files: output paths; the suffix selects the content.
         chord_tol: DXF/SVG outline chord tolerance in the design's units; it takes precedence
             over the file's ``[outputs] chord_tol`` (None: that key, else 1e-3 mm,
-            :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
+            :attr:`ght_cad.pattern.flat_pattern.FlatPattern.chord_tol`).
 
     Raises:
         DesignError: a suffix that is not allowed, a surface output without [surface].

@@ -148,7 +148,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
         timeout: with ``wait``, give up after this many seconds (None: no limit).
         chord_tol: DXF/SVG outline chord tolerance in the design's units; it takes precedence
             over the file's ``[outputs] chord_tol`` (None: that key, else 1e-3 mm,
-            :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`).
+            :attr:`ght_cad.pattern.flat_pattern.FlatPattern.chord_tol`).
 
     Returns:
         The report dictionary (the content of ``report.json``).
@@ -286,7 +286,7 @@ def run_design(design: Design, out_dir: str | os.PathLike, *, progress: bool = T
                 elif plates:
                     closed = [p.closed_form_volume for p in plates]
                     report["plate"] = {"valid": True, "solids": len(plates), "volume": float(sum(p.volume for p in plates)),
-                                       # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.plate.plate_volume)
+                                       # V = T A + σ (T²/2) ∫ 2H dA of the exact plates (ght_cad.sheetmetal.plate.plate_volume)
                                        "volume_closed_form": None if None in closed else float(sum(closed)),
                                        **built.design.sheet.to_sheet().as_dict(), **_table_entry(built.design.sheet)}
                 if "step" in want_files:

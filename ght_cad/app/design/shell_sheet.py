@@ -1,7 +1,7 @@
 r"""A ``[sheet]`` on several surfaces (``[[surfaces]]``): one shell, the material on one side of it.
 
 Orientation rule. Every part of a surface is a ruled surface ``X(u, v) = a(u) + v g(u)`` with the
-unit normal ``n = X_u × X_v / |X_u × X_v|`` (:func:`ght_cad.sheet.ruling_normal`). That normal
+unit normal ``n = X_u × X_v / |X_u × X_v|`` (:func:`ght_cad.sheetmetal.sheet.ruling_normal`). That normal
 orients the parameter square counter-clockwise, so it induces on the boundary ``a`` the direction
 ``+a'(u)`` and on ``b`` the direction ``-b'(u)``. Two surfaces sharing a rail (a boundary ``a`` or
 ``b`` of one lies on a boundary of the other: points within ``1e-6`` of the model size) are

@@ -219,7 +219,7 @@ def unroll_step(
     ``(u, v) ↦ (R u, v)`` and cones ``ρ (cos(s u), sin(s u))``; quadrature along the rulings
     ``φ = ∫ d'·e``, ``A = ∫ (a'·d) D + (a'·e) D⊥`` for other ruled faces). Panels are labelled
     ``F<n>`` with the 1-based face number ``n`` (file order, ``TopExp_Explorer``); edges shared
-    by two selected faces get matching edge marks (:func:`ght_cad.flat_pattern.mark_shared_edges`).
+    by two selected faces get matching edge marks (:func:`ght_cad.pattern.flat_pattern.mark_shared_edges`).
 
     Args:
         path: ``.step``/``.stp`` file.
@@ -230,7 +230,7 @@ def unroll_step(
             declared length unit, else mm. Coordinates are converted by OCCT's reader.
         tol_deg: largest accepted ``θ_max`` in degrees.
         rulings: bend lines per face.
-        thickness, k_factor, din_k_factor, side: the sheet (:func:`ght_cad.sheet.make_sheet`,
+        thickness, k_factor, din_k_factor, side: the sheet (:func:`ght_cad.sheetmetal.sheet.make_sheet`,
             spec 6.1): every face's neutral surface at ``±K T`` along its normal is unrolled. When
             the file holds one solid plate (:func:`ght_cad.cad.sheet_solid.plate_faces`: its two
             large faces at a constant distance) and no faces are selected, only its inside face

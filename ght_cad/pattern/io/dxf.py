@@ -1,8 +1,8 @@
 """DXF writers of a flat pattern: DXF R2010 through ezdxf and a hand-written ASCII R12 writer
 (no ezdxf needed, e.g. in FreeCAD's Python); the same layers and outline arcs in both.
 
-Moved from :class:`ght_cad.flat_pattern.FlatPattern` (issue 27): the methods ``export_dxf`` and
-``dxf_r12_text`` call these functions. ``pattern`` is a :class:`ght_cad.flat_pattern.FlatPattern`.
+Moved from :class:`ght_cad.pattern.flat_pattern.FlatPattern` (issue 27): the methods ``export_dxf`` and
+``dxf_r12_text`` call these functions. ``pattern`` is a :class:`ght_cad.pattern.flat_pattern.FlatPattern`.
 """
 
 from __future__ import annotations
@@ -73,8 +73,8 @@ def arcs_to_rational_quadratic(points: np.ndarray, bulges: np.ndarray) -> tuple[
 
 
 def export_dxf(pattern: Any, path: str | os.PathLike, *, spline: bool = False, chord_tol: float | None = None) -> Path:
-    """Write ``pattern`` (a :class:`ght_cad.flat_pattern.FlatPattern`): the body of
-    :meth:`ght_cad.flat_pattern.FlatPattern.export_dxf`, whose docstring states the format."""
+    """Write ``pattern`` (a :class:`ght_cad.pattern.flat_pattern.FlatPattern`): the body of
+    :meth:`ght_cad.pattern.flat_pattern.FlatPattern.export_dxf`, whose docstring states the format."""
     tol = pattern._chord_tol(chord_tol)
     try:
         import ezdxf
@@ -117,8 +117,8 @@ def export_dxf(pattern: Any, path: str | os.PathLike, *, spline: bool = False, c
 
 
 def dxf_r12_text(pattern: Any, chord_tol: float | None = None) -> str:
-    """The text of ``pattern`` (a :class:`ght_cad.flat_pattern.FlatPattern`): the body of
-    :meth:`ght_cad.flat_pattern.FlatPattern.dxf_r12_text`, whose docstring states the format."""
+    """The text of ``pattern`` (a :class:`ght_cad.pattern.flat_pattern.FlatPattern`): the body of
+    :meth:`ght_cad.pattern.flat_pattern.FlatPattern.dxf_r12_text`, whose docstring states the format."""
     out: list[str] = []
 
     def put(code: int, value: Any) -> None:

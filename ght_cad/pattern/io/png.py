@@ -1,7 +1,7 @@
 """PNG preview of a flat pattern (matplotlib's object API, Agg; no pyplot).
 
-Moved from :class:`ght_cad.flat_pattern.FlatPattern` (issue 27): the method ``plot_png`` calls
-:func:`plot_png`. ``pattern`` is a :class:`ght_cad.flat_pattern.FlatPattern`.
+Moved from :class:`ght_cad.pattern.flat_pattern.FlatPattern` (issue 27): the method ``plot_png`` calls
+:func:`plot_png`. ``pattern`` is a :class:`ght_cad.pattern.flat_pattern.FlatPattern`.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from ...core.io import atomic_path
 
 
 def plot_png(pattern: Any, path: str | os.PathLike, *, dpi: int = 120, title: str | None = None) -> Path:
-    """Write ``pattern`` (a :class:`ght_cad.flat_pattern.FlatPattern`): the body of
-    :meth:`ght_cad.flat_pattern.FlatPattern.plot_png`, whose docstring states the format."""
+    """Write ``pattern`` (a :class:`ght_cad.pattern.flat_pattern.FlatPattern`): the body of
+    :meth:`ght_cad.pattern.flat_pattern.FlatPattern.plot_png`, whose docstring states the format."""
     from matplotlib.figure import Figure  # object API: no pyplot, no global backend switch
 
     fig = Figure(figsize=(8, 6))

@@ -1,7 +1,7 @@
 """SVG writer of a flat pattern: Inkscape layers, outline loops as paths of lines and arcs, true scale.
 
-Moved from :class:`ght_cad.flat_pattern.FlatPattern` (issue 27): the methods ``svg_text`` and
-``export_svg`` call these functions. ``pattern`` is a :class:`ght_cad.flat_pattern.FlatPattern`.
+Moved from :class:`ght_cad.pattern.flat_pattern.FlatPattern` (issue 27): the methods ``svg_text`` and
+``export_svg`` call these functions. ``pattern`` is a :class:`ght_cad.pattern.flat_pattern.FlatPattern`.
 """
 
 from __future__ import annotations
@@ -52,8 +52,8 @@ def svg_arc_path(points: np.ndarray, bulges: np.ndarray, tr: Callable[[np.ndarra
 
 
 def svg_text(pattern: Any, margin: float | None = None, chord_tol: float | None = None) -> str:
-    """The text of ``pattern`` (a :class:`ght_cad.flat_pattern.FlatPattern`): the body of
-    :meth:`ght_cad.flat_pattern.FlatPattern.svg_text`, whose docstring states the format."""
+    """The text of ``pattern`` (a :class:`ght_cad.pattern.flat_pattern.FlatPattern`): the body of
+    :meth:`ght_cad.pattern.flat_pattern.FlatPattern.svg_text`, whose docstring states the format."""
     arcs = pattern.outline_arcs(chord_tol)
     pts = np.concatenate(pattern.outlines, axis=0)
     lo, hi = points_bbox(pts)

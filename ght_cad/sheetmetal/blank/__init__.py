@@ -2,10 +2,10 @@ r"""One blank per bent part: connected unfolding of a sheet's skin (kernel-free 
 
 A kernel adapter (:mod:`ght_cad.cad.unfold_solid` for OCP/build123d/cadquery) recognises the
 sheet in a solid and describes its *skin* -- the faces of one side of the sheet -- as a
-:class:`SheetSkin`: every face as a :class:`ght_cad.face_unroll.FaceData` whose edges are named by
+:class:`SheetSkin`: every face as a :class:`ght_cad.unrolling.face_unroll.FaceData` whose edges are named by
 the solid's edge keys, the thickness ``T`` and which edges two skin faces share. This module
 
-* develops every skin face exactly (:func:`ght_cad.face_unroll.unroll_face_data`: closed forms
+* develops every skin face exactly (:func:`ght_cad.unrolling.face_unroll.unroll_face_data`: closed forms
   for planes, cylinders and cones, quadrature along the rulings for other developables); a bend
   face is developed on its neutral surface, offset into the material by ``K T`` when the skin
   face is the inside of its bend and by ``(1 - K) T`` when it is the outside, so either skin gives
@@ -17,7 +17,7 @@ the solid's edge keys, the thickness ``T`` and which edges two skin faces share.
   made orientation-preserving with respect to the solid's outward normal, so a face lands on the
   far side of the edge); shared edges not on the spanning tree are cut and reported;
 * merges all faces' boundary edges that are not shared inside the tree into closed loops: the
-  outline (largest area) and holes, one :class:`ght_cad.flat_pattern.FlatPanel` per solid, with
+  outline (largest area) and holes, one :class:`ght_cad.pattern.flat_pattern.FlatPanel` per solid, with
   both tangent lines of every bend (or its centre line) as bend lines, the rulings of freeform
   bends, and a bend table (angle ``A``, inside radius ``R``, ``K``, bend allowance
   ``BA = (R + K T) A``, bend deduction ``BD = 2 (R + T) tan(A / 2) - BA``, direction up/down);

@@ -26,7 +26,7 @@ class SkinFace:
 
     Attributes:
         number: 1-based face number in the source shape (reports name faces ``F<number>``).
-        data: the face (:class:`ght_cad.face_unroll.FaceData`); its edges' ``name`` is the solid's
+        data: the face (:class:`ght_cad.unrolling.face_unroll.FaceData`); its edges' ``name`` is the solid's
             edge key (e.g. ``E12``), the same in both faces sharing the edge; ``data.reversed``
             makes the normal the solid's outward normal.
         area: 3-D area (the default base face is the largest planar face).
@@ -65,7 +65,7 @@ class Blank:
 
     Attributes:
         name: the solid's name.
-        panels: one :class:`ght_cad.flat_pattern.FlatPanel` (several with ``allow_split``).
+        panels: one :class:`ght_cad.pattern.flat_pattern.FlatPanel` (several with ``allow_split``).
         thickness: ``T``.
         bends: the bend table, one dict per bend (:func:`bend_row`).
         base_face: face number of the base face (it keeps its own flat coordinates).
@@ -120,7 +120,7 @@ class Unfolded:
     """Result of :func:`unfold_skins` / ``ght_cad.unfold``.
 
     Attributes:
-        pattern: a :class:`ght_cad.flat_pattern.FlatPattern` with one panel per solid (labelled
+        pattern: a :class:`ght_cad.pattern.flat_pattern.FlatPattern` with one panel per solid (labelled
             with the solid's name; several per solid only with ``allow_split``), laid out in rows.
         blanks: one :class:`Blank` per solid, in the shape's order.
         face_count: faces of the source shape.

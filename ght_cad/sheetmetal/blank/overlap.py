@@ -53,7 +53,7 @@ def _overlap_area(a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> float:
 
         area(A ∩ B) = ½ Σ_{s ⊂ ∂A ∩ B} (x_0 y_1 - x_1 y_0) + ½ Σ_{s ⊂ ∂B ∩ A} (x_0 y_1 - x_1 y_0),
 
-    the boundary segments clipped to the other region (:func:`ght_cad.flat_pattern.clip_segments`).
+    the boundary segments clipped to the other region (:func:`ght_cad.pattern.flat_pattern.clip_segments`).
     Exact for the polygons (the outline polylines of the faces)."""
     from ...pattern.flat_pattern import clip_segments
 

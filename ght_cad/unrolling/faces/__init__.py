@@ -7,5 +7,5 @@ These modules import nothing above the surfaces they describe: the development i
 (:func:`ght_cad.unrolling.face_unroll.unroll_face_data`, which reaches
 :mod:`ght_cad.unrolling.unroll` and :mod:`ght_cad.sheetmetal.sheet`) stays in
 :mod:`ght_cad.unrolling.face_unroll`, and every name moved here stays importable from there. Old
-path of this package: ``ght_cad.faces``.
+path of this package: ``ght_cad.unrolling.faces``.
 """

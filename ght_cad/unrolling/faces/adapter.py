@@ -1,6 +1,6 @@
 """A CAD face as the kernel-free unroller sees it: the surface adapter, its jets, edges and faces.
 
-Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.unrolling.face_unroll` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ class SurfaceAdapter:
     def c0_breaks(self, direction: str) -> np.ndarray:
         """Parameters in ``direction`` where the surface is only C0 (B-spline knots of full
         multiplicity, e.g. a loft's joint rulings): the boundary measures are split there
-        (:attr:`ght_cad.flat_pattern.BoundaryEdge.breaks`); empty when unknown."""
+        (:attr:`ght_cad.pattern.flat_pattern.BoundaryEdge.breaks`); empty when unknown."""
         return np.zeros(0)
 
     def jet(self, u: np.ndarray, v: np.ndarray, order: int) -> list[np.ndarray]:
@@ -173,5 +173,5 @@ class FaceData:
     surface: SurfaceAdapter
     bounds: Bounds
     wires: list[list[EdgeData]]
-    #: the face's orientation is reversed: its normal is ``-(S_u × S_v)`` (sheet side, ght_cad.sheet)
+    #: the face's orientation is reversed: its normal is ``-(S_u × S_v)`` (sheet side, ght_cad.sheetmetal.sheet)
     reversed: bool = False

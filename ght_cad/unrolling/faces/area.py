@@ -1,6 +1,6 @@
 """The 3-D area of a trimmed face by Green's theorem in (u, v) with Gauss-Legendre quadrature.
 
-Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.unrolling.face_unroll` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

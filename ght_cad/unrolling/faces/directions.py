@@ -1,6 +1,6 @@
 """Which isolines of a face are straight: isoline statistics, the ruling direction, best effort.
 
-Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.unrolling.face_unroll` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """A face's boundary loops in (u, v): areas, the outer loop, chaining, derivatives, edge samples and
 the rulings clipped to the loops.
 
-Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.unrolling.face_unroll` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations
@@ -229,7 +229,7 @@ def _c0_crossings(uvf: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], c0
     or the other way round: the rails and rulings of a B-spline face) crosses a knot line where the
     surface is only C0 (``c0u``/``c0v``, :meth:`SurfaceAdapter.c0_breaks`): ``t = (k - u(0)) /
     (u(1) - u(0))``. There the edge's parameter speed jumps (a loft's joint ruling), so its
-    measures are split there (:attr:`ght_cad.flat_pattern.BoundaryEdge.breaks`). Other edges: ()."""
+    measures are split there (:attr:`ght_cad.pattern.flat_pattern.BoundaryEdge.breaks`). Other edges: ()."""
     u, v = (np.asarray(x, dtype=float) for x in uvf(np.array([0.0, 0.5, 1.0])))
     out: list[float] = []
     for along, fixed, ks in ((u, v, c0u), (v, u, c0v)):

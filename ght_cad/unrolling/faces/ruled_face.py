@@ -1,6 +1,6 @@
 """A face whose isolines in one direction are straight, as a :class:`ght_cad.surfaces.ruled.RuledSurface`.
 
-Moved from :mod:`ght_cad.face_unroll` (issue 27; every name stays importable from there).
+Moved from :mod:`ght_cad.unrolling.face_unroll` (issue 27; every name stays importable from there).
 """
 
 from __future__ import annotations

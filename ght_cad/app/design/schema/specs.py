@@ -147,7 +147,7 @@ class OutputSpec:
     figures: list[str] = field(default_factory=lambda: list(FIGURE_OUTPUTS))
     #: ``[outputs] chord_tol``: largest distance between a curved (not line, not circle) boundary edge
     #: and the arcs the DXF/SVG outline writes for it, in the design's units (None: 1e-3 mm,
-    #: :attr:`ght_cad.flat_pattern.FlatPattern.chord_tol`); ``--chord-tol`` takes precedence
+    #: :attr:`ght_cad.pattern.flat_pattern.FlatPattern.chord_tol`); ``--chord-tol`` takes precedence
     chord_tol: float | None = None
 
 
@@ -176,7 +176,7 @@ class SheetSpec:
     k_factor_ratio: float | None = None
 
     def to_sheet(self) -> Any:
-        """The :class:`ght_cad.sheet.Sheet`."""
+        """The :class:`ght_cad.sheetmetal.sheet.Sheet`."""
         from ....sheetmetal.sheet import Sheet
 
         return Sheet(self.thickness, self.k_factor, self.side)
