@@ -377,8 +377,11 @@ def make_flat_pattern(
     src, flat = source.Shape.BoundBox, obj.Shape.BoundBox
     if src.isValid() and flat.isValid():
         gap = 0.2 * max(src.DiagonalLength, flat.DiagonalLength)
+        # Part::Feature moves its Shape with the new Placement at once; the pattern itself does not
+        # change, so the touch the Placement set is cleared instead of computing the pattern again
+        # (a second recompute doubled the cost of every new flat pattern)
         obj.Placement = App.Placement(App.Vector(src.XMax + gap - flat.XMin, src.YMin - flat.YMin, 0), App.Rotation())
-        obj.Document.recompute()  # the Placement touched it: returned up to date, as every make_*
+        obj.purgeTouched()  # returned up to date, as every make_*
     return obj
 
 

@@ -206,6 +206,9 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
         cases = [("", "whole"), (pl.InsideFace, "inside"), (f"Face{pl.FaceNames.index('outside') + 1}", "outside")]
         for sub, what in cases:
             fp = flat_pattern.make_flat_pattern(pl, sub, 4, doc=self.doc, name=f"FP_{what}")
+            # returned up to date and laid beside its source (make_flat_pattern's Placement)
+            self.assertNotIn("Touched", fp.State, what)
+            self.assertGreater(fp.Shape.BoundBox.XMin, pl.Shape.BoundBox.XMax, what)
             self.assertEqual(_recompute(self.doc), [])
             self.assertEqual(fp.ThicknessUsed, T)  # the plate's own (plate_partner's measure agrees to 1e-6)
             self.assertEqual(len(fp.Shape.Faces), 1, what)  # one panel, fans included
@@ -220,18 +223,24 @@ class PlateTest(RefusalAssertions, unittest.TestCase):
             err = max(abs(g / e - 1.0) for g, e in zip(got, ref_edges) if e > 0)
             self.assertLess(err, 1e-9, what)
             print(f"flat pattern of the plate ({what}): area {fp.AreaFlat / ref.area - 1:.2g}, edges {err:.2g} relative to the core's")
-        # the plate's KFactor is the one the pattern uses
-        pl.KFactor = 0.3
-        self.assertEqual(_recompute(self.doc), [])
-        ref3 = unroll(surf, sheet=Sheet(T, 0.3, "normal"), rulings=4, samples=65)
-        self.assertLess(abs(self.doc.getObject("FP_whole").AreaFlat / ref3.area - 1.0), 1e-9)
-        self.assertGreater(abs(ref3.area / ref.area - 1.0), 1e-6)  # K matters: the check above can fail
-        # the material on the concave side of a fan's apex is refused (the core's message)
+        # the material on the concave side of a fan's apex is refused (the core's message); the flat
+        # patterns on the plate wait (they print nothing: exactly the plate's line is shown). The
+        # outside face's pattern, checked above, takes the same path as the inside face's and is
+        # removed first, so the recompute below does not unroll it again
+        self.doc.removeObject("FP_outside")
         pl.Side = "reverse"
         self.assert_refused_as(self.doc, pl, lambda: pl.Proxy.compute(pl),
                                r"^thickness=4.0 \(side='reverse'\) is not allowed on DevelopableLoft: the ruling at u=0 ends in an apex")
-        pl.Side = "normal"
-        self.assert_recompute_clean(self.doc, pl)
+        # back to the good side with another KFactor: the plate and its patterns recompute clean, and
+        # the plate's KFactor is the one the patterns use (of the whole plate and of its inside face)
+        pl.Side, pl.KFactor = "normal", 0.3
+        fps = [self.doc.getObject(f"FP_{what}") for what in ("whole", "inside")]
+        self.assert_recompute_clean(self.doc, pl, *fps)
+        self.assertEqual(_recompute(self.doc), [])
+        ref3 = unroll(surf, sheet=Sheet(T, 0.3, "normal"), rulings=4, samples=65)
+        for fp in fps:
+            self.assertLess(abs(fp.AreaFlat / ref3.area - 1.0), 1e-9, fp.Label)
+        self.assertGreater(abs(ref3.area / ref.area - 1.0), 1e-6)  # K matters: the check above can fail
         # STEP of the plate (read back with OCP by the pytest driver)
         step = os.path.join(OUT, "fc_plate_loft.step")
         export.export_step([pl], step)
