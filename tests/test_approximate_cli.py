@@ -43,7 +43,7 @@ def test_choices_come_from_the_design_constants(capsys: pytest.CaptureFixture) -
     """--direction and --method offer exactly APPROX_DIRECTIONS / APPROX_METHODS (what design files
     and the FreeCAD feature offer); a bad one: exit 2, one line naming the option and the choices."""
     from ght_cad.app.cli import build_parser
-    from ght_cad.design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
+    from ght_cad.app.design.schema.constants import APPROX_DIRECTIONS, APPROX_METHODS
 
     sub = next(a for a in build_parser()._actions if a.dest == "command").choices["approximate"]
     opts = {a.dest: a for a in sub._actions}

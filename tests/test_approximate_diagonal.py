@@ -183,8 +183,8 @@ def test_diagonal_march_has_a_seam_on_the_kink():
 def test_direction_values_everywhere():
     import argparse
 
-    from ght_cad.approximate_cli import add_parser
-    from ght_cad.design.schema.constants import APPROX_DIRECTIONS
+    from ght_cad.app.approximate_cli import add_parser
+    from ght_cad.app.design.schema.constants import APPROX_DIRECTIONS
 
     assert DIRECTIONS == ("auto", "u", "v", "diagonal", "antidiagonal")
     assert APPROX_DIRECTIONS == DIRECTIONS
@@ -229,7 +229,7 @@ def test_small_saddle_end_to_end_without_a_kernel(tmp_path):
     ~8 s): diagonal strips, cones at the two corners, seams shared, the sheets of the panels on the
     target's normal side, the deviation plot."""
     from ght_cad.approximation import ConeStrip
-    from ght_cad.design.approximate import panel_sheets, plot_deviation
+    from ght_cad.app.design.approximate import panel_sheets, plot_deviation
     from ght_cad.sheetmetal.sheet import Sheet
 
     def jet(u, v, order):

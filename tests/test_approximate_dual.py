@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from ght_cad.approximation import SurfaceTarget, _Frame, approximate
-from ght_cad.approximation_dual import fit_strip
+from ght_cad.approximation.dual import fit_strip
 from ght_cad.core.errors import GHTError
 
 
@@ -175,7 +175,7 @@ def test_loft_beside_dual_shares_the_trimmed_seam():
     lam = np.linspace(0.0, 1.0, 257)
     assert max(dist(p0.b(lam)).max(), dist(p1.a(lam)).max()) <= 1e-6 * fr.size
     # and the seam is on the dual fit's envelope: the normal lines of the seam row meet it at δ
-    from ght_cad.approximation_dual import normal_hits
+    from ght_cad.approximation.dual import normal_hits
 
     x = np.linspace(0.05, 0.95, 19)
     j = fr.jet(x, np.full(x.size, 0.5), 1)

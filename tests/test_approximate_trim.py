@@ -190,7 +190,7 @@ def test_design_key_untrimmed(dome, tmp_path: Path, capsys: pytest.CaptureFixtur
     from test_design_approximate import BASE, _toml
 
     from ght_cad.cad.occ import write_step
-    from ght_cad.design import parse_design
+    from ght_cad.app.design import parse_design
 
     write_step(holed_face(dome), tmp_path / "holed.step")
     d = copy.deepcopy(BASE)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from ght_cad.app.cli import main
-from ght_cad.design import unroll_step
+from ght_cad.app.design import unroll_step
 from ght_cad.core.errors import NotDevelopableError
 
 pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]  # process pools over STEP files

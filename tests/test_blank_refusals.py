@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from sheet_parts import crossed_flanges, spherical_shell, square_bar  # noqa: E402
 
 import ght_cad  # noqa: E402
-from ght_cad.blank import BlankError  # noqa: E402
+from ght_cad.sheetmetal.blank import BlankError  # noqa: E402
 from ght_cad.cad.occ import write_step  # noqa: E402
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 

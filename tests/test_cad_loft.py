@@ -282,7 +282,7 @@ def test_edge_rails_equal_ght_rails(dory_shape) -> None:
     """The loft between the B-spline edges equals the loft between the exact GHT curves: same
     segments; σ (which depends on the rails' tangents, fitted to 1e-7 of the size in position)
     agrees to 1e-5 (measured 1.0e-6), the fan share to 1e-6."""
-    exact = ght_cad.loft.developable_loft(CHINE, SHEER)
+    exact = ght_cad.developable_loft(CHINE, SHEER)
     loft = dory_shape.ght_loft
     assert [sg.kind for sg in loft.segments] == [sg.kind for sg in exact.segments]
     t = np.linspace(0.05, 0.95, 19)

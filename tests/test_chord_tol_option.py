@@ -41,7 +41,7 @@ def hopper_design(path: Path, name: str = "hopper-transition", chord_tol: str | 
 @pytest.fixture(scope="module")
 def hopper():
     """The hopper's exact flat pattern (built from the design file, as ``run`` builds it)."""
-    from ght_cad.design import build_surfaces, load_design, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, load_design, unroll_surfaces
 
     return unroll_surfaces(build_surfaces(load_design(EXAMPLES / "design_hopper_transition.toml")))
 

@@ -154,7 +154,7 @@ def test_optimize_needs_a_surface(tmp_path: Path, capsys) -> None:
 
 
 def test_internal_failure_exit_1(cone: Path, tmp_path: Path, capsys, monkeypatch) -> None:
-    import ght_cad.design as D
+    import ght_cad.app.design as D
 
     def boom(*a, **k):
         raise RuntimeError("kernel exploded")
@@ -319,7 +319,7 @@ def test_unroll_outputs_are_all_or_nothing(tmp_path, monkeypatch) -> None:
     """A failing PNG after the DXF and SVG were written: none of the three targets appears."""
     from pathlib import Path
 
-    import ght_cad.design as design_mod
+    import ght_cad.app.design as design_mod
     from ght_cad.app.cli import main
 
     duct = Path(__file__).resolve().parents[1] / "examples" / "design_duct.toml"

@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 from ght_cad.surfaces.bspline import BSplineSurfaceData
 from ght_cad.cad.occ import make_face, write_step
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
-from ght_cad.design import unroll_step
-from ght_cad.developable import CompositeDevelopable, developable_from_planes, join_developable
+from ght_cad.app.design import unroll_step
+from ght_cad.developables.envelope import CompositeDevelopable, developable_from_planes, join_developable
 
 RTOL = 1e-9
 

@@ -19,7 +19,7 @@ def test_batch_step_names_resolve_from_batch() -> None:
     """Cycle batch -> design -> design.step_input -> batch: the parallel STEP unroll moved into
     ``ght_cad.design.step_input``, the worker helpers into ``ght_cad.core.workers``."""
     import ght_cad.app.batch as batch
-    import ght_cad.design.step_input as step_input
+    import ght_cad.app.design.step_input as step_input
     import ght_cad.core.workers as workers
     from ght_cad.app.batch import map_step_faces
 

@@ -146,7 +146,7 @@ def test_report_developability_matches_recomputation(demo) -> None:
 
 def test_report_optimization_is_consistent(demo) -> None:
     from ght_cad import GHTCurve
-    from ght_cad.design import dual_curve_objectives, parse_design_text
+    from ght_cad.app.design import dual_curve_objectives, parse_design_text
     from ght_cad.app.demo import default_design_text
     from ght_cad.surfaces.planes import normalize_planes
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ght_cad.app.cli import main
-from ght_cad.design import DesignError, load_design, parse_design, parse_design_text, run_design
+from ght_cad.app.design import DesignError, load_design, parse_design, parse_design_text, run_design
 
 # a small valid design: the exact quarter cone of the spec, no optimization (fast)
 GOOD = """
@@ -265,7 +265,7 @@ def test_two_strip_design_end_to_end(tmp_path: Path) -> None:
     import ezdxf
 
     from ght_cad.cad.occ import is_valid, read_step
-    from ght_cad.design import build_surface, ruled_area, shared_edge_count
+    from ght_cad.app.design import build_surface, ruled_area, shared_edge_count
 
     out = tmp_path / "out"
     assert main(["run", str(EXAMPLES / "design_duct_two_strips.toml"), "--out", str(out), "--no-progress"]) == 0
@@ -308,7 +308,7 @@ def test_two_strip_design_per_surface_panels_and_joined_blank_agree(tmp_path: Pa
     strips' 3-D areas to 1e-9, the joint ruling marked E1 on both); the default blank's area is the
     sum of those panels' flat areas to 1e-12 and its outline is one simple loop whose boundary edges
     are the panels' outer edges less the joint (same lengths to 1e-12)."""
-    from ght_cad.design import build_surface, ruled_area, unroll_surface
+    from ght_cad.app.design import build_surface, ruled_area, unroll_surface
     from ght_cad.sheetmetal.join_panels import outline_self_overlap
 
     per = parse_design_text(TWO_STRIPS.replace("[unroll]\n", '[unroll]\npanels = "per-surface"\n'), "two.toml")
@@ -344,7 +344,7 @@ def test_unroll_panels_bad_value_exit_2(tmp_path: Path, capsys) -> None:
 @pytest.mark.parametrize("order, normalize", [("G1", "false"), ("G3", "false"), ("G2", "true")])
 def test_requested_joint_order_is_achieved(order: str, normalize: str) -> None:
     """The measured joint order equals the requested one (generic free planes: not higher)."""
-    from ght_cad.design import build_surface, surface_summary
+    from ght_cad.app.design import build_surface, surface_summary
 
     text = strips_edit('continuity = "G2"', f'continuity = "{order}"').replace("normalize = false", f"normalize = {normalize}")
     d = parse_design_text(text, "two.toml")
@@ -405,7 +405,7 @@ def test_step_declares_the_design_units(tmp_path) -> None:
     import re
     from pathlib import Path
 
-    from ght_cad.design import load_design, run_design
+    from ght_cad.app.design import load_design, run_design
 
     src = Path(__file__).resolve().parents[1] / "examples" / "design_duct_two_strips.toml"
     design = load_design(src)
@@ -434,7 +434,7 @@ def test_planes_optimization_rejects_degenerate_candidates(tmp_path: Path, capsy
     is stationary at both ends and the surface cannot be built. PSO clips onto that corner; the
     candidate must get +inf (docs: candidates whose surface degenerates are rejected) so that
     `ght-cad optimize` and `ght-cad run` end with a surface that exists."""
-    from ght_cad.design import build_surface, optimize_design
+    from ght_cad.app.design import build_surface, optimize_design
 
     text = Path(__file__).resolve().parents[1].joinpath("examples", "design_duct.toml").read_text()
     text += '\n[optimize]\nmethod = "pso"\nobjective = "AL"\npopulation = 8\niterations = 12\nseed = 0\n'
@@ -456,7 +456,7 @@ def test_optimized_curve_strip_exports_the_optimized_curves(tmp_path: Path) -> N
     optimized boundary curves (not the file's), and a curve joined to a boundary curve is re-joined
     to the optimized one. A G2 join makes the difference visible: re-solving keeps G2."""
     from ght_cad.cad.occ import read_step
-    from ght_cad.design import build_curves, build_surface
+    from ght_cad.app.design import build_curves, build_surface
 
     text = (EXAMPLES / "design_hull_plate_quasi.toml").read_text()
     text = text.replace('continuity = "G1"\nk = 0.8', 'continuity = "G2"\nk = 0.8')
@@ -508,7 +508,7 @@ def test_boundary_curve_that_is_a_join_second_is_rejoined_per_candidate() -> Non
     """The sheer (curve_b) continues a stem with G2: its first control points are re-solved by the
     join from its own shape parameters, so every candidate re-applies the join; the reported value
     is R of the strip rebuilt from build_curves(design, shape), and the join stays G2."""
-    from ght_cad.design import build_curves, build_surface, optimize_design
+    from ght_cad.app.design import build_curves, build_surface, optimize_design
 
     text = (EXAMPLES / "design_hull_plate_quasi.toml").read_text()
     text = text.replace('first = "sheer"\nsecond = "stem"\ncontinuity = "G1"', 'first = "stem"\nsecond = "sheer"\ncontinuity = "G2"')
@@ -529,7 +529,7 @@ def test_planes_objective_is_inf_exactly_when_the_surface_degenerates(x: list[fl
     cannot be built, else En of the unit-normal dual curve (recomputed here with 80 nodes; En's
     integrand is smooth. AL's |U'| has a near-kink where U' almost vanishes on this design, and
     64-node Gauss–Legendre AL is only within ~1e-4 relative of the converged integral there)."""
-    from ght_cad.design import OptimizeSpec, _objective_fn, build_surface
+    from ght_cad.app.design import OptimizeSpec, _objective_fn, build_surface
     from ght_cad.core.errors import GHTError
     from ght_cad.surfaces.planes import normalize_planes
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ght_cad.design import DesignError, load_design, parse_design
+from ght_cad.app.design import DesignError, load_design, parse_design
 from ght_cad.app.cli import main
 
 try:
@@ -137,7 +137,7 @@ def test_two_surfaces_and_ght_target_and_deviation_figure() -> None:
 
 
 def test_inline_targets_evaluate_the_patch_and_degenerate_nets_are_refused() -> None:
-    from ght_cad.design.approximate import approximation_target
+    from ght_cad.app.design.approximate import approximation_target
     from ght_cad.surfaces.nurbs import NurbsSurface
     from ght_cad.surfaces.patch import GHTSurface
 
@@ -186,7 +186,7 @@ def test_unmet_tolerance_exits_2_with_the_cores_best_deviation(tmp_path: Path, c
     import re
 
     from ght_cad.approximation import approximate
-    from ght_cad.design.approximate import approximation_target
+    from ght_cad.app.design.approximate import approximation_target
 
     data = _variant(max_panels=1, method="loft")
     path = tmp_path / "d.toml"
@@ -366,7 +366,7 @@ def test_sheet_side_is_measured_on_the_target_normal() -> None:
     from OCP.BRepTools import BRepTools
     from scipy.optimize import minimize
 
-    from ght_cad.design import build_surface, plate_solids
+    from ght_cad.app.design import build_surface, plate_solids
     from ght_cad.surfaces.patch import GHTSurface
 
     net = [[[600.0 * i, 400.0 * j, [0.0, 80.0, 0.0][j]] for j in range(3)] for i in range(3)]
@@ -400,7 +400,7 @@ def test_method_key_parsed_validated_and_passed_through(tmp_path: Path, capsys: 
     the message of a bad value lists them), kept by ``to_dict``, passed to ``ght_cad.approximate``
     and recorded in the report: a developable GHT cylinder target with ``method = "loft"`` gives
     one loft panel within 1e-6 of the size, ``surface.approximation.method`` = "loft"."""
-    from ght_cad.design.schema.constants import APPROX_METHODS
+    from ght_cad.app.design.schema.constants import APPROX_METHODS
 
     assert parse_design(BASE, "d.toml").surface.method == "auto"
     for m in APPROX_METHODS:
@@ -423,6 +423,6 @@ def test_method_key_parsed_validated_and_passed_through(tmp_path: Path, capsys: 
     ap = json.loads(capsys.readouterr().out)["surface"]["approximation"]
     assert ap["method"] == "loft" and [p["method"] for p in ap["panel_report"]] == ["loft"] * ap["panels"]
     assert ap["panels"] == 1 and ap["max_deviation"] <= 1e-6 * ap["size"]
-    from ght_cad.design.approximate import report_markdown
+    from ght_cad.app.design.approximate import report_markdown
 
     assert "- method: loft (per strip: 1 loft)" in report_markdown(ap)

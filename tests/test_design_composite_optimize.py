@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ght_cad.app.cli import main
-from ght_cad.design import (
+from ght_cad.app.design import (
     DesignError,
     build_surface,
     composite_objective,
@@ -79,7 +79,7 @@ def gl_fairness(curve, nodes: int) -> dict[str, float]:
 def rebuild(design_file: Path, shape: dict[str, float]) -> list:
     """The strips rebuilt from the file and the reported shape parameters, by the developable
     module directly (not through ght_cad.design)."""
-    from ght_cad.developable import developable_from_planes, join_developable
+    from ght_cad.developables.envelope import developable_from_planes, join_developable
 
     try:
         import tomllib
@@ -122,7 +122,7 @@ def test_run_writes_step_dxf_and_report(run_result) -> None:
     from OCP.TopExp import TopExp_Explorer
 
     from ght_cad.cad.occ import is_valid, read_step, unwrap
-    from ght_cad.design import shared_edge_count
+    from ght_cad.app.design import shared_edge_count
 
     out, r, stdout = run_result
     obj = json.loads(stdout)  # the whole of stdout is one JSON object
@@ -154,7 +154,7 @@ def test_objective_strictly_lower_joints_kept_strips_developable(run_result) -> 
     """best < initial on the example; per-strip values sum to the totals; the joint measures G2
     (requested) after optimization, on the report and on the strips rebuilt independently; every
     strip's θ_max stays at round-off."""
-    from ght_cad.developable import measure_developable_joint
+    from ght_cad.developables.envelope import measure_developable_joint
 
     _, r, _ = run_result
     o = r["optimization"]

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from ght_cad.blank import K_TABLES
+from ght_cad.sheetmetal.blank import K_TABLES
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main
 
 DUCT = (Path(__file__).parent.parent / "examples" / "design_duct.toml").read_text().split("[outputs]")[0]
@@ -56,7 +56,7 @@ def test_inline_table_equals_explicit_k(tmp_path: Path, capsys, side: str, ratio
     other = _design(tmp_path, "other", f'side = "{side}"\nk_factor = {0.75 - k}')
     rc, c = _unroll(other, capsys)
     assert _figures(c) != _figures(a)
-    from ght_cad.design import build_surface, load_design
+    from ght_cad.app.design import build_surface, load_design
 
     built = build_surface(load_design(table))
     assert abs(built.design.sheet.k_factor_ratio / ratio - 1) < 1e-6
@@ -103,7 +103,7 @@ def test_table_and_k_factor_together_refused(tmp_path: Path, capsys) -> None:
 def test_run_plate_and_pattern_use_the_table(tmp_path: Path) -> None:
     """``ght-cad run``: the plate report carries the K read (0.45 at R/T = 22.36) and the table; the
     flat pattern equals the explicit K's."""
-    from ght_cad.design import load_design, run_design
+    from ght_cad.app.design import load_design, run_design
 
     reports = []
     for name, sheet in (("table", "k_factor_table = [[0, 0.30], [22, 0.45]]"), ("explicit", "k_factor = 0.45")):
@@ -129,7 +129,7 @@ def test_surfaces_read_the_table_at_their_own_thickness() -> None:
     sys.path.insert(0, str(Path(__file__).parent))
     from test_join_panels import _WALL
 
-    from ght_cad.design import build_surfaces, parse_design_text, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, parse_design_text, unroll_surfaces
 
     def pattern(upper: str, sheet: str):
         txt = _WALL.replace('curve_b = "top"\n', 'curve_b = "top"\n\n[surfaces.sheet]\n' + upper + "\n")
@@ -153,7 +153,7 @@ def test_surfaces_read_the_table_at_their_own_thickness() -> None:
 def test_optimize_checks_with_the_largest_k_and_the_result_with_its_own(tmp_path: Path) -> None:
     """With ``[optimize]`` the candidates are checked with the table's largest K (|K T| = 0.45 x 10)
     and the result's plate carries the K of its own R/T."""
-    from ght_cad.design import load_design, run_design
+    from ght_cad.app.design import load_design, run_design
 
     p = _design(tmp_path, "opt", "k_factor_table = [[0, 0.30], [22, 0.45]]")
     p.write_text(p.read_text() + '\n[optimize]\nmethod = "pso"\npopulation = 4\niterations = 2\n\n'

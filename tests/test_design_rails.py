@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 pytest.importorskip("build123d")
 
 from ght_cad.app.cli import main
-from ght_cad.design import DesignError, build_curves, load_design, optimize_design, parse_design_text
+from ght_cad.app.design import DesignError, build_curves, load_design, optimize_design, parse_design_text
 
 from dxf_read import dxf_outline_areas
 
@@ -195,7 +195,7 @@ def test_hopper_exact_in_core_and_in_the_step(hopper) -> None:
     (flat,) = dxf_outline_areas(out / "flat_pattern.dxf")
     step_area = sum(face_area(f) for f in faces)
     assert flat == pytest.approx(step_area, rel=1e-7)
-    from ght_cad.design import build_surfaces, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, unroll_surfaces
 
     (out / "r12.dxf").write_text(unroll_surfaces(build_surfaces(load_design(HOPPER))).dxf_r12_text())
     (flat12,) = dxf_outline_areas(out / "r12.dxf")
@@ -371,7 +371,7 @@ def test_rails_optimization_fan_share_never_worse_and_recomputed() -> None:
     """[optimize] on a rails surface: the fan share over the rails' shape parameters through
     ght_cad.optimize (PSO); never worse than the file's rails; the reported best value is the fan
     share of the loft rebuilt from the best shape parameters (1e-9)."""
-    from ght_cad.design import build_surface
+    from ght_cad.app.design import build_surface
 
     text = HULL.read_text().replace("population = 8\niterations = 5", "population = 4\niterations = 2")
     d = parse_design_text(text)
@@ -400,7 +400,7 @@ def test_hopper_loft_exact_over_a_box_of_shape_parameters(x: list[float]) -> Non
     """Over the box [-0.6, 0.6]^6 of the hopper rails' shape parameters, the rails surface built from
     the design is an exact developable (θ_max ≤ 1e-8° over the sampled rulings of every segment, and
     the developability degree DD = 1 to 1e-12) covering both rails end to end."""
-    from ght_cad.design import build_surface
+    from ght_cad.app.design import build_surface
 
     d = load_design(HOPPER)
     shape = dict(zip(("a.mu", "a.nu", "a.gamma", "b.mu", "b.nu", "b.gamma"), x))

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import ght_cad
 import ght_cad.surfaces.ruled
 from ght_cad import GHTCurve
-from ght_cad.developable import (
+from ght_cad.developables.envelope import (
     CanalSurface,
     CompositeDevelopable,
     EnvelopeDevelopable,
@@ -492,7 +492,7 @@ def test_canal_cone_with_different_parametrizations_is_recognized():
 
 def test_bspline_data_in_the_core_keeps_rulings_paired():
     """developable_bspline needs no CAD kernel: degree 1 across, pole pairs on matched parameters."""
-    from ght_cad.developable import developable_bspline
+    from ght_cad.developables.envelope import developable_bspline
 
     s = ship()
     data = developable_bspline(s)
@@ -506,7 +506,7 @@ def test_bspline_data_in_the_core_keeps_rulings_paired():
 
 
 def test_bspline_data_meets_a_theta_tolerance():
-    from ght_cad.developable import developable_bspline
+    from ght_cad.developables.envelope import developable_bspline
 
     s = ship()
     coarse = developable_bspline(s)
@@ -592,11 +592,11 @@ def test_conversion_and_measure_arguments_are_checked_by_name():
     s = cylinder(2.0, 3.0)
     for bad in (0, 2.5, "5"):
         with pytest.raises(GHTError, match=rf"degree={bad!r} is not allowed; B-spline degrees are integers 1..25"):
-            s.to_face(degree=bad) if bad == "5" else ght_cad.developable.developable_bspline(s, degree=bad)
+            s.to_face(degree=bad) if bad == "5" else ght_cad.developables.envelope.developable_bspline(s, degree=bad)
     with pytest.raises(GHTError, match=r"tol='x' is not a number"):
-        ght_cad.developable.developable_bspline(s, tol="x")
+        ght_cad.developables.envelope.developable_bspline(s, tol="x")
     with pytest.raises(GHTError, match=r"theta_tol_deg='x' is not a number"):
-        ght_cad.developable.developable_bspline(s, theta_tol_deg="x")
+        ght_cad.developables.envelope.developable_bspline(s, theta_tol_deg="x")
     with pytest.raises(GHTError, match=r"nodes='64' is not allowed; .*integer >= 64"):
         s.developability(nodes="64")
     with pytest.raises(GHTError, match=r"phi_range=\(0.0, nan\) is not allowed"):

@@ -28,7 +28,7 @@ from ght_cad.cad.developable_faces import (  # noqa: E402
     shell_faces,
 )
 from ght_cad.cad.occ import is_valid, read_step, write_step  # noqa: E402
-from ght_cad.developable import (  # noqa: E402
+from ght_cad.developables.envelope import (  # noqa: E402
     CompositeDevelopable,
     RectifyingDevelopable,
     TangentDevelopable,

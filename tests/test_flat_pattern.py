@@ -369,7 +369,7 @@ def test_readme_cone_dxf_corners_arcs_and_area_exact(readme_cone: FlatPattern, v
 
 @pytest.fixture(scope="module")
 def hopper_pattern() -> FlatPattern:
-    from ght_cad.design import build_surfaces, load_design, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, load_design, unroll_surfaces
 
     return unroll_surfaces(build_surfaces(load_design(EXAMPLES / "design_hopper_transition.toml")))
 

@@ -30,7 +30,7 @@ def test_plates_from_ght_cad_are_valid_in_freecad(tmp_path) -> None:
     side = "normal" if n[:2] @ cone.evaluate(0.5, 0.5)[:2] > 0 else "reverse"
     write_plate_step(plate_solid(cone, Sheet(T, 0.42, side)), tmp_path / "cone_plate.step")
     ell = math.hypot(r2 - r1, H)
-    from ght_cad.loft import developable_loft
+    from ght_cad.developables.loft import developable_loft
     from ght_cad.unrolling.unroll import unroll
     from tests.test_loft import CHINE, SHEER
 

@@ -276,7 +276,7 @@ def test_mutated_design(case: tuple[str, bytes, str], tmp_path_factory: pytest.T
     path = folder / name
     path.write_bytes(text)
     if name in SLOW_BUILD:  # validation only (the surface command's first step)
-        from ght_cad.design import load_design
+        from ght_cad.app.design import load_design
         from ght_cad.core.errors import GHTError
 
         err = ""

@@ -18,8 +18,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from ght_cad.design import composite_objective, composite_value_and_grad, optimize_design, parse_design_text
-from ght_cad.design.objectives import composite_dual_objectives, composite_dual_objectives_grad
+from ght_cad.app.design import composite_objective, composite_value_and_grad, optimize_design, parse_design_text
+from ght_cad.app.design.objectives import composite_dual_objectives, composite_dual_objectives_grad
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "design_duct_two_strips_optimized.toml"
 TEXT = EXAMPLE.read_text()
@@ -110,9 +110,9 @@ def test_subset_of_parameters_and_fixed_values() -> None:
 @pytest.mark.parametrize("cont", ["C1", "C2", "C3"])
 def test_parametric_joins_gradient(cont: str) -> None:
     """C1..C3 joins (``T_r = U^(r)(1)``), through the developable module directly."""
-    from ght_cad.developable import developable_from_planes, join_developable
-    from ght_cad.design.build import _make_composite  # noqa: F401 (same path as the design)
-    from ght_cad.developable import CompositeDevelopable
+    from ght_cad.developables.envelope import developable_from_planes, join_developable
+    from ght_cad.app.design.build import _make_composite  # noqa: F401 (same path as the design)
+    from ght_cad.developables.envelope import CompositeDevelopable
 
     d = parse_design_text(TEXT, "duct.toml")
     s0, s1 = d.surface.segments

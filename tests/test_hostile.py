@@ -434,7 +434,7 @@ def test_step_reader_crash_and_hang_in_its_worker_give_exit_2(cylinder_step: byt
     import signal
     import time
 
-    import ght_cad.design.step_input as si
+    import ght_cad.app.design.step_input as si
 
     if not hasattr(os, "fork"):
         pytest.skip("no fork: the reader runs in this process")

@@ -201,7 +201,7 @@ def test_design_surfaces_meeting_g1_along_a_rail_are_one_blank(sheet: str) -> No
     rectangle (profile length) x 120 (with a sheet: the neutral profile, whose length equals the
     profile's here because the profile's end tangents are parallel), area = sum of the per-surface
     panels to 1e-12; `per-surface` keeps two panels marked E1."""
-    from ght_cad.design import build_surfaces, parse_design_text, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, parse_design_text, unroll_surfaces
 
     d = parse_design_text(_WALL + sheet, "wall.toml")
     pat = unroll_surfaces(build_surfaces(d))
@@ -224,7 +224,7 @@ def test_plated_composite_design_is_one_neutral_blank() -> None:
     strips' edges and bend lines numbered on."""
     from pathlib import Path
 
-    from ght_cad.design import build_surface, parse_design_text, unroll_surface
+    from ght_cad.app.design import build_surface, parse_design_text, unroll_surface
 
     text = (Path(__file__).resolve().parents[1] / "examples" / "design_duct_two_strips.toml").read_text()
     text += "\n[sheet]\nthickness = 0.01\nk_factor = 0.4\n"

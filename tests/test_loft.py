@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 import ght_cad
 from ght_cad import GHTCurve
 from ght_cad.core.errors import DegenerateGeometryError, GHTError, NotDevelopableError
-from ght_cad.loft import CallableRail, DevelopableLoft, as_rail, developable_loft, loft_function, plot_loft_sign
+from ght_cad.developables.loft import (CallableRail, DevelopableLoft, as_rail, developable_loft, loft_function,
+                                       plot_loft_sign)
 from ght_cad.optimize.problems import LoftProblem
 from ght_cad.surfaces.ruled import RuledSurface
 

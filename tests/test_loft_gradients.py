@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.loft import developable_loft
+from ght_cad.developables.loft import developable_loft
 from ght_cad.optimize.problems import LoftGradientFallback, LoftProblem, loft_measures_and_gradients
 from ght_cad.optimize import minimize
 
@@ -136,9 +136,9 @@ def test_hybrid_uses_the_exact_loft_gradient() -> None:
 
 
 def _design_fns(text: str):
-    from ght_cad.design import parse_design_text
-    from ght_cad.design.build import _initial_shape, build_curves
-    from ght_cad.design.optimize import _objective_fn, _value_and_grad_fn
+    from ght_cad.app.design import parse_design_text
+    from ght_cad.app.design.build import _initial_shape, build_curves
+    from ght_cad.app.design.optimize import _objective_fn, _value_and_grad_fn
 
     d = parse_design_text(text, "plate.toml")
     curves, _ = build_curves(d)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ght_cad
-from ght_cad.loft import developable_loft
+from ght_cad.developables.loft import developable_loft
 
 PLANES = [(-400, 1, 0, 0.5), (-400, 1, 1, 0.5), (-400, 0, 1, 0.5)]
 CUTS = [(0, 0, 0, 1), (-400, 0, 0, 1)]
@@ -90,7 +90,7 @@ gamma = -1.0
 def test_design_files_and_api_share_one_normalize_default():
     """The README's cone planes copied into a design file give the README's surface: the exact
     quarter cone frustum (area in closed form), not the +3.3 % non-conical one of unit normals."""
-    from ght_cad.design import build_surface, parse_design_text, surface_area
+    from ght_cad.app.design import build_surface, parse_design_text, surface_area
 
     api = ght_cad.developable_from_planes(PLANES, CUTS, gamma=-1)
     design = parse_design_text(README_CONE, "readme-cone.toml")

@@ -30,9 +30,9 @@ from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.surfaces.bspline import BSplineCurveData, fit_function, join_bsplines  # noqa: E402
 from ght_cad.cad.occ import has_c0_faces, is_valid, read_step, volume  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
-from ght_cad.developable import developable_bspline, ruled_pieces  # noqa: E402
+from ght_cad.developables.envelope import developable_bspline, ruled_pieces  # noqa: E402
 from ght_cad.core.errors import GHTError, NotDevelopableError  # noqa: E402
-from ght_cad.loft import developable_loft  # noqa: E402
+from ght_cad.developables.loft import developable_loft  # noqa: E402
 from ght_cad.sheetmetal.plate import plate_bspline, plate_volume  # noqa: E402
 from ght_cad.sheetmetal.sheet import Sheet, SheetError, check_offset, ruling_normal  # noqa: E402
 from ght_cad.unrolling.unroll import unroll  # noqa: E402

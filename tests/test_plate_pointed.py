@@ -27,7 +27,7 @@ from ght_cad import GHTCurve  # noqa: E402
 from ght_cad.cad.occ import is_valid  # noqa: E402
 from ght_cad.cad.sheet_solid import plate_faces, plate_solid, read_step_face_names, write_plate_step  # noqa: E402
 from ght_cad.core.errors import NotDevelopableError  # noqa: E402
-from ght_cad.loft import developable_loft  # noqa: E402
+from ght_cad.developables.loft import developable_loft  # noqa: E402
 from ght_cad.sheetmetal.plate import plate_volume  # noqa: E402
 from ght_cad.sheetmetal.sheet import Sheet, SheetError, bending_radius, check_offset, ruling_normal  # noqa: E402
 from ght_cad.unrolling.unroll import unroll  # noqa: E402

@@ -38,7 +38,7 @@ def test_the_n_point_rule_is_exact_to_degree_2n_minus_1(n: int) -> None:
 
 def test_the_old_public_names_are_the_helper() -> None:
     from ght_cad.curves.curve import gauss_legendre as curve_gl
-    from ght_cad.design import _gauss_legendre
+    from ght_cad.app.design import _gauss_legendre
 
     assert curve_gl is gauss_legendre and _gauss_legendre is gauss_legendre_unit
 

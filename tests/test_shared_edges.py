@@ -193,7 +193,7 @@ def test_candidates_grow_linearly():
 def test_step_faces_same_marks_as_all_pairs(tmp_path, monkeypatch):
     import importlib.util
 
-    from ght_cad.design import unroll_step
+    from ght_cad.app.design import unroll_step
 
     spec = importlib.util.spec_from_file_location("bench_batch", ROOT / "bench" / "bench_batch.py")
     bench = importlib.util.module_from_spec(spec)
@@ -214,7 +214,7 @@ def test_step_faces_same_marks_as_all_pairs(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 def test_dory_surfaces_same_marks_as_all_pairs(monkeypatch):
-    from ght_cad.design import build_surfaces, load_design, unroll_surfaces
+    from ght_cad.app.design import build_surfaces, load_design, unroll_surfaces
 
     seen: list[int] = []
     real = fp.mark_shared_edges

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ght_cad import GHTCurve
-from ght_cad.developable import RectifyingDevelopable, TangentDevelopable, developable_from_planes
+from ght_cad.developables.envelope import RectifyingDevelopable, TangentDevelopable, developable_from_planes
 from ght_cad.core.errors import GHTError
 from ght_cad.surfaces.ruled import CurvePairRuledSurface
 from ght_cad.sheetmetal.sheet import (

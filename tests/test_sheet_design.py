@@ -54,7 +54,7 @@ def test_unroll_design_with_sheet(tmp_path, capsys) -> None:
 def test_thickness_zero_is_the_plain_pattern(tmp_path) -> None:
     import numpy as np
 
-    from ght_cad.design import build_surface, load_design, unroll_surface
+    from ght_cad.app.design import build_surface, load_design, unroll_surface
 
     plain = unroll_surface(build_surface(load_design(_design(tmp_path, "", "p.toml"))))
     zero = unroll_surface(build_surface(load_design(_design(tmp_path, "thickness = 0.0\nk_factor = 0.3\n", "z.toml"))))

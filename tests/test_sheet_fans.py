@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ght_cad import GHTCurve
-from ght_cad.loft import developable_loft
+from ght_cad.developables.loft import developable_loft
 from ght_cad.sheetmetal.sheet import OffsetRuledSurface, Sheet, ruling_normal
 from ght_cad.unrolling.unroll import ruled_area, unroll
 
@@ -163,8 +163,8 @@ def test_metric_check_does_not_difference_across_a_joint() -> None:
 
     import tomllib
 
-    from ght_cad.design import build_surfaces
-    from ght_cad.design.schema import parse_design
+    from ght_cad.app.design import build_surfaces
+    from ght_cad.app.design.schema import parse_design
 
     path = Path(__file__).resolve().parents[1] / "examples" / "design_dory_multichine_plated.toml"
     design = parse_design(tomllib.loads(path.read_text()), str(path))

@@ -18,10 +18,10 @@ import pytest
 pytest.importorskip("build123d")
 
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
-from ght_cad.design import (SHEET_MARGIN, build_curves, build_surface, check_sheet, optimize_design,  # noqa: E402
+from ght_cad.app.design import (SHEET_MARGIN, build_curves, build_surface, check_sheet, optimize_design,  # noqa: E402
                             parse_design_text, sheet_parts, thickness_factor)
-from ght_cad.design.optimize import _SheetGuard, _objective_fn, _value_and_grad_fn, composite_objective  # noqa: E402
-from ght_cad.design.optimize import composite_value_and_grad  # noqa: E402
+from ght_cad.app.design.optimize import _SheetGuard, _objective_fn, _value_and_grad_fn, composite_objective  # noqa: E402
+from ght_cad.app.design.optimize import composite_value_and_grad  # noqa: E402
 from ght_cad.surfaces.ruled import RuledSurface  # noqa: E402
 from ght_cad.sheetmetal.sheet import Sheet, SheetError, check_offset  # noqa: E402
 
@@ -343,7 +343,7 @@ def test_every_candidate_surface_goes_through_accept(kind: str) -> None:
         assert all(isinstance(p, RuledSurface) for p in sheet_parts(surface))
         raise SheetError("refused")
 
-    from ght_cad.design.build import _initial_shape
+    from ght_cad.app.design.build import _initial_shape
 
     sh = _initial_shape(d, curves)
     f = _objective_fn(d, curves, d.optimize, accept)
@@ -392,7 +392,7 @@ def test_thickness_factor_refuses_bad_values() -> None:
 
 
 def test_a_result_the_final_check_refuses_falls_back_to_the_next_best(monkeypatch) -> None:
-    import ght_cad.design.optimize as O
+    import ght_cad.app.design.optimize as O
 
     d = design(QUARTER.format(method="pso", pop=6, it=3) + _sheet(180.0, 1.0))
     ref = optimize_design(d, progress=False)

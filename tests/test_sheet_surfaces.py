@@ -56,8 +56,8 @@ figures = {figures}
 
 
 def _sheets(text: str):
-    from ght_cad.design import build_curves, build_surfaces, parse_design_text
-    from ght_cad.design.shell_sheet import surface_sheets
+    from ght_cad.app.design import build_curves, build_surfaces, parse_design_text
+    from ght_cad.app.design.shell_sheet import surface_sheets
 
     d = parse_design_text(text, "dory.toml")
     curves, _ = build_curves(d)
@@ -130,7 +130,7 @@ def test_step_unroll_finds_every_plate(plated_run, capsys) -> None:
 @pytest.mark.slow
 def test_neutral_patterns_as_for_one_surface() -> None:
     """Each panel is its surface's neutral pattern exactly as a single [surface] unrolls it."""
-    from ght_cad.design import unroll_surfaces
+    from ght_cad.app.design import unroll_surfaces
     from ght_cad.sheetmetal.sheet import OffsetRuledSurface
     from ght_cad.unrolling.unroll import ruled_area, unroll
 
@@ -179,7 +179,7 @@ k_factor = 0.4
 
 @pytest.mark.slow
 def test_neutral_patterns_exact_without_fans() -> None:
-    from ght_cad.design import unroll_surfaces
+    from ght_cad.app.design import unroll_surfaces
     from ght_cad.sheetmetal.sheet import OffsetRuledSurface
     from ght_cad.unrolling.unroll import ruled_area
 
@@ -215,7 +215,7 @@ def test_material_on_the_same_side_of_the_shell(variant) -> None:
 
 
 def test_per_surface_overrides() -> None:
-    from ght_cad.design.shell_sheet import rail_joints
+    from ght_cad.app.design.shell_sheet import rail_joints
 
     text = _dory('thickness = 6\nk_factor = 0.44\nside = "normal"\n',
                  side_extra='[surfaces.sheet]\nthickness = 4\nk_factor = 0.3\nside = "reverse"\n')
@@ -267,8 +267,8 @@ def test_refusal_names_the_surface(tmp_path, capsys) -> None:
 def test_thickness_zero_and_no_sheet_are_the_plain_run() -> None:
     """T = 0 on every surface: the patterns of the design without [sheet], bit for bit, and the
     design dict of a [[surfaces]] design without [sheet] has no new keys."""
-    from ght_cad.design import parse_design_text, unroll_surfaces
-    from ght_cad.design.build import build_curves, build_surfaces
+    from ght_cad.app.design import parse_design_text, unroll_surfaces
+    from ght_cad.app.design.build import build_curves, build_surfaces
 
     def pattern(text):
         d = parse_design_text(text, "d.toml")

@@ -19,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from sheet_parts import Profile, bracket, profile_solid, u_channel, z_profile  # noqa: E402
 
 import ght_cad  # noqa: E402
-from ght_cad.blank import K_TABLES, BlankError, k_factor_table  # noqa: E402
+from ght_cad.sheetmetal.blank import K_TABLES, BlankError, k_factor_table  # noqa: E402
 from ght_cad.cad.occ import write_step  # noqa: E402
 from ght_cad.app.cli import EXIT_OK, EXIT_USAGE, main  # noqa: E402
 
@@ -126,7 +126,7 @@ def test_cli_default_two_parts_and_outputs(tmp_path: Path, capsys) -> None:
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
 
-    from ght_cad.design.step_input import _read_step_in
+    from ght_cad.app.design.step_input import _read_step_in
 
     shape, _, _ = _read_step_in(plate, None)
     props = GProp_GProps()
@@ -262,7 +262,7 @@ def test_overlap_refusal_and_split(monkeypatch) -> None:
     """The crossing detector finds a figure eight's crossing and none on a square; a blank whose
     pieces overlap is refused naming the faces and the area, or split into one panel per face with
     matching marks (the detector's verdict forced here: an extruded profile's strip cannot overlap)."""
-    import ght_cad.blank as blank
+    import ght_cad.sheetmetal.blank as blank
 
     eight = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
     square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)

@@ -375,8 +375,8 @@ def test_metric_check_does_not_straddle_a_fan_joint() -> None:
     stencil across the joint measured the parameter kink as a 0.29 degree angle error."""
     from pathlib import Path
 
-    from ght_cad.design import parse_design_text
-    from ght_cad.design.build import build_surfaces
+    from ght_cad.app.design import parse_design_text
+    from ght_cad.app.design.build import build_surfaces
 
     path = Path(__file__).resolve().parents[1] / "examples" / "design_dory_multichine.toml"
     bottom = build_surfaces(parse_design_text(path.read_text(), path.name))[0].surface
