@@ -223,13 +223,16 @@ def _dask_bin() -> str:
 
 def _start_worker(address: str, log: Path) -> subprocess.Popen:
     return subprocess.Popen([_dask_bin(), "worker", address, "--host", "127.0.0.1", "--nthreads", "1",
-                             "--no-nanny", "--no-dashboard"], stdout=subprocess.DEVNULL,
-                            stderr=open(log, "w"))
+                             "--no-nanny", "--no-dashboard", "--local-directory", str(log.parent / "dask")],
+                            stdout=subprocess.DEVNULL, stderr=open(log, "w"))
 
 
 @contextlib.contextmanager
 def start_cluster(tmp_path: Path, env: dict[str, str] | None = None):
-    """A scheduler and two 1-thread workers (no nanny) on 127.0.0.1: yields (address, processes)."""
+    """A scheduler and two 1-thread workers (no nanny, scratch space in ``tmp_path``) on 127.0.0.1:
+    yields (address, processes). Afterwards the workers are killed (SIGKILL: a worker that has
+    imported ght_cad and OCP takes seconds to finish on SIGTERM, 6-20 s on a loaded machine) and
+    the scheduler is terminated."""
     pytest.importorskip("distributed")
     from distributed import Client
 
@@ -245,9 +248,12 @@ def start_cluster(tmp_path: Path, env: dict[str, str] | None = None):
             client.wait_for_workers(2, timeout=90)
         yield address, procs
     finally:
-        for p in reversed(procs):
+        for p in reversed(procs):  # the workers, then the scheduler (procs[0])
             if p.poll() is None:
-                p.terminate()
+                if p is procs[0]:
+                    p.terminate()
+                else:
+                    p.kill()
         for p in procs:
             try:
                 p.wait(timeout=20)
