@@ -6,7 +6,8 @@ Modules: :mod:`~ght_cad.core.errors` (the exception hierarchy), :mod:`~ght_cad.c
 :mod:`~ght_cad.core._lazy` (PEP 562 lazy names), :mod:`~ght_cad.core.io` (atomic files),
 :mod:`~ght_cad.core.outdir` (output folders and their locks), :mod:`~ght_cad.core.progress`
 (progress bar), :mod:`~ght_cad.core.step_guard` (STEP text scan), :mod:`~ght_cad.core.workers`
-(worker processes) and :mod:`~ght_cad.core._kernel` (the CAD kernel registry). Each moved one keeps
+(worker processes), :mod:`~ght_cad.core._kernel` (the CAD kernel registry) and
+:mod:`~ght_cad.core._aliases` (the import hook of the moved modules' old paths). Each moved one keeps
 its old path ``ght_cad.<name>`` (the same module object). This package imports none of them:
 ``import ght_cad.core`` is free.
 """
