@@ -249,32 +249,57 @@ def test_direction_is_along_meridians_for_the_cap():
     assert est["v"] < 0.3 * est["u"]
 
 
+@pytest.fixture(scope="module")
+def cap_cli(tmp_path_factory):
+    """``ght-cad approximate cap.step --tol 1 --max-panels 14`` once for the module (the cap at 1 mm
+    is checked by :func:`test_spherical_cap` and :func:`test_cli_approximate` from these files, not
+    computed twice): (the cap face, the output folder, report.json)."""
+    from ght_cad.app.cli import main
+    from ght_cad.cad.occ import write_step
+
+    d = tmp_path_factory.mktemp("cap_cli")
+    face = cap_face()
+    step = write_step(face, d / "cap.step")
+    out = d / "out"
+    assert main(["approximate", str(step), "--tol", "1", "--max-panels", "14", "--out", str(out)]) == 0
+    return face, step, out, json.loads((out / "report.json").read_text())
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("tol, max_panels", [(1.0, 14), (0.25, 28)])
-def test_spherical_cap(tol, max_panels, tmp_path):
+def test_spherical_cap(tol, max_panels, tmp_path, request):
+    """The cap within 1 mm (through ``ght-cad approximate``: its panels.step and report.json) and
+    within 0.25 mm (``ght_cad.approximate``, the STEP written here): the panels read back from STEP
+    are within tol of the cap both ways, developable, their areas those of the flat pattern, and
+    they form one watertight shell."""
     from ght_cad.cad.occ import read_step, write_step
 
-    face = cap_face()
-    res = ght_cad.approximate(face, tol, max_panels=max_panels)
-    assert len(res.panels) <= max_panels
-    assert res.direction == "v"
-    shell = panels_shell(res)
-    step = write_step(shell, tmp_path / "panels.step")
+    if tol == 1.0:
+        face, _, out, rep = request.getfixturevalue("cap_cli")
+        n, direction, size = rep["panels"], rep["direction"], rep["size"]
+        flat = sorted(p["flat_area"] for p in rep["panel_report"])
+        step = out / "panels.step"
+    else:
+        face = cap_face()
+        res = ght_cad.approximate(face, tol, max_panels=max_panels)
+        n, direction, size = len(res.panels), res.direction, res.size
+        flat = sorted(p.area_flat for p in res.flat_pattern().panels)
+        step = write_step(panels_shell(res), tmp_path / "panels.step")
+    assert n <= max_panels
+    assert direction == "v"
     back = read_step(step)
     faces = shape_faces(back)
-    assert len(faces) == len(res.panels)
+    assert len(faces) == n
     # independent two-way deviation (OCCT distances), within tol (0.1 % for sampling)
     assert two_way(face, back) <= tol * 1.001
     # every exported panel developable
     assert max(twist_deg(f) for f in faces) <= 0.01
     # flat pattern areas = STEP face areas
-    pattern = res.flat_pattern()
-    flat = sorted(p.area_flat for p in pattern.panels)
     step_areas = sorted(face_area(f) for f in faces)
     for a, b in zip(flat, step_areas):
         assert abs(a - b) <= 1e-6 * b
     # watertight: one shell, every seam shared (no free edge but the two outer boundary circles/pole)
-    assert free_wires(back, 1e-6 * res.size) == 1  # only the rim circle (the pole is a point)
+    assert free_wires(back, 1e-6 * size) == 1  # only the rim circle (the pole is a point)
 
 
 @pytest.mark.slow
@@ -313,14 +338,10 @@ def test_hull_side():
 
 
 @pytest.mark.slow
-def test_cli_approximate(tmp_path):
-    from ght_cad.cad.occ import write_step
+def test_cli_approximate(cap_cli, tmp_path):
     from ght_cad.app.cli import main
 
-    step = write_step(cap_face(), tmp_path / "cap.step")
-    out = tmp_path / "out"
-    assert main(["approximate", str(step), "--tol", "1", "--out", str(out)]) == 0
-    rep = json.loads((out / "report.json").read_text())
+    _, step, out, rep = cap_cli
     assert rep["panels"] <= 14 and rep["max_deviation"] <= 1.0
     for name in ("panels.step", "flat.dxf", "flat.svg", "deviation.png", "report.md"):
         assert (out / name).stat().st_size > 0
