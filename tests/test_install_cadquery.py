@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from test_install import CADQUERY_SLOW_TESTS, CADQUERY_TESTS, TEST_TOOLS, ROOT, _pytest_in, _venv, _versions
+from test_install import CADQUERY_TESTS, TEST_TOOLS, _pytest_in, _venv, _versions
 
 
 @pytest.mark.slow
@@ -18,14 +18,14 @@ def test_cadquery_extra_works_on_ocp_7_9_without_build123d() -> None:
     """``.venv-cadquery``: ``pip install -e '.[cadquery]'`` gives cadquery 2.8 on OCP 7.9 (cadquery-ocp
     alone: no build123d, no second OCP distribution); the plugin's tests, tests/test_cq_world.py, the
     cadquery example and the cadquery halves of other modules pass there, none of them skipped."""
-    python = _venv(".venv-cadquery", ["-e", f"{ROOT}[cadquery]", *TEST_TOOLS])
+    python = _venv(".venv-cadquery", "cadquery", more=TEST_TOOLS)
     there = _versions(python)
     assert there["cadquery"].startswith("2.8") and there["cadquery-ocp"].startswith("7.9"), there
     assert "build123d" not in there and "cadquery-ocp-novtk" not in there, there
-    tails = [_pytest_in(python, CADQUERY_TESTS), _pytest_in(python, CADQUERY_SLOW_TESTS, marks="")]
-    assert all(" passed" in tail for tail in tails)
-    # none of the cadquery tests may skip there: only what needs build123d does (test_install.py's own
-    # build123d checks, the README's build123d blocks), and the host suite when GHT_CAD_HOST_SUITES=off asks
-    skipped = [line for tail in tails for line in tail.splitlines() if line.startswith("SKIPPED")]
+    tail = _pytest_in(python, CADQUERY_TESTS, marks="")
+    assert " passed" in tail
+    # none of the cadquery tests may skip there (they all skip in the main world): only what needs
+    # build123d may, and the host suite when GHT_CAD_HOST_SUITES=off asks
+    skipped = [line for line in tail.splitlines() if line.startswith("SKIPPED")]
     allowed = ("could not import 'build123d'", "GHT_CAD_HOST_SUITES=off")
     assert all(any(a in line for a in allowed) for line in skipped), skipped
