@@ -213,11 +213,30 @@ def _target_face():
     return make_face(BSplineSurfaceData(POLES, k, k, 2, 2))
 
 
+@pytest.fixture(scope="module")
+def facade_cli(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, dict]:
+    """``ght-cad approximate facade.step --tol 2 --max-panels 12 --thickness 3 --k-factor 0.4`` once
+    for the module (the STEP face of the example's target): (the STEP file, the output folder,
+    report.json). The same panels as without the sheet (the core runs first, the plates after):
+    :func:`test_example_run_through_the_code_of_ght_cad_approximate` compares them with
+    ``ght-cad run``'s, :func:`test_cli_approximate_thickness` checks the plates."""
+    pytest.importorskip("OCP")
+    from ght_cad.cad.occ import write_step
+
+    d = tmp_path_factory.mktemp("facade_cli")
+    step = write_step(_target_face(), d / "facade.step")
+    out = d / "out"
+    assert main(["approximate", str(step), "--tol", "2", "--max-panels", "12", "--thickness", "3",
+                 "--k-factor", "0.4", "--out", str(out)]) == 0
+    return step, out, json.loads((out / "report.json").read_text())
+
+
 @pytest.mark.slow
-def test_example_run_through_the_code_of_ght_cad_approximate(tmp_path: Path) -> None:
+def test_example_run_through_the_code_of_ght_cad_approximate(tmp_path: Path, facade_cli) -> None:
     """The example (NURBS target inline) and the same target as a STEP face, once through
     ``ght-cad run`` (design with a STEP target, path relative to the design file) and once through
-    ``ght-cad approximate``: the same panels; deviation within tol both ways by OCCT distances."""
+    ``ght-cad approximate`` (:func:`facade_cli`): the same panels; deviation within tol both ways by
+    OCCT distances."""
     pytest.importorskip("OCP")
     from test_approximate import face_area, two_way
 
@@ -251,9 +270,7 @@ def test_example_run_through_the_code_of_ght_cad_approximate(tmp_path: Path) -> 
     (tmp_path / "d.toml").write_text(_toml(d))
     assert main(["run", str(tmp_path / "d.toml"), "--out", str(tmp_path / "run2"), "--no-progress"]) == 0
     a2 = json.loads((tmp_path / "run2" / "report.json").read_text())["surface"]["approximation"]
-    assert main(["approximate", str(tmp_path / "facade.step"), "--tol", "2", "--max-panels", "12",
-                 "--out", str(tmp_path / "cli")]) == 0
-    a3 = json.loads((tmp_path / "cli" / "report.json").read_text())
+    a3 = facade_cli[2]
     assert a2["panels"] == a3["panels"] and a2["max_deviation"] == a3["max_deviation"]
     assert [p["area"] for p in a2["panel_report"]] == [p["area"] for p in a3["panel_report"]]
     # the STEP face is the inline patch: the same strips to the march's resolution
@@ -310,17 +327,10 @@ def test_sheet_plates_every_panel(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_cli_approximate_thickness(tmp_path: Path) -> None:
-    """``ght-cad approximate --thickness T --k-factor K``: one plate solid per panel in panels.step,
-    the flat patterns the neutral surfaces (the code the design's [sheet] runs)."""
-    pytest.importorskip("OCP")
-    from ght_cad.cad.occ import write_step
-
-    step = write_step(_target_face(), tmp_path / "facade.step")
-    out = tmp_path / "out"
-    assert main(["approximate", str(step), "--tol", "2", "--max-panels", "12", "--thickness", "3",
-                 "--k-factor", "0.4", "--out", str(out)]) == 0
-    rep = json.loads((out / "report.json").read_text())
+def test_cli_approximate_thickness(tmp_path: Path, facade_cli) -> None:
+    """``ght-cad approximate --thickness T --k-factor K`` (:func:`facade_cli`): one plate solid per
+    panel in panels.step, the flat patterns the neutral surfaces (the code the design's [sheet] runs)."""
+    step, out, rep = facade_cli
     assert rep["plate"]["solids"] == rep["panels"] and rep["sheet"]["thickness"] == 3.0
     area = sum(p["area"] for p in rep["panel_report"])
     assert abs(rep["plate"]["volume"] - 3.0 * area) <= 5e-3 * 3.0 * area
