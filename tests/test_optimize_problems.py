@@ -76,14 +76,22 @@ def test_strip_optimization_lowers_theta_max():
     assert after["R"] == pytest.approx(r.fun, rel=1e-12)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("opt", [igwo, pso])
-def test_strip_two_parameters_agree_with_dense_grid(opt):
-    """Over (a.mu, b.nu) a 161 x 161 grid cannot beat the optimizer by more than 1e-6 relative."""
+@pytest.fixture(scope="module")
+def strip_grid():
+    """The two-parameter strip problem over (a.mu, b.nu) and its values on a 161 x 161 grid
+    (evaluated once for both optimizers)."""
     p = default_strip_problem(free=("a.mu", "b.nu"))
     g = np.linspace(-1.0, 1.0, 161)
     G = np.array(np.meshgrid(g, g, indexing="ij")).reshape(2, -1).T
     v = np.concatenate([p(G[i : i + 4000]) for i in range(0, len(G), 4000)])
+    return p, g, G, v
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("opt", [igwo, pso])
+def test_strip_two_parameters_agree_with_dense_grid(opt, strip_grid):
+    """Over (a.mu, b.nu) a 161 x 161 grid cannot beat the optimizer by more than 1e-6 relative."""
+    p, g, G, v = strip_grid
     i = int(np.argmin(v))
     r = opt(p, p.bounds, pop_size=15, max_iter=40, seed=0)
     assert r.fun <= v[i] * (1.0 + 1e-6)

@@ -11,6 +11,7 @@ below 1e-9); ``|V - T A| <= (T²/2) ∫ |2H| dA`` always.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from pathlib import Path
@@ -164,7 +165,7 @@ def test_developable_bspline_of_a_loft_with_fans_at_a_tight_tolerance() -> None:
     valid face developable to 1e-3°."""
     from ght_cad.cad.developable_faces import developable_face, face_developability
 
-    loft = developable_loft(CHINE, SHEER)
+    loft = LOFTS["hull"]()
     assert [sg.kind for sg in loft.segments] == ["fan_b", "main", "fan_b"]
     data = developable_bspline(loft, tol=1.2e-7)
     assert data.info["spans"] <= 60 and data.max_deviation <= 1.2e-7
@@ -182,11 +183,20 @@ def test_developable_bspline_of_a_loft_with_fans_at_a_tight_tolerance() -> None:
 
 
 # -- plates -----------------------------------------------------------------------------------
-LOFTS = {
+_MAKE = {
     "hull": lambda: developable_loft(CHINE, SHEER),  # fan_b, main, fan_b; material on the normal side
     "hull_swapped": lambda: developable_loft(SHEER, CHINE),  # fan_a, main, fan_a; reverse side
     "hopper": lambda: developable_loft(*hopper_rails()),  # fan_a, planar triangle (b still), fan_a
 }
+
+
+@functools.lru_cache(maxsize=None)
+def _loft(name: str):
+    """The loft ``name`` of :data:`LOFTS`, built once in this module (the tests only read it)."""
+    return _MAKE[name]()
+
+
+LOFTS = {name: functools.partial(_loft, name) for name in _MAKE}
 
 
 @pytest.mark.slow
@@ -209,7 +219,7 @@ def test_material_on_the_concave_side_of_an_apex_stays_refused(name: str, side: 
 
 
 @pytest.mark.slow
-@settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(dz0=st.floats(-150.0, 150.0), dy0=st.floats(-150.0, 150.0), dx3=st.floats(-300.0, 300.0),
        dz3=st.floats(-150.0, 150.0), swap=st.booleans(), T=st.floats(0.5, 30.0), side=st.sampled_from(["normal", "reverse"]))
 def test_every_accepted_plate_of_a_loft_with_fans_is_exact(dz0, dy0, dx3, dz3, swap, T, side) -> None:
@@ -266,7 +276,7 @@ def test_plate_step_names_readers_and_unroll(tmp_path) -> None:
     from ght_cad.surfaces.bspline import curve_to_bspline
     from ght_cad.cad.occ import make_edge
 
-    loft, sheet = developable_loft(CHINE, SHEER), Sheet(4.0, 0.4)
+    loft, sheet = LOFTS["hull"](), Sheet(4.0, 0.4)
     plate = plate_solid(loft, sheet)
     path = write_plate_step(plate, tmp_path / "hull.step", extra=[make_edge(curve_to_bspline(CHINE))])
     shape, names = read_step_face_names(path)
@@ -301,7 +311,7 @@ def test_fan_face_unrolls_with_a_sheet() -> None:
     """A fan's face (its apex a collapsed pole row, normal undefined there) unrolls with a sheet:
     the neutral offset of the apex is the arc P + δ n (limit normal), the area the fan's own."""
     pytest.importorskip("build123d")
-    loft, sheet = developable_loft(CHINE, SHEER), Sheet(4.0, 0.4)
+    loft, sheet = LOFTS["hull"](), Sheet(4.0, 0.4)
     fan = loft.to_face().faces()[0]
     pat = unroll(fan, sheet=sheet)
     assert np.isfinite(pat.area)

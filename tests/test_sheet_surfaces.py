@@ -6,6 +6,7 @@ and ``ght-cad unroll model.step`` finding every plate's inside face."""
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 
@@ -55,7 +56,10 @@ figures = {figures}
     return text + ("\n[sheet]\n" + sheet if sheet is not None else "")
 
 
+@functools.lru_cache(maxsize=None)
 def _sheets(text: str):
+    """The design, built surfaces, surface sheets and rail joints of ``text``; built once per text
+    in this module (the tests only read them)."""
     from ght_cad.app.design import build_curves, build_surfaces, parse_design_text
     from ght_cad.app.design.shell_sheet import surface_sheets
 
