@@ -13,6 +13,7 @@ cadquery 2.8's sdist ships its test modules without ``tests/__init__.py`` (their
 from __future__ import annotations
 
 import importlib.metadata
+import json
 import os
 import subprocess
 import sys
@@ -86,24 +87,28 @@ def host_tests(package: str) -> Path:
     return src
 
 
-def outcomes(src: Path, modules: list[str], plugin: str | None, tmp: Path) -> dict[str, str]:
-    """Per test id: passed, failed, error or skipped, from a pytest run in a fresh interpreter."""
-    xml = tmp / f"{plugin or 'plain'}.xml"
+def outcomes(src: Path, modules: list[str], plugins: list[str | None], tmp: Path) -> list[dict[str, str]]:
+    """Per session (one per entry of ``plugins``: None = plain) and test id: passed, failed, error or
+    skipped. All sessions run one after the other in one fresh interpreter
+    (``host_suites/run_sessions.py``: the host is imported once); a plain session must come first
+    and runs before anything of ght_cad is imported."""
+    xmls = [tmp / f"{plugin or 'plain'}.xml" for plugin in plugins]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(PLUGINS), str(src)]))
-    args = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly", f"--junitxml={xml}",
-            "--rootdir", str(src), "-o", "addopts=", "-W", "default"]
-    if plugin:
-        args += ["-p", plugin]
+    args = [sys.executable, str(PLUGINS / "run_sessions.py"), json.dumps([[str(x), p] for x, p in zip(xmls, plugins)]),
+            "-q", "-p", "no:cacheprovider", "-p", "no:randomly", "--rootdir", str(src), "-o", "addopts=", "-W", "default"]
     run = subprocess.run(args + [str(src / m) for m in modules], cwd=src, env=env, capture_output=True, text=True,
                          timeout=1800)
-    if not xml.exists():
-        raise AssertionError(f"pytest did not run ({plugin}): {run.stdout[-1500:]} {run.stderr[-1500:]}")
-    out: dict[str, str] = {}
-    for case in ET.parse(xml).getroot().iter("testcase"):
-        kinds = {c.tag for c in case}
-        out[f"{case.get('classname')}::{case.get('name')}"] = (
-            "failed" if "failure" in kinds else "error" if "error" in kinds else "skipped" if "skipped" in kinds else "passed")
-    return out
+    results = []
+    for xml, plugin in zip(xmls, plugins):
+        if not xml.exists():
+            raise AssertionError(f"pytest did not run ({plugin}): {run.stdout[-1500:]} {run.stderr[-1500:]}")
+        out: dict[str, str] = {}
+        for case in ET.parse(xml).getroot().iter("testcase"):
+            kinds = {c.tag for c in case}
+            out[f"{case.get('classname')}::{case.get('name')}"] = (
+                "failed" if "failure" in kinds else "error" if "error" in kinds else "skipped" if "skipped" in kinds else "passed")
+        results.append(out)
+    return results
 
 
 def _differences(base: dict[str, str], other: dict[str, str]) -> list[str]:
@@ -114,14 +119,15 @@ def test_build123d_clean_history_algebra_tests_inside_exact_edges_and_with_the_p
     """Same outcome per test: plain, with ght_cad's adapters imported, and every test inside
     ``exact_edges()`` (history merged, "Unable to clean" warned, nested SkipClean respected)."""
     src = host_tests("build123d")
-    base = outcomes(src, BUILD123D_MODULES, None, tmp_path)
+    plugins = ["ght_plugin_imported", "ght_plugin_exact_edges"]
+    base, *others = outcomes(src, BUILD123D_MODULES, [None, *plugins], tmp_path)
     assert len(base) >= 100, sorted(base)[:5]
-    for plugin in ("ght_plugin_imported", "ght_plugin_exact_edges"):
-        assert _differences(base, outcomes(src, BUILD123D_MODULES, plugin, tmp_path)) == [], plugin
+    for plugin, other in zip(plugins, others):
+        assert _differences(base, other) == [], plugin
 
 
 def test_cadquery_workplane_tests_with_the_plugin(tmp_path):
     src = host_tests("cadquery")
-    base = outcomes(src, CADQUERY_MODULES, None, tmp_path)
+    base, other = outcomes(src, CADQUERY_MODULES, [None, "ght_plugin_imported"], tmp_path)
     assert len(base) >= 15 and list(base.values()).count("passed") >= 15, base
-    assert _differences(base, outcomes(src, CADQUERY_MODULES, "ght_plugin_imported", tmp_path)) == []
+    assert _differences(base, other) == []
