@@ -32,6 +32,7 @@ import json
 import os
 import re
 import sys
+import time
 import traceback
 
 import FreeCAD as App
@@ -159,6 +160,7 @@ def step(name, fn, allow=()):
     step with an allowed error.
     """
     mark = WATCH.mark()
+    t0 = time.perf_counter()
     try:
         value = fn()
         entry = {"name": name, "ok": True, "value": value}
@@ -167,6 +169,7 @@ def step(name, fn, allow=()):
     finally:
         if Gui.Control.activeDialog():
             Gui.Control.closeDialog()
+    entry["seconds"] = round(time.perf_counter() - t0, 3)  # where the GUI check spends its time
     lines = WATCH.since(mark)
     entry["report_errors"] = lines
     entry["tracebacks"] = [l for l in lines if TRACEBACK_RE.search(l.split(": ", 1)[-1])]
