@@ -69,7 +69,7 @@ FOREIGN_NODES = re.compile(r"legendre\.leggauss|roots_legendre|fixed_quad|specia
 def _violations(rel: str, text: str) -> list[str]:
     """What in the module ``rel`` bypasses the helper or the cache scheme: a node construction of
     numpy/scipy, ``functools.lru_cache``/``functools.cache`` (decorator or import), a module-level
-    global whose name says cache."""
+    global whose name says cache or memo."""
     bad = [f"{rel}: Gauss–Legendre nodes by {m.group(0)!r}" for m in FOREIGN_NODES.finditer(text)]
     tree = ast.parse(text, filename=rel)
     for node in ast.walk(tree):
@@ -79,12 +79,12 @@ def _violations(rel: str, text: str) -> list[str]:
         if isinstance(node, ast.ImportFrom) and node.module == "functools":
             bad += [f"{rel}:{node.lineno}: from functools import {a.name}" for a in node.names
                     if a.name in ("lru_cache", "cache")]
-    for stmt in tree.body:  # a global container named *cache* (its size limits, plain numbers, may stay)
+    for stmt in tree.body:  # a global container named *cache* or *memo* (its size limits, plain numbers, may stay)
         targets = stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target] if isinstance(stmt, ast.AnnAssign) else []
         if isinstance(getattr(stmt, "value", None), (ast.Constant, ast.UnaryOp, ast.BinOp)):
             continue
         bad += [f"{rel}:{stmt.lineno}: module-level cache {t.id}" for t in targets
-                if isinstance(t, ast.Name) and "cache" in t.id.lower()]
+                if isinstance(t, ast.Name) and ("cache" in t.id.lower() or "memo" in t.id.lower())]
     return bad
 
 
@@ -105,11 +105,11 @@ def test_the_guard_sees_what_it_forbids() -> None:
         "import functools\nfrom functools import lru_cache\nimport numpy as np\n"
         "@functools.lru_cache(8)\ndef f(n): return np.polynomial.legendre.leggauss(n)\n"
         "@functools.cache\ndef g(n): return scipy.special.roots_legendre(n)\n"
-        "_X_CACHE: dict = {}\n_jet_cache = weakref.WeakKeyDictionary()\n"
+        "_X_CACHE: dict = {}\n_jet_cache = weakref.WeakKeyDictionary()\n_BASIS_MEMO: dict = {}\n"
     )
     found = _violations("m.py", bad)
     for what in ("legendre.leggauss", "roots_legendre", "functools.lru_cache", "functools.cache",
-                 "import lru_cache", "cache _X_CACHE", "cache _jet_cache"):
+                 "import lru_cache", "cache _X_CACHE", "cache _jet_cache", "cache _BASIS_MEMO"):
         assert any(what in v for v in found), (what, found)
     good = "from ..core._cache import readonly_cache\n_CACHE_SIZE = 8\n@readonly_cache(maxsize=_CACHE_SIZE)\ndef f(n): return n\n"
     assert _violations("m.py", good) == []

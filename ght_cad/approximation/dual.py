@@ -39,12 +39,12 @@ the half range ``(max h - min h) / 2`` (the deviation after centring) with
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ..core._cache import readonly_cache
 from ..curves.basis import basis
 
 __all__ = ["DualFit", "PlaneSamples", "tangent_planes", "fit_dual_planes", "normal_hits", "fit_strip", "check_optimizer"]
@@ -97,30 +97,28 @@ def tangent_planes(frame: Any, x: np.ndarray, y: float, ell: float) -> PlaneSamp
     return PlaneSamples(_t_of_x(x), c, n, nx / (1.0 - 2.0 * _T_PAD), c.mean(axis=0), float(ell))
 
 
-#: the last basis matrices of :func:`_basis_pair`, by (t's bytes, m, (μ, ν, γ), k)
-_BASIS_MEMO: dict[tuple[Any, ...], list[np.ndarray]] = {}
-_BASIS_MEMO_SIZE = 64
-_BASIS_LOCK = threading.Lock()
+#: how many argument tuples of :func:`_basis_matrices` are kept (least recently used dropped first)
+_BASIS_CACHE_SIZE = 64
+
+
+@readonly_cache(maxsize=_BASIS_CACHE_SIZE)
+def _basis_matrices(t_bytes: bytes, shape: tuple[int, ...], m: int, p_bytes: bytes, k: int) -> tuple[np.ndarray, ...]:
+    """``(b^{(0)}_{i,m}(t; μ, ν, γ), ..., b^{(k)})`` for ``t`` and ``(μ, ν, γ)`` given by their bytes
+    (the cache key of the project's one scheme, :func:`ght_cad.core._cache.readonly_cache`)."""
+    t = np.frombuffer(t_bytes, dtype=float).reshape(shape)
+    mu, nu, gamma = np.frombuffer(p_bytes, dtype=float)
+    return tuple(basis(t, m, float(mu), float(nu), float(gamma), derivative=r) for r in range(k + 1))
 
 
 def _basis_pair(t: np.ndarray, m: int, p: tuple[float, float, float], k: int = 1) -> list[np.ndarray]:
     """``[b^{(0)}_{i,m}(t; μ, ν, γ), ..., b^{(k)}]`` (read-only arrays), remembered for the last
-    :data:`_BASIS_MEMO_SIZE` arguments: a strip's fit measures the same (μ, ν, γ) at the same
+    :data:`_BASIS_CACHE_SIZE` arguments: a strip's fit measures the same (μ, ν, γ) at the same
     parameters several times (``centred``: the plane fit and the normal hits of every pass; the
     saddle: 1,245 calls, 418 distinct, 70 % of the basis time). The values are those a new
-    evaluation gives, bit for bit."""
-    t = np.asarray(t, dtype=float)
-    key = (t.tobytes(), t.shape, int(m), np.asarray(p, dtype=float).tobytes(), int(k))
-    hit = _BASIS_MEMO.get(key)
-    if hit is None:
-        hit = [basis(t, m, *p, derivative=r) for r in range(k + 1)]
-        for b in hit:
-            b.setflags(write=False)
-        with _BASIS_LOCK:
-            while len(_BASIS_MEMO) >= _BASIS_MEMO_SIZE:
-                _BASIS_MEMO.pop(next(iter(_BASIS_MEMO)))  # the oldest entry
-            _BASIS_MEMO[key] = hit
-    return list(hit)
+    evaluation gives, bit for bit (the key is the arguments' bytes)."""
+    t = np.ascontiguousarray(t, dtype=float)
+    p_bytes = np.asarray(p, dtype=float).reshape(3).tobytes()
+    return list(_basis_matrices(t.tobytes(), t.shape, int(m), p_bytes, int(k)))
 
 
 def fit_dual_planes(ps: PlaneSamples, degree: int, params: tuple[float, float, float],
